@@ -1,0 +1,79 @@
+# Makefile for libmech and the `mech` command line.
+#   make            build build/libmech.a and build/mech (warnings are errors)
+#   make deps       install missing Debian packages (apt-get; tools/deps.sh)
+#   make run        deps + build + the main job (see README)
+#   make test       deps + build + the full test suite
+#   make test-san   the test suite built with -fsanitize=address,undefined
+#   make install PREFIX=/usr/local
+#   make clean
+CC      ?= cc
+PREFIX  ?= /usr/local
+BUILD   ?= build
+OPT     ?= -O2 -g
+SAN     ?=
+CFLAGS_BASE = -std=c11 -Wall -Wextra -Werror -Wshadow -Wstrict-prototypes \
+              -Wmissing-prototypes -Wno-missing-field-initializers -D_POSIX_C_SOURCE=200809L
+# SuiteSparse KLU: pkg-config when a .pc exists, else the Debian 12 layout.
+KLU_CFLAGS := $(shell pkg-config --cflags klu 2>/dev/null || echo -I/usr/include/suitesparse)
+KLU_LIBS   := $(shell pkg-config --libs klu 2>/dev/null || echo -lklu -lbtf -lamd -lcolamd -lsuitesparseconfig)
+YAML_CFLAGS := $(shell pkg-config --cflags yaml-0.1 2>/dev/null)
+YAML_LIBS   := $(shell pkg-config --libs yaml-0.1 2>/dev/null || echo -lyaml)
+CRIT_LIBS   := $(shell pkg-config --libs criterion 2>/dev/null || echo -lcriterion)
+
+CFLAGS  = $(CFLAGS_BASE) $(OPT) $(SAN) -Iinclude $(YAML_CFLAGS) $(KLU_CFLAGS)
+LDLIBS  = $(YAML_LIBS) $(KLU_LIBS) -lm
+LDFLAGS = $(SAN)
+
+LIB_SRC  = $(filter-out src/main.c,$(wildcard src/*.c))
+LIB_OBJ  = $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o)
+TEST_SRC = $(wildcard tests/unit/*.c)
+TEST_OBJ = $(TEST_SRC:tests/unit/%.c=$(BUILD)/tests/%.o)
+
+.PHONY: all deps run test test-san check-mechanisms install clean
+
+all: $(BUILD)/mech
+
+$(BUILD)/obj/%.o: src/%.c include/mech.h src/internal.h | $(BUILD)/obj
+	$(CC) $(CFLAGS) -c $< -o $@
+
+$(BUILD)/libmech.a: $(LIB_OBJ)
+	rm -f $@
+	ar rcs $@ $^
+
+$(BUILD)/mech: $(BUILD)/obj/main.o $(BUILD)/libmech.a
+	$(CC) $(LDFLAGS) -o $@ $^ $(LDLIBS)
+
+$(BUILD)/tests/%.o: tests/unit/%.c include/mech.h src/internal.h | $(BUILD)/tests
+	$(CC) $(CFLAGS) -Isrc -c $< -o $@
+
+$(BUILD)/unit-tests: $(TEST_OBJ) $(BUILD)/libmech.a
+	$(CC) $(LDFLAGS) -o $@ $^ $(CRIT_LIBS) $(LDLIBS)
+
+$(BUILD)/obj $(BUILD)/tests:
+	mkdir -p $@
+
+deps:
+	@sh tools/deps.sh
+
+# The main job: validate every mechanism file (until the solver exists).
+run: deps
+	@$(MAKE) --no-print-directory all
+	$(BUILD)/mech check mechanisms/*.yaml
+
+test: deps
+	@$(MAKE) --no-print-directory $(BUILD)/mech $(BUILD)/unit-tests
+	$(BUILD)/unit-tests --jobs 2
+	MECH=$(BUILD)/mech sh tests/cli.sh
+
+test-san:
+	@$(MAKE) --no-print-directory test BUILD=build/san OPT="-O1 -g -fno-omit-frame-pointer" \
+	    SAN="-fsanitize=address,undefined -fno-sanitize-recover=all"
+
+install: all
+	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib $(DESTDIR)$(PREFIX)/include
+	install -m 755 $(BUILD)/mech $(DESTDIR)$(PREFIX)/bin/mech
+	install -m 644 $(BUILD)/libmech.a $(DESTDIR)$(PREFIX)/lib/libmech.a
+	install -m 644 include/mech.h $(DESTDIR)$(PREFIX)/include/mech.h
+
+clean:
+	rm -rf build

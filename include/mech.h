@@ -1,0 +1,228 @@
+/* include/mech.h: public API of libmech, a declarative planar-mechanism
+ * interpreter (YAML file -> model -> loop equations -> solutions).
+ *
+ * Three kinds of data are kept apart (see docs/architecture.md):
+ *   the model   (this header: what the file says, in SI units, fixed after load),
+ *   the system  (equations, tape, sparsity pattern; built once),
+ *   the state   (positions, velocities, ...; changes every crank step).
+ *
+ * Ownership: every mech_*_new / mech_load_* result is released by the matching
+ * mech_*_free, which accepts NULL. */
+#ifndef MECH_H
+#define MECH_H
+
+#include <stddef.h>
+#include <stdio.h>
+
+#define MECH_VERSION "0.1.0"
+
+/* Status codes returned by library calls: 0 success, < 0 failure. */
+enum {
+    MECH_OK = 0,
+    MECH_EINPUT = -1,  /* the file or the mechanism is invalid */
+    MECH_ENOMEM = -2,  /* out of memory */
+    MECH_EIO = -3,     /* cannot read or write a file */
+    MECH_ESOLVE = -4   /* numerical failure (no assembly, singular position) */
+};
+
+/* ------------------------------------------------------------------ */
+/* Diagnostics: every problem found, with its place in the input.      */
+
+typedef enum { MECH_SEV_ERROR, MECH_SEV_WARNING, MECH_SEV_NOTE } mech_severity;
+
+/* A place in an input file; line and col are 1-based, 0 means "unknown". */
+typedef struct mech_mark {
+    int line;
+    int col;
+} mech_mark;
+
+typedef struct mech_diag_entry {
+    mech_severity severity;
+    char *file;          /* file name as given, owned */
+    mech_mark mark;
+    char *message;       /* one sentence, no trailing newline, owned */
+} mech_diag_entry;
+
+typedef struct mech_diag {
+    mech_diag_entry *entries; /* [count] in the order found */
+    size_t count;
+    size_t capacity;
+    size_t nerrors;           /* entries with severity ERROR */
+    size_t max_errors;        /* stop recording errors after this many (0 = 100) */
+    int truncated;            /* 1 when errors were dropped */
+} mech_diag;
+
+void mech_diag_init(mech_diag *d);
+void mech_diag_free(mech_diag *d);
+/* Print "file:line:col: error: message" lines, one per entry. */
+void mech_diag_print(const mech_diag *d, FILE *out);
+
+/* ------------------------------------------------------------------ */
+/* The model: everything in SI units (m, rad, kg, s, N).               */
+
+typedef struct mech_point {
+    char *name;     /* owned */
+    int id;         /* index into mech_model.point_names (shared names = same pin) */
+    double x, y;    /* in the link's own frame, m */
+    mech_mark mark;
+} mech_point;
+
+typedef struct mech_link {
+    char *name;          /* owned; the ground link is always links[0], named "ground" */
+    char *symbol;        /* printing symbol of the link angle, or NULL */
+    int is_ground;
+    mech_point *points;  /* [npoints] */
+    int npoints;
+    int has_mass;        /* mass/center/inertia were given */
+    double mass;         /* kg */
+    double center[2];    /* centre of mass in the link frame, m */
+    double inertia;      /* about the centre of mass, kg*m^2 */
+    mech_mark mark;
+} mech_link;
+
+typedef enum { MECH_JOINT_REVOLUTE, MECH_JOINT_SLIDER } mech_joint_kind;
+
+typedef struct mech_joint {
+    mech_joint_kind kind;
+    char *name;        /* owned; default: point name (revolute), "s_<point>" (slider) */
+    char *symbol;      /* printing symbol of the slider displacement, or NULL */
+    int link[2];       /* revolute: the two links; slider: [0] sliding link, [1] guide */
+    int point[2];      /* point index in link[0] and link[1]; for a slider, [1] is the
+                          guide's `through` point */
+    double angle;      /* slider: line direction in the guide's frame, rad */
+    int locked;        /* slider: 1 = prismatic (no relative rotation), 0 = pin in slot */
+    double friction;   /* Coulomb coefficient, 0 if none */
+    double pin_radius; /* revolute: pin radius for the friction moment, m */
+    int is_explicit;   /* listed under joints: (else implied by a shared point name) */
+    mech_mark mark;
+} mech_joint;
+
+typedef enum { MECH_DRIVE_ANGLE, MECH_DRIVE_SLIDER } mech_drive_kind;
+
+typedef struct mech_driver {
+    mech_drive_kind kind;
+    int index;         /* link index (ANGLE) or joint index (SLIDER) */
+    double *values;    /* [nvalues] driver positions, rad or m */
+    int nvalues;
+    double speed;      /* rad/s or m/s */
+    double accel;      /* rad/s^2 or m/s^2 */
+    mech_mark mark;
+} mech_driver;
+
+typedef struct mech_guess {
+    int is_slider;     /* 0: link angle, 1: slider displacement */
+    int index;         /* link or joint index */
+    double value;      /* rad or m */
+    mech_mark mark;
+} mech_guess;
+
+/* Assembly branch: the turn A->B->C must be counter-clockwise (sign +1) or
+ * clockwise (sign -1); points are name ids. */
+typedef struct mech_branch {
+    int point[3];
+    int sign;
+    mech_mark mark;
+} mech_branch;
+
+typedef struct mech_loop {
+    int *points;       /* [npoints] name ids, first == last */
+    int npoints;
+    mech_mark mark;
+    mech_mark *marks;  /* [npoints] place of each name */
+} mech_loop;
+
+typedef enum { MECH_LOAD_FORCE, MECH_LOAD_TORQUE, MECH_LOAD_DISTRIBUTED } mech_load_kind;
+
+typedef struct mech_load {
+    mech_load_kind kind;
+    int link;
+    int point[2];      /* FORCE: [0] point of application; DISTRIBUTED: from, to */
+    double force[2];   /* FORCE: N, in the ground frame */
+    double torque;     /* TORQUE: N*m, counter-clockwise positive */
+    double intensity;  /* DISTRIBUTED: N/m along the segment */
+    double direction;  /* DISTRIBUTED: direction of the load in the ground frame, rad */
+    mech_mark mark;
+} mech_load;
+
+typedef struct mech_param {
+    char *name;
+    double value;      /* SI, or a pure number */
+    mech_mark mark;
+} mech_param;
+
+typedef struct mech_outputs {
+    int *points;       /* [npoints] name ids */
+    int npoints;
+    int *links;        /* [nlinks] link indices */
+    int nlinks;
+    int *sliders;      /* [nsliders] joint indices */
+    int nsliders;
+    int forces;        /* joint reactions and driver torque wanted */
+} mech_outputs;
+
+typedef struct mech_model {
+    char *file;           /* path as given */
+    char *name;
+    char *description;    /* or NULL */
+    double gravity[2];    /* m/s^2 */
+    mech_param *params;   /* [nparams] */
+    int nparams;
+    mech_link *links;     /* [nlinks]; links[0] is the ground */
+    int nlinks;
+    mech_joint *joints;   /* [njoints] */
+    int njoints;
+    char **point_names;   /* [npoint_names] distinct point names */
+    int npoint_names;
+    int has_driver;
+    mech_driver driver;
+    mech_guess *guesses;  /* [nguesses] */
+    int nguesses;
+    mech_branch *branches;/* [nbranches] */
+    int nbranches;
+    mech_loop *loops;     /* [nloops] explicit loops (may be 0: found automatically) */
+    int nloops;
+    mech_load *loads;     /* [nloads] */
+    int nloads;
+    mech_outputs outputs;
+} mech_model;
+
+/* Read and validate a mechanism file. On success *out is the model and the
+ * result is MECH_OK; otherwise *out is NULL and d holds every error found. */
+int mech_load_file(const char *path, mech_model **out, mech_diag *d);
+/* Same, from memory; `name` is used in messages. */
+int mech_load_string(const char *text, size_t len, const char *name,
+                     mech_model **out, mech_diag *d);
+void mech_model_free(mech_model **m);
+
+int mech_find_link(const mech_model *m, const char *name);   /* index or -1 */
+int mech_find_joint(const mech_model *m, const char *name);  /* index or -1 */
+int mech_find_point(const mech_model *m, const char *name);  /* name id or -1 */
+
+/* ------------------------------------------------------------------ */
+/* Structure: counts and the Gruebler-Kutzbach mobility.               */
+
+typedef struct mech_summary {
+    int nlinks;           /* including the ground */
+    int nrevolute;
+    int nprismatic;       /* locked sliders: 2 constraints each */
+    int npin_in_slot;     /* free sliders: 1 constraint each */
+    int nunknowns;        /* link angles + slider displacements, driver excluded */
+    int nloops;           /* independent loops = joints - links + 1 */
+    int nequations;       /* 2 * nloops */
+    int mobility;         /* 3 (n - 1) - 2 j_full - j_half */
+    int ndrivers;
+} mech_summary;
+
+/* Check the topology (connectivity, mobility, unknowns against equations).
+ * Fills *s even on failure; errors name the links or joints involved. */
+int mech_check(const mech_model *m, mech_summary *s, mech_diag *d);
+
+/* Exit codes of the `mech` program. */
+enum {
+    MECH_EXIT_OK = 0,
+    MECH_EXIT_SOLVE = 1,  /* input fine, but the mechanism could not be solved */
+    MECH_EXIT_INPUT = 2,  /* bad usage or bad input */
+    MECH_EXIT_IO = 3      /* cannot read or write a file */
+};
+
+#endif /* MECH_H */

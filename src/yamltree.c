@@ -1,0 +1,229 @@
+/* src/yamltree.c: turn libyaml's event stream into a small document tree
+ * with a mark on every node, under fixed limits (input is untrusted).
+ * The only file that includes <yaml.h>. */
+#include <stdlib.h>
+#include <string.h>
+#include <yaml.h>
+
+#include "internal.h"
+
+const yaml_limits yaml_default_limits = {
+    .max_bytes = 64u << 20,   /* 64 MiB: a chain of 100 000 loops is ~20 MiB */
+    .max_depth = 32,
+    .max_nodes = 8u << 20,
+    .max_scalar = 4096,
+};
+
+typedef struct builder {
+    const char *file;
+    const yaml_limits *lim;
+    mech_diag *d;
+    size_t nodes;
+    ynode *stack[64];  /* open collections; depth bounded by lim->max_depth <= 64 */
+    int depth;
+    ynode *root;
+} builder;
+
+static mech_mark mark_of(yaml_mark_t m)
+{
+    return (mech_mark){(int)m.line + 1, (int)m.column + 1};  /* libyaml is 0-based */
+}
+
+const char *ynode_kind_name(ynode_kind k)
+{
+    switch (k) {
+    case YNODE_SCALAR: return "a single value";
+    case YNODE_SEQ: return "a list";
+    case YNODE_MAP: return "a mapping";
+    }
+    return "?";
+}
+
+void ytree_free(ynode *n)
+{
+    if (!n)
+        return;
+    for (size_t i = 0; i < n->nraw; i++)
+        ytree_free(n->items[i]);
+    free(n->items);
+    free(n->text);
+    free(n);
+}
+
+ynode *ymap_get(const ynode *map, const char *key)
+{
+    if (!map || map->kind != YNODE_MAP)
+        return NULL;
+    for (size_t i = 0; i < map->n; i++) {
+        const ynode *k = map->items[2 * i];
+        if (k->kind == YNODE_SCALAR && strcmp(k->text, key) == 0)
+            return map->items[2 * i + 1];
+    }
+    return NULL;
+}
+
+/* Items arrive one by one (for a mapping: key, value, key, ...); `nraw`
+ * counts them until the collection closes, when `n` is set. */
+static int append(ynode *parent, ynode *child)
+{
+    size_t count = parent->nraw;
+    /* grow by doubling: capacity is the next power of two >= count + 1 */
+    if ((count & (count - 1)) == 0) {
+        ynode **items = xrealloc_array(parent->items, count ? 2 * count : 2, sizeof *items);
+        if (!items)
+            return -1;
+        parent->items = items;
+    }
+    parent->items[parent->nraw++] = child;
+    parent->n = parent->kind == YNODE_MAP ? parent->nraw / 2 : parent->nraw;
+    return 0;
+}
+
+/* Attach a finished node to the open collection (or make it the root). */
+static int attach(builder *b, ynode *n)
+{
+    if (b->depth == 0) {
+        b->root = n;
+        return 0;
+    }
+    if (append(b->stack[b->depth - 1], n) < 0) {
+        ytree_free(n);
+        return -1;
+    }
+    return 0;
+}
+
+static ynode *new_node(builder *b, ynode_kind kind, yaml_mark_t m)
+{
+    if (++b->nodes > b->lim->max_nodes) {
+        diag_error(b->d, b->file, mark_of(m), "file too large: more than %zu YAML nodes",
+                   b->lim->max_nodes);
+        return NULL;
+    }
+    ynode *n = xcalloc(1, sizeof *n);
+    if (!n) {
+        diag_error(b->d, b->file, mark_of(m), "out of memory");
+        return NULL;
+    }
+    n->kind = kind;
+    n->mark = mark_of(m);
+    return n;
+}
+
+static int on_scalar(builder *b, const yaml_event_t *ev)
+{
+    if (ev->data.scalar.length > b->lim->max_scalar) {
+        diag_error(b->d, b->file, mark_of(ev->start_mark),
+                   "value too long (%zu bytes; at most %zu)", (size_t)ev->data.scalar.length,
+                   b->lim->max_scalar);
+        return -1;
+    }
+    ynode *n = new_node(b, YNODE_SCALAR, ev->start_mark);
+    if (!n)
+        return -1;
+    n->len = ev->data.scalar.length;
+    n->text = malloc(n->len + 1);
+    if (!n->text) {
+        mech_mark at = n->mark;
+        free(n);
+        return diag_error(b->d, b->file, at, "out of memory");
+    }
+    memcpy(n->text, ev->data.scalar.value, n->len);
+    n->text[n->len] = '\0';
+    if (strlen(n->text) != n->len) {
+        mech_mark at = n->mark;
+        ytree_free(n);
+        return diag_error(b->d, b->file, at, "value contains a NUL character");
+    }
+    n->quoted = ev->data.scalar.style != YAML_PLAIN_SCALAR_STYLE;
+    return attach(b, n);
+}
+
+static int on_open(builder *b, const yaml_event_t *ev, ynode_kind kind)
+{
+    if (b->depth >= b->lim->max_depth || b->depth >= 64)
+        return diag_error(b->d, b->file, mark_of(ev->start_mark),
+                          "nesting too deep (more than %d levels)", b->lim->max_depth);
+    ynode *n = new_node(b, kind, ev->start_mark);
+    if (!n)
+        return -1;
+    if (attach(b, n) < 0)
+        return diag_error(b->d, b->file, n->mark, "out of memory");
+    b->stack[b->depth++] = n;
+    return 0;
+}
+
+static void on_close(builder *b) { b->depth--; }
+
+static int parser_error(builder *b, const yaml_parser_t *p)
+{
+    mech_mark at = mark_of(p->problem_mark);
+    const char *problem = p->problem ? p->problem : "malformed YAML";
+    if (p->context)
+        return diag_error(b->d, b->file, at, "YAML syntax: %s %s (line %d)", problem,
+                          p->context, (int)p->context_mark.line + 1);
+    return diag_error(b->d, b->file, at, "YAML syntax: %s", problem);
+}
+
+static int handle(builder *b, const yaml_event_t *ev, int *ndocs)
+{
+    switch (ev->type) {
+    case YAML_DOCUMENT_START_EVENT:
+        if (++*ndocs > 1)
+            return diag_error(b->d, b->file, mark_of(ev->start_mark),
+                              "more than one YAML document ('---'); a file holds one mechanism");
+        return 0;
+    case YAML_ALIAS_EVENT:
+        return diag_error(b->d, b->file, mark_of(ev->start_mark),
+                          "YAML aliases (*name) are not supported; write the value out");
+    case YAML_SCALAR_EVENT:
+        return on_scalar(b, ev);
+    case YAML_SEQUENCE_START_EVENT:
+        return on_open(b, ev, YNODE_SEQ);
+    case YAML_MAPPING_START_EVENT:
+        return on_open(b, ev, YNODE_MAP);
+    case YAML_SEQUENCE_END_EVENT:
+    case YAML_MAPPING_END_EVENT:
+        on_close(b);
+        return 0;
+    default:
+        return 0;
+    }
+}
+
+ynode *ytree_parse(const char *text, size_t len, const char *file, const yaml_limits *lim,
+                   mech_diag *d)
+{
+    builder b = {file, lim ? lim : &yaml_default_limits, d, 0, {0}, 0, NULL};
+    if (len > b.lim->max_bytes) {
+        diag_error(d, file, (mech_mark){0, 0}, "file too large (%zu bytes; at most %zu)", len,
+                   b.lim->max_bytes);
+        return NULL;
+    }
+    yaml_parser_t parser;
+    if (!yaml_parser_initialize(&parser)) {
+        diag_error(d, file, (mech_mark){0, 0}, "out of memory");
+        return NULL;
+    }
+    yaml_parser_set_input_string(&parser, (const unsigned char *)text, len);
+    int ndocs = 0, rc = 0, done = 0;
+    while (!done && rc == 0) {
+        yaml_event_t ev;
+        if (!yaml_parser_parse(&parser, &ev)) {
+            rc = parser_error(&b, &parser);
+            break;
+        }
+        done = ev.type == YAML_STREAM_END_EVENT;
+        rc = handle(&b, &ev, &ndocs);
+        yaml_event_delete(&ev);
+    }
+    yaml_parser_delete(&parser);
+    if (rc != 0) {
+        ytree_free(b.root);
+        return NULL;
+    }
+    if (!b.root)
+        diag_error(d, file, (mech_mark){1, 1}, "empty file: expected a mapping with 'name', "
+                                               "'ground', 'links' and 'driver'");
+    return b.root;
+}
