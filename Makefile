@@ -33,7 +33,9 @@ TEST_OBJ = $(TEST_SRC:tests/unit/%.c=$(BUILD)/tests/%.o)
 
 all: $(BUILD)/mech
 
-$(BUILD)/obj/%.o: src/%.c include/mech.h src/internal.h | $(BUILD)/obj
+HEADERS = include/mech.h $(wildcard src/*.h)
+
+$(BUILD)/obj/%.o: src/%.c $(HEADERS) | $(BUILD)/obj
 	$(CC) $(CFLAGS) -c $< -o $@
 
 $(BUILD)/libmech.a: $(LIB_OBJ)
@@ -43,7 +45,7 @@ $(BUILD)/libmech.a: $(LIB_OBJ)
 $(BUILD)/mech: $(BUILD)/obj/main.o $(BUILD)/libmech.a
 	$(CC) $(LDFLAGS) -o $@ $^ $(LDLIBS)
 
-$(BUILD)/tests/%.o: tests/unit/%.c include/mech.h src/internal.h | $(BUILD)/tests
+$(BUILD)/tests/%.o: tests/unit/%.c $(HEADERS) | $(BUILD)/tests
 	$(CC) $(CFLAGS) -Isrc -c $< -o $@
 
 $(BUILD)/unit-tests: $(TEST_OBJ) $(BUILD)/libmech.a

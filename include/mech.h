@@ -217,6 +217,22 @@ typedef struct mech_summary {
  * Fills *s even on failure; errors name the links or joints involved. */
 int mech_check(const mech_model *m, mech_summary *s, mech_diag *d);
 
+/* ------------------------------------------------------------------ */
+/* The equation system: unknowns, loop equations, symbolic derivatives */
+/* and their compiled evaluator, built once per mechanism.             */
+
+typedef struct mech_system mech_system;
+
+/* Build the system of a checked model (the model must outlive it). */
+int mech_system_new(const mech_model *m, mech_system **out, mech_diag *d);
+void mech_system_free(mech_system **s);
+int mech_system_size(const mech_system *s);   /* number of unknowns */
+
+typedef enum { MECH_FORMAT_TEXT, MECH_FORMAT_LATEX } mech_format;
+/* Print unknowns, loops, position equations, Jacobian nonzeros and the
+ * velocity and acceleration right-hand sides. */
+void mech_system_print(const mech_system *s, mech_format fmt, FILE *out);
+
 /* Exit codes of the `mech` program. */
 enum {
     MECH_EXIT_OK = 0,

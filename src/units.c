@@ -309,7 +309,21 @@ static qval parse_number(qparser *p)
     if (!unit_parse(u, &scale, &d, &uend)) {
         char word[64];
         snprintf(word, sizeof word, "%.*s", (int)(n < 40 ? n : 40), u);
-        qfail(p, u, "unknown unit '%s'", word);
+        const char *names[NUNITS];
+        for (size_t i = 0; i < NUNITS; i++)
+            names[i] = unit_table[i].name;
+        const char *near = nearest_name(word, names, NUNITS);
+        if (near)
+            qfail(p, u, "unknown unit '%s' (did you mean '%s'?)", word, near);
+        else {
+            char known[160];
+            size_t k = 0;
+            known[0] = '\0';
+            for (size_t i = 0; i < NUNITS && k < sizeof known; i++)
+                k += (size_t)snprintf(known + k, sizeof known - k, "%s%s", i ? " " : "",
+                                      names[i]);
+            qfail(p, u, "unknown unit '%s' (known units: %s)", word, known);
+        }
         return make_bare(v);
     }
     p->s = uend;
@@ -427,7 +441,8 @@ static qval parse_atom(qparser *p)
         if (unit_lookup(at, n))
             qfail(p, at, "unit '%.*s' without a number (write 1 %.*s)", (int)n, at, (int)n, at);
         else
-            qfail(p, at, "unknown name '%.*s' (not a parameter)", (int)(n < 64 ? n : 64), at);
+            qfail(p, at, "unknown name '%.*s' (not a unit, a function, or a parameter defined "
+                         "above)", (int)(n < 64 ? n : 64), at);
         return make_bare(0);
     }
     if (*at == '\0') {

@@ -67,10 +67,13 @@ const char *nearest_name(const char *word, const char *const *names, size_t n)
             best = names[i];
         }
     }
-    /* a typo: at most a third of the word wrong, and at least one letter right */
+    /* a typo: at most a third of the word wrong, and at least one letter right
+     * (so a one-letter name is never "corrected" to another one-letter name) */
     size_t len = strlen(word);
     int allowed = len <= 3 ? 1 : (int)(len / 3) + 1;
-    return best_d <= allowed ? best : NULL;
+    if (!best || best_d > allowed || (size_t)best_d >= len || (size_t)best_d >= strlen(best))
+        return NULL;
+    return best;
 }
 
 static size_t hash_string(const char *s)

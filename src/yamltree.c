@@ -155,14 +155,76 @@ static int on_open(builder *b, const yaml_event_t *ev, ynode_kind kind)
 
 static void on_close(builder *b) { b->depth--; }
 
-static int parser_error(builder *b, const yaml_parser_t *p)
+/* What libyaml's context ("while parsing a block mapping") is about, in words
+ * for the note that points at its start. */
+static const char *context_noun(const char *context)
 {
-    mech_mark at = mark_of(p->problem_mark);
+    static const struct { const char *key, *noun; } table[] = {
+        {"mapping", "the mapping"},     {"block collection", "the list"},
+        {"sequence", "the list"},       {"quoted scalar", "the quoted value"},
+        {"simple key", "the key"},      {"plain scalar", "the value"},
+        {"block scalar", "the text block"},
+    };
+    for (size_t i = 0; i < sizeof table / sizeof table[0]; i++)
+        if (strstr(context, table[i].key))
+            return table[i].noun;
+    return NULL;
+}
+
+/* libyaml's messages are about tokens and events; say what went wrong in
+ * the file's terms, and point a note at the construct that was open. */
+static int parser_error(builder *b, const yaml_parser_t *p, const char *text, size_t len)
+{
+    mech_mark at = mark_of(p->problem_mark), ctx = mark_of(p->context_mark);
     const char *problem = p->problem ? p->problem : "malformed YAML";
-    if (p->context)
-        return diag_error(b->d, b->file, at, "YAML syntax: %s %s (line %d)", problem,
-                          p->context, (int)p->context_mark.line + 1);
-    return diag_error(b->d, b->file, at, "YAML syntax: %s", problem);
+    const char *context = p->context ? p->context : "";
+    size_t pos = p->problem_mark.index;
+    char c = pos < len ? text[pos] : '\0';
+    char msg[256];
+    const char *note = NULL;
+    char note_buf[128];
+    if (strstr(problem, "tab character") ||
+        (strstr(problem, "cannot start any token") && c == '\t')) {
+        snprintf(msg, sizeof msg, "tab character; YAML indentation must use spaces");
+    } else if (strstr(problem, "cannot start any token")) {
+        snprintf(msg, sizeof msg, "a value cannot start with '%c'; put the value in quotes", c);
+    } else if (strstr(problem, "mapping values are not allowed")) {
+        snprintf(msg, sizeof msg, "unexpected ':' (is this line indented too far, or does a "
+                                  "value that contains ': ' need quotes?)");
+    } else if (strstr(problem, "did not find expected key")) {
+        snprintf(msg, sizeof msg, "this line does not line up with the keys of the mapping it "
+                                  "is in (check the indentation)");
+        snprintf(note_buf, sizeof note_buf, "the mapping starts here; its keys are at column %d",
+                 ctx.col);
+        note = note_buf;
+    } else if (strstr(problem, "did not find expected '-'")) {
+        snprintf(msg, sizeof msg, "expected a '- ' item of the list here (check the "
+                                  "indentation)");
+        snprintf(note_buf, sizeof note_buf, "the list starts here; its items are at column %d",
+                 ctx.col);
+        note = note_buf;
+    } else if (strstr(problem, "expected ',' or ']'") || strstr(problem, "expected ',' or '}'")) {
+        int seq = strstr(problem, "']'") != NULL;
+        snprintf(msg, sizeof msg, "expected ',' or '%c': the %s opened with '%c' is not closed",
+                 seq ? ']' : '}', seq ? "list" : "mapping", seq ? '[' : '{');
+        snprintf(note_buf, sizeof note_buf, "the %s starts here", seq ? "list" : "mapping");
+        note = note_buf;
+    } else if (strstr(problem, "end of stream") && strstr(context, "quoted")) {
+        snprintf(msg, sizeof msg, "the file ends inside a quoted value (a closing quote is "
+                                  "missing)");
+        note = "the quoted value starts here";
+    } else {
+        snprintf(msg, sizeof msg, "%s", problem);
+        const char *noun = context_noun(context);
+        if (noun) {
+            snprintf(note_buf, sizeof note_buf, "%s starts here", noun);
+            note = note_buf;
+        }
+    }
+    diag_error(b->d, b->file, at, "YAML syntax: %s", msg);
+    if (note && p->context && (ctx.line != at.line || ctx.col != at.col))
+        diag_note(b->d, b->file, ctx, "%s", note);
+    return MECH_EINPUT;
 }
 
 static int handle(builder *b, const yaml_event_t *ev, int *ndocs)
@@ -175,7 +237,8 @@ static int handle(builder *b, const yaml_event_t *ev, int *ndocs)
         return 0;
     case YAML_ALIAS_EVENT:
         return diag_error(b->d, b->file, mark_of(ev->start_mark),
-                          "YAML aliases (*name) are not supported; write the value out");
+                          "YAML alias '*%s' is not supported; write the value out in full",
+                          (const char *)ev->data.alias.anchor);
     case YAML_SCALAR_EVENT:
         return on_scalar(b, ev);
     case YAML_SEQUENCE_START_EVENT:
@@ -210,7 +273,7 @@ ynode *ytree_parse(const char *text, size_t len, const char *file, const yaml_li
     while (!done && rc == 0) {
         yaml_event_t ev;
         if (!yaml_parser_parse(&parser, &ev)) {
-            rc = parser_error(&b, &parser);
+            rc = parser_error(&b, &parser, text, len);
             break;
         }
         done = ev.type == YAML_STREAM_END_EVENT;
@@ -223,7 +286,8 @@ ynode *ytree_parse(const char *text, size_t len, const char *file, const yaml_li
         return NULL;
     }
     if (!b.root)
-        diag_error(d, file, (mech_mark){1, 1}, "empty file: expected a mapping with 'name', "
-                                               "'ground', 'links' and 'driver'");
+        diag_error(d, file, (mech_mark){1, 1}, "the file holds no mechanism (it is empty or only "
+                                               "comments): expected 'name', 'ground', 'links' "
+                                               "and 'driver'");
     return b.root;
 }

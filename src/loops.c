@@ -1,0 +1,382 @@
+/* src/loops.c: independent loops of the link/joint graph, as vector sums.
+ * Loops listed in the file (walks of point names) are checked: every step
+ * must lie on one link or cross one slider, the walk must cross real joints,
+ * and the loops must be independent and as many as the graph has. Without
+ * them, a cycle basis comes from a breadth-first spanning tree rooted at the
+ * ground: each joint off the tree closes one loop. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "system.h"
+
+int loops_attach(const mech_joint *j, int l) { return j->link[0] == l ? j->point[0] : j->point[1]; }
+
+void loops_free(loop_set *ls)
+{
+    free(ls->terms);
+    free(ls->start);
+    memset(ls, 0, sizeof *ls);
+}
+
+typedef struct term_buf {
+    loop_term *t;
+    int n, cap;
+} term_buf;
+
+static int push(term_buf *b, loop_term t)
+{
+    if (b->n == b->cap) {
+        int cap = b->cap ? 2 * b->cap : 64;
+        loop_term *nt = xrealloc_array(b->t, (size_t)cap, sizeof *nt);
+        if (!nt)
+            return -1;
+        b->t = nt;
+        b->cap = cap;
+    }
+    b->t[b->n++] = t;
+    return 0;
+}
+
+static int push_body(term_buf *b, int link, int p0, int p1)
+{
+    if (p0 == p1)
+        return 0;
+    return push(b, (loop_term){TERM_BODY, link, p0, p1, -1, 0});
+}
+
+/* Cross joint j from link `from` to the other link: a slider adds +-s dir. */
+static int push_crossing(term_buf *b, const mech_joint *j, int ji, int from)
+{
+    if (j->kind != MECH_JOINT_SLIDER)
+        return 0;
+    return push(b, (loop_term){TERM_SLIDE, -1, -1, -1, ji, from == j->link[1] ? +1 : -1});
+}
+
+/* ---- automatic: cycle basis from a BFS spanning tree ---------------- */
+
+typedef struct graph {
+    int *adj_start;  /* [nlinks+1] */
+    int *adj;        /* [2 njoints] joint indices incident to each link */
+    int *parent;     /* [nlinks] link's parent in the tree, -1 at the root */
+    int *pjoint;     /* [nlinks] joint to the parent */
+    int *depth;      /* [nlinks] */
+    char *tree;      /* [njoints] 1 if the joint is a tree edge */
+} graph;
+
+static void graph_free(graph *g)
+{
+    free(g->adj_start);
+    free(g->adj);
+    free(g->parent);
+    free(g->pjoint);
+    free(g->depth);
+    free(g->tree);
+}
+
+static int graph_build(const mech_model *m, graph *g)
+{
+    int nl = m->nlinks, nj = m->njoints;
+    g->adj_start = xcalloc((size_t)nl + 1, sizeof *g->adj_start);
+    g->adj = xcalloc(2 * (size_t)nj, sizeof *g->adj);
+    g->parent = xcalloc((size_t)nl, sizeof *g->parent);
+    g->pjoint = xcalloc((size_t)nl, sizeof *g->pjoint);
+    g->depth = xcalloc((size_t)nl, sizeof *g->depth);
+    g->tree = xcalloc((size_t)nj, 1);
+    int *queue = xcalloc((size_t)nl, sizeof *queue), *fill = xcalloc((size_t)nl, sizeof *fill);
+    if (!g->adj_start || !g->adj || !g->parent || !g->pjoint || !g->depth || !g->tree || !queue ||
+        !fill) {
+        free(queue);
+        free(fill);
+        return -1;
+    }
+    for (int j = 0; j < nj; j++) {
+        g->adj_start[m->joints[j].link[0] + 1]++;
+        g->adj_start[m->joints[j].link[1] + 1]++;
+    }
+    for (int l = 0; l < nl; l++)
+        g->adj_start[l + 1] += g->adj_start[l];
+    for (int j = 0; j < nj; j++)
+        for (int k = 0; k < 2; k++) {
+            int l = m->joints[j].link[k];
+            g->adj[g->adj_start[l] + fill[l]++] = j;
+        }
+    for (int l = 0; l < nl; l++)
+        g->parent[l] = -2;  /* unvisited */
+    int head = 0, tail = 0;
+    queue[tail++] = 0;
+    g->parent[0] = -1;
+    g->pjoint[0] = -1;
+    while (head < tail) {
+        int l = queue[head++];
+        for (int k = g->adj_start[l]; k < g->adj_start[l + 1]; k++) {
+            const mech_joint *j = &m->joints[g->adj[k]];
+            int other = j->link[0] == l ? j->link[1] : j->link[0];
+            if (g->parent[other] != -2)
+                continue;
+            g->parent[other] = l;
+            g->pjoint[other] = g->adj[k];
+            g->depth[other] = g->depth[l] + 1;
+            g->tree[g->adj[k]] = 1;
+            queue[tail++] = other;
+        }
+    }
+    free(queue);
+    free(fill);
+    return 0;
+}
+
+/* The loop closed by off-tree joint ji: cross ji from a to b, climb from b
+ * to the common ancestor, descend to a. Body vectors join consecutive
+ * crossings within each link. */
+static int cycle_terms(const mech_model *m, const graph *g, int ji, term_buf *b, int *path)
+{
+    const mech_joint *jt = &m->joints[ji];
+    int a = jt->link[0], c = jt->link[1];
+    /* crossings: list of (joint, from-link) */
+    int n = 0;
+    path[n++] = ji;
+    path[n++] = a;
+    int x = a, y = c, nup = 0;
+    int *down = path + 2 * (m->njoints + 1);  /* second half: the a-side chain */
+    while (x != y) {  /* climb the deeper side until both meet */
+        if (g->depth[y] >= g->depth[x]) {
+            path[n++] = g->pjoint[y];
+            path[n++] = y;
+            y = g->parent[y];
+        } else {
+            down[nup++] = x;
+            x = g->parent[x];
+        }
+    }
+    for (int k = nup - 1; k >= 0; k--) {  /* descend from the ancestor to a */
+        path[n++] = g->pjoint[down[k]];
+        path[n++] = g->parent[down[k]];
+    }
+    /* path holds (joint, from) pairs; the link after crossing k is the
+     * "other" side, and it is left by crossing k+1 (cyclically) */
+    int ncross = n / 2;
+    for (int k = 0; k < ncross; k++) {
+        const mech_joint *jk = &m->joints[path[2 * k]];
+        int from = path[2 * k + 1];
+        int to = jk->link[0] == from ? jk->link[1] : jk->link[0];
+        if (push_crossing(b, jk, path[2 * k], from) < 0)
+            return -1;
+        const mech_joint *jn = &m->joints[path[2 * ((k + 1) % ncross)]];
+        if (push_body(b, to, loops_attach(jk, to), loops_attach(jn, to)) < 0)
+            return -1;
+    }
+    return 0;
+}
+
+static int build_automatic(const mech_model *m, loop_set *ls, mech_diag *d)
+{
+    graph g = {0};
+    term_buf b = {0};
+    int nloops = m->njoints - m->nlinks + 1;
+    int *path = xcalloc(4 * ((size_t)m->njoints + 1) + 4, sizeof *path);
+    ls->start = xcalloc((size_t)(nloops > 0 ? nloops : 0) + 1, sizeof *ls->start);
+    if (!path || !ls->start || graph_build(m, &g) < 0) {
+        diag_error(d, m->file, (mech_mark){0, 0}, "out of memory");
+        goto fail;
+    }
+    for (int l = 0; l < m->nlinks; l++)
+        if (g.parent[l] == -2) {
+            diag_error(d, m->file, m->links[l].mark, "link '%s' is not connected to the ground",
+                       m->links[l].name);
+            goto fail;
+        }
+    for (int j = 0; j < m->njoints; j++) {
+        if (g.tree[j])
+            continue;
+        if (cycle_terms(m, &g, j, &b, path) < 0) {
+            diag_error(d, m->file, (mech_mark){0, 0}, "out of memory");
+            goto fail;
+        }
+        ls->start[++ls->nloops] = b.n;
+    }
+    ls->terms = b.t;
+    graph_free(&g);
+    free(path);
+    return MECH_OK;
+fail:
+    graph_free(&g);
+    free(path);
+    free(b.t);
+    loops_free(ls);
+    return MECH_EINPUT;
+}
+
+/* ---- loops from the file -------------------------------------------- */
+
+/* The revolute joint between links a and b at point name id, or -1. */
+static int revolute_between(const mech_model *m, int a, int b, int id)
+{
+    for (int j = 0; j < m->njoints; j++) {
+        const mech_joint *jt = &m->joints[j];
+        if (jt->kind != MECH_JOINT_REVOLUTE)
+            continue;
+        if (((jt->link[0] == a && jt->link[1] == b) || (jt->link[0] == b && jt->link[1] == a)) &&
+            m->links[jt->link[0]].points[jt->point[0]].id == id)
+            return j;
+    }
+    return -1;
+}
+
+/* One step P -> Q: the links it starts and ends on, and the terms. */
+static int walk_step(const mech_model *m, int P, int Q, term_buf *b, int *start_link,
+                     int *end_link, int *slider)
+{
+    *slider = -1;
+    for (int l = 0; l < m->nlinks; l++) {
+        int i = model_point_in_link(&m->links[l], P), k = model_point_in_link(&m->links[l], Q);
+        if (i >= 0 && k >= 0) {
+            *start_link = *end_link = l;
+            return push_body(b, l, i, k) < 0 ? -1 : 1;
+        }
+    }
+    for (int ji = 0; ji < m->njoints; ji++) {
+        const mech_joint *j = &m->joints[ji];
+        if (j->kind != MECH_JOINT_SLIDER)
+            continue;
+        const mech_link *mover = &m->links[j->link[0]], *guide = &m->links[j->link[1]];
+        int pm = model_point_in_link(mover, P), qg = model_point_in_link(guide, Q);
+        int qm = model_point_in_link(mover, Q), pg = model_point_in_link(guide, P);
+        if (pm == j->point[0] && qg >= 0) {          /* mover's P -> T -> Q on the guide */
+            *start_link = j->link[0];
+            *end_link = j->link[1];
+            *slider = ji;
+            if (push_crossing(b, j, ji, j->link[0]) < 0 || push_body(b, j->link[1], j->point[1], qg) < 0)
+                return -1;
+            return 1;
+        }
+        if (qm == j->point[0] && pg >= 0) {          /* guide's P -> T -> mover's Q */
+            *start_link = j->link[1];
+            *end_link = j->link[0];
+            *slider = ji;
+            if (push_body(b, j->link[1], pg, j->point[1]) < 0 || push_crossing(b, j, ji, j->link[1]) < 0)
+                return -1;
+            return 1;
+        }
+    }
+    return 0;
+}
+
+/* Walk one listed loop; fills row[] (signed joint crossings) for the rank test. */
+static int walk_loop(const mech_model *m, const mech_loop *lp, term_buf *b, double *row, mech_diag *d)
+{
+    int nsteps = lp->npoints - 1, first_link = -1, prev_link = -1, ok = 1;
+    for (int s = 0; s < nsteps; s++) {
+        int P = lp->points[s], Q = lp->points[s + 1], sl, el, slider;
+        int r = walk_step(m, P, Q, b, &sl, &el, &slider);
+        if (r < 0)
+            return diag_error(d, m->file, lp->mark, "out of memory");
+        if (r == 0) {
+            diag_error(d, m->file, lp->marks[s + 1],
+                       "loop step %s -> %s lies on no single link and crosses no slider",
+                       m->point_names[P], m->point_names[Q]);
+            ok = 0;
+            continue;
+        }
+        if (slider >= 0)
+            row[slider] += sl == m->joints[slider].link[0] ? 1.0 : -1.0;
+        if (s == 0)
+            first_link = sl;
+        else if (prev_link >= 0 && prev_link != sl) {
+            int j = revolute_between(m, prev_link, sl, P);
+            if (j < 0) {
+                diag_error(d, m->file, lp->marks[s],
+                           "loop passes from link '%s' to link '%s' at '%s', but no joint joins "
+                           "them there", m->links[prev_link].name, m->links[sl].name,
+                           m->point_names[P]);
+                ok = 0;
+            } else {
+                row[j] += m->joints[j].link[0] == prev_link ? 1.0 : -1.0;
+            }
+        }
+        prev_link = el;
+    }
+    if (ok && prev_link != first_link) {
+        int j = revolute_between(m, prev_link, first_link, lp->points[0]);
+        if (j < 0) {
+            diag_error(d, m->file, lp->marks[nsteps],
+                       "loop closes from link '%s' to link '%s' at '%s', but no joint joins them "
+                       "there", m->links[prev_link].name, m->links[first_link].name,
+                       m->point_names[lp->points[0]]);
+            ok = 0;
+        } else {
+            row[j] += m->joints[j].link[0] == prev_link ? 1.0 : -1.0;
+        }
+    }
+    return ok ? MECH_OK : MECH_EINPUT;
+}
+
+/* Rank of the loops' joint-crossing rows by forward elimination (the
+ * entries are small integers; 1e-9 separates zero from the rest). Each row
+ * is reduced by the earlier pivot rows in order, so it is zero exactly when
+ * the loop is a combination of the loops before it. */
+static int check_independent(const mech_model *m, double *rows, int nl, int nj, mech_diag *d)
+{
+    int *pivot = xcalloc((size_t)nl, sizeof *pivot);  /* pivot column of row r */
+    if (!pivot)
+        return diag_error(d, m->file, (mech_mark){0, 0}, "out of memory");
+    int rc = MECH_OK;
+    for (int r = 0; r < nl && rc == MECH_OK; r++) {
+        double *row = rows + (size_t)r * (size_t)nj;
+        for (int p = 0; p < r; p++) {
+            const double *pr = rows + (size_t)p * (size_t)nj;
+            double f = row[pivot[p]] / pr[pivot[p]];
+            if (f != 0.0)
+                for (int c = 0; c < nj; c++)
+                    row[c] -= f * pr[c];
+        }
+        int pc = 0;
+        while (pc < nj && row[pc] < 1e-9 && row[pc] > -1e-9)
+            pc++;
+        if (pc == nj)
+            rc = diag_error(d, m->file, m->loops[r].mark,
+                            "loop %d is not independent: it is a combination of the loops "
+                            "listed before it", r + 1);
+        pivot[r] = pc;
+    }
+    free(pivot);
+    return rc;
+}
+
+static int build_from_file(const mech_model *m, loop_set *ls, mech_diag *d)
+{
+    int needed = m->njoints - m->nlinks + 1;
+    if (m->nloops != needed)
+        return diag_error(d, m->file, m->loops[0].mark,
+                          "the file lists %d loop%s but the mechanism has %d independent loops "
+                          "(joints - links + 1 = %d - %d + 1)%s",
+                          m->nloops, m->nloops == 1 ? "" : "s", needed, m->njoints, m->nlinks,
+                          m->nloops < needed ? "; add the missing loops or remove 'loops' to find them automatically"
+                                             : "; remove the extra loops");
+    term_buf b = {0};
+    double *rows = xcalloc((size_t)m->nloops * (size_t)m->njoints, sizeof *rows);
+    ls->start = xcalloc((size_t)m->nloops + 1, sizeof *ls->start);
+    if (!rows || !ls->start) {
+        free(rows);
+        return diag_error(d, m->file, (mech_mark){0, 0}, "out of memory");
+    }
+    int rc = MECH_OK;
+    for (int k = 0; k < m->nloops; k++) {
+        if (walk_loop(m, &m->loops[k], &b, rows + (size_t)k * (size_t)m->njoints, d) != MECH_OK)
+            rc = MECH_EINPUT;
+        ls->start[++ls->nloops] = b.n;
+    }
+    if (rc == MECH_OK)
+        rc = check_independent(m, rows, m->nloops, m->njoints, d);
+    free(rows);
+    ls->terms = b.t;
+    ls->from_file = 1;
+    if (rc != MECH_OK)
+        loops_free(ls);
+    return rc;
+}
+
+int loops_build(const mech_model *m, loop_set *ls, mech_diag *d)
+{
+    memset(ls, 0, sizeof *ls);
+    return m->nloops > 0 ? build_from_file(m, ls, d) : build_automatic(m, ls, d);
+}

@@ -1,0 +1,165 @@
+/* src/print.c: `mech equations`: the derived equations, printed so a person
+ * can hold them next to a paper (text, or a standalone LaTeX document). */
+#include <stdio.h>
+#include <string.h>
+
+#include "system.h"
+
+static void describe_unknown(const mech_system *s, int i, FILE *out)
+{
+    const mech_model *m = s->model;
+    if (s->unk_kind[i] == UNK_ANGLE)
+        fprintf(out, "angle of link '%s'", m->links[s->unk_index[i]].name);
+    else
+    {
+        const mech_joint *j = &m->joints[s->unk_index[i]];
+        fprintf(out, "displacement of slider '%s' (point '%s' of '%s' along '%s', from '%s')",
+                j->name, m->links[j->link[0]].points[j->point[0]].name, m->links[j->link[0]].name,
+                m->links[j->link[1]].name, m->links[j->link[1]].points[j->point[1]].name);
+    }
+}
+
+/* A loop as the walk of its terms: "crank O->A, coupler A->B, +s_B along ground". */
+static void print_loop(const mech_system *s, int k, FILE *out)
+{
+    const mech_model *m = s->model;
+    for (int t = s->loops.start[k]; t < s->loops.start[k + 1]; t++) {
+        const loop_term *lt = &s->loops.terms[t];
+        if (t > s->loops.start[k])
+            fputs(", ", out);
+        if (lt->kind == TERM_BODY) {
+            const mech_link *l = &m->links[lt->link];
+            fprintf(out, "%s %s->%s", l->name, l->points[lt->p0].name, l->points[lt->p1].name);
+        } else {
+            const mech_joint *j = &m->joints[lt->joint];
+            fprintf(out, "%c%s along %s", lt->sign > 0 ? '+' : '-', j->name, m->links[j->link[1]].name);
+        }
+    }
+}
+
+static expr_names names_of(const mech_system *s)
+{
+    return (expr_names){(const char *const *)s->names, (const char *const *)s->latex};
+}
+
+static void print_text(const mech_system *s, FILE *out)
+{
+    const mech_model *m = s->model;
+    expr_names nm = names_of(s);
+    int n = s->n;
+    fprintf(out, "# %s (%s)\n\n", m->name ? m->name : "mechanism", m->file);
+    fprintf(out, "unknowns x (%d):\n", n);
+    for (int i = 0; i < n; i++) {
+        fprintf(out, "  x%-3d %-14s ", i + 1, s->names[i]);
+        describe_unknown(s, i, out);
+        fputc('\n', out);
+    }
+    fprintf(out, "input q: %s = %s, with rates %s and %s\n\n", s->names[n],
+            m->driver.kind == MECH_DRIVE_ANGLE ? "driver link angle" : "driver slider displacement",
+            s->names[SYS_VAR_QDOT(n)], s->names[SYS_VAR_QDDOT(n)]);
+    fprintf(out, "loops (%d, %s):\n", s->loops.nloops,
+            s->loops.from_file ? "as listed in the file" : "found automatically");
+    for (int k = 0; k < s->loops.nloops; k++) {
+        fprintf(out, "  L%d: ", k + 1);
+        print_loop(s, k, out);
+        fputc('\n', out);
+    }
+    fprintf(out, "\nposition equations f(x, q) = 0:\n");
+    for (int r = 0; r < n; r++) {
+        fprintf(out, "  f%d = ", r + 1);
+        expr_print(&s->ex, s->f[r], &nm, 0, out);
+        fprintf(out, "    [loop %d, %c]\n", r / 2 + 1, r % 2 ? 'y' : 'x');
+    }
+    fprintf(out, "\njacobian df/dx (%d nonzeros):\n", s->nnz);
+    for (int j = 0; j < n; j++)
+        for (int k = s->Jp[j]; k < s->Jp[j + 1]; k++) {
+            fprintf(out, "  df%d/d%s = ", s->Ji[k] + 1, s->names[j]);
+            expr_print(&s->ex, s->Jx[k], &nm, 0, out);
+            fputc('\n', out);
+        }
+    fprintf(out, "\nvelocity: J x' = b\n");
+    for (int r = 0; r < n; r++) {
+        fprintf(out, "  b%d = ", r + 1);
+        expr_print(&s->ex, s->vel[r], &nm, 0, out);
+        fputc('\n', out);
+    }
+    fprintf(out, "\nacceleration: J x'' = c\n");
+    for (int r = 0; r < n; r++) {
+        fprintf(out, "  c%d = ", r + 1);
+        expr_print(&s->ex, s->acc[r], &nm, 0, out);
+        fputc('\n', out);
+    }
+}
+
+/* Text with LaTeX's special characters escaped. */
+static void latex_text(const char *t, FILE *out)
+{
+    for (; *t; t++) {
+        if (strchr("#$%&_{}", *t))
+            fputc('\\', out);
+        if (*t == '\\' || *t == '^' || *t == '~')
+            fputs(*t == '\\' ? "\\textbackslash{}" : *t == '^' ? "\\^{}" : "\\~{}", out);
+        else
+            fputc(*t, out);
+    }
+}
+
+static void latex_rows(const mech_system *s, const char *lhs, const ex *rows, const char *rhs,
+                       FILE *out)
+{
+    expr_names nm = names_of(s);
+    fputs("\\begin{align*}\n", out);
+    for (int r = 0; r < s->n; r++) {
+        fprintf(out, "%s_{%d} &= ", lhs, r + 1);
+        expr_print(&s->ex, rows[r], &nm, 1, out);
+        fprintf(out, "%s%s\n", rhs, r + 1 < s->n ? " \\\\" : "");
+    }
+    fputs("\\end{align*}\n", out);
+}
+
+static void print_latex(const mech_system *s, FILE *out)
+{
+    const mech_model *m = s->model;
+    expr_names nm = names_of(s);
+    int n = s->n;
+    fputs("\\documentclass[10pt]{article}\n\\usepackage[a4paper,landscape,margin=1.5cm]{geometry}\n"
+          "\\usepackage{amsmath}\n\\allowdisplaybreaks\n\\begin{document}\n\\section*{",
+          out);
+    latex_text(m->name ? m->name : "Mechanism", out);
+    fputs("}\n\\subsection*{Unknowns}\n\\begin{itemize}\n", out);
+    for (int i = 0; i < n; i++) {
+        fprintf(out, "\\item $x_{%d} = %s$: ", i + 1, s->latex[i]);
+        char buf[512];
+        FILE *mem = fmemopen(buf, sizeof buf, "w");
+        if (mem) {
+            describe_unknown(s, i, mem);
+            fclose(mem);
+            latex_text(buf, out);
+        }
+        fputc('\n', out);
+    }
+    fprintf(out, "\\item input $q = %s$, rates $%s$, $%s$\n\\end{itemize}\n", s->latex[n],
+            s->latex[SYS_VAR_QDOT(n)], s->latex[SYS_VAR_QDDOT(n)]);
+    fputs("\\subsection*{Position equations $f(x, q) = 0$}\n", out);
+    latex_rows(s, "f", s->f, " = 0", out);
+    fputs("\\subsection*{Jacobian $\\partial f / \\partial x$ (nonzeros)}\n\\begin{align*}\n", out);
+    for (int j = 0; j < n; j++)
+        for (int k = s->Jp[j]; k < s->Jp[j + 1]; k++) {
+            fprintf(out, "\\frac{\\partial f_{%d}}{\\partial %s} &= ", s->Ji[k] + 1, s->latex[j]);
+            expr_print(&s->ex, s->Jx[k], &nm, 1, out);
+            fputs(j + 1 < n || k + 1 < s->Jp[j + 1] ? " \\\\\n" : "\n", out);
+        }
+    fputs("\\end{align*}\n\\subsection*{Velocity: $J\\dot{x} = b$}\n", out);
+    latex_rows(s, "b", s->vel, "", out);
+    fputs("\\subsection*{Acceleration: $J\\ddot{x} = c$}\n", out);
+    latex_rows(s, "c", s->acc, "", out);
+    fputs("\\end{document}\n", out);
+}
+
+void mech_system_print(const mech_system *s, mech_format fmt, FILE *out)
+{
+    if (fmt == MECH_FORMAT_LATEX)
+        print_latex(s, out);
+    else
+        print_text(s, out);
+}

@@ -1,0 +1,510 @@
+/* src/system.c: from the model and its loops to the symbolic equations
+ *   f(x, q) = 0                    (vector-loop closure, 2 rows per loop)
+ *   J = df/dx (CSC pattern), df/dq
+ *   J xdot  = -df/dq qdot                                  (velocity)
+ *   J xddot = -(d/dx (J xdot + f_q qdot)) xdot
+ *             - d/dq (J xdot + f_q qdot) qdot - f_q qddot   (acceleration)
+ * all derived symbolically, then compiled to one tape with three phases. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "system.h"
+
+enum { PHASE_POSITION, PHASE_VELOCITY, PHASE_ACCELERATION, NPHASES };
+
+/* ---- unknowns and names --------------------------------------------- */
+
+static const mech_joint *locking_slider(const mech_model *m, int l)
+{
+    for (int j = 0; j < m->njoints; j++)
+        if (m->joints[j].kind == MECH_JOINT_SLIDER && m->joints[j].locked && m->joints[j].link[0] == l)
+            return &m->joints[j];
+    return NULL;
+}
+
+static int driver_link(const mech_model *m)
+{
+    return m->has_driver && m->driver.kind == MECH_DRIVE_ANGLE ? m->driver.index : -1;
+}
+
+static int driver_slider(const mech_model *m)
+{
+    return m->has_driver && m->driver.kind == MECH_DRIVE_SLIDER ? m->driver.index : -1;
+}
+
+static int assign_unknowns(mech_system *s)
+{
+    const mech_model *m = s->model;
+    int n = 0;
+    s->unk_kind = xcalloc((size_t)(m->nlinks + m->njoints), sizeof *s->unk_kind);
+    s->unk_index = xcalloc((size_t)(m->nlinks + m->njoints), sizeof *s->unk_index);
+    s->link_var = xcalloc((size_t)m->nlinks, sizeof *s->link_var);
+    s->joint_var = xcalloc((size_t)m->njoints + 1, sizeof *s->joint_var);
+    if (!s->unk_kind || !s->unk_index || !s->link_var || !s->joint_var)
+        return -1;
+    for (int l = 0; l < m->nlinks; l++) {
+        s->link_var[l] = -1;
+        if (l == 0 || l == driver_link(m) || locking_slider(m, l))
+            continue;
+        s->unk_kind[n] = UNK_ANGLE;
+        s->unk_index[n] = l;
+        s->link_var[l] = n++;
+    }
+    for (int j = 0; j < m->njoints; j++) {
+        s->joint_var[j] = -1;
+        if (m->joints[j].kind != MECH_JOINT_SLIDER || j == driver_slider(m))
+            continue;
+        s->unk_kind[n] = UNK_SLIDE;
+        s->unk_index[n] = j;
+        s->joint_var[j] = n++;
+    }
+    s->n = n;
+    return 0;
+}
+
+/* "coupler" -> "\mathrm{coupler}", with '_' escaped. */
+static char *latex_word(const char *w)
+{
+    size_t n = strlen(w);
+    char *out = malloc(2 * n + 16);
+    if (!out)
+        return NULL;
+    char *p = out + sprintf(out, "\\mathrm{");
+    for (const char *c = w; *c; c++) {
+        if (*c == '_')
+            *p++ = '\\';
+        *p++ = *c;
+    }
+    strcpy(p, "}");
+    return out;
+}
+
+/* Text and LaTeX names of a position variable (an unknown or the driver). */
+static int position_names(const mech_system *s, int var, char **text, char **latex)
+{
+    const mech_model *m = s->model;
+    const char *symbol, *name;
+    int is_angle;
+    if (var == SYS_VAR_Q(s->n)) {
+        is_angle = m->driver.kind == MECH_DRIVE_ANGLE;
+        const int i = m->driver.index;
+        symbol = is_angle ? m->links[i].symbol : m->joints[i].symbol;
+        name = is_angle ? m->links[i].name : m->joints[i].name;
+    } else {
+        is_angle = s->unk_kind[var] == UNK_ANGLE;
+        const int i = s->unk_index[var];
+        symbol = is_angle ? m->links[i].symbol : m->joints[i].symbol;
+        name = is_angle ? m->links[i].name : m->joints[i].name;
+    }
+    char buf[160];
+    if (symbol) {
+        *text = xstrdup(symbol);
+        *latex = xstrdup(symbol);
+    } else if (is_angle) {
+        snprintf(buf, sizeof buf, "th_%s", name);
+        *text = xstrdup(buf);
+        char *w = latex_word(name);
+        snprintf(buf, sizeof buf, "\\theta_{%s}", w ? w : "?");
+        free(w);
+        *latex = xstrdup(buf);
+    } else {
+        *text = xstrdup(name);
+        *latex = latex_word(name);
+    }
+    return *text && *latex ? 0 : -1;
+}
+
+static char *decorate(const char *base, const char *before, const char *after)
+{
+    size_t n = strlen(base) + strlen(before) + strlen(after) + 1;
+    char *out = malloc(n);
+    if (out)
+        snprintf(out, n, "%s%s%s", before, base, after);
+    return out;
+}
+
+static int make_names(mech_system *s)
+{
+    int n = s->n, nv = SYS_NVARS(n);
+    s->names = xcalloc((size_t)nv, sizeof *s->names);
+    s->latex = xcalloc((size_t)nv, sizeof *s->latex);
+    if (!s->names || !s->latex)
+        return -1;
+    for (int v = 0; v <= n; v++) {  /* positions and q */
+        if (position_names(s, v, &s->names[v], &s->latex[v]) < 0)
+            return -1;
+        int dv = v == n ? SYS_VAR_QDOT(n) : SYS_VAR_XDOT(n, v);
+        s->names[dv] = decorate(s->names[v], "", "'");
+        s->latex[dv] = decorate(s->latex[v], "\\dot{", "}");
+        if (!s->names[dv] || !s->latex[dv])
+            return -1;
+    }
+    s->names[SYS_VAR_QDDOT(n)] = decorate(s->names[n], "", "''");
+    s->latex[SYS_VAR_QDDOT(n)] = decorate(s->latex[n], "\\ddot{", "}");
+    return s->names[SYS_VAR_QDDOT(n)] && s->latex[SYS_VAR_QDDOT(n)] ? 0 : -1;
+}
+
+/* ---- the residual --------------------------------------------------- */
+
+static int link_angles(mech_system *s, mech_diag *d)
+{
+    const mech_model *m = s->model;
+    expr_ctx *c = &s->ex;
+    s->link_angle = xcalloc((size_t)m->nlinks, sizeof *s->link_angle);
+    s->slide = xcalloc((size_t)m->njoints + 1, sizeof *s->slide);
+    if (!s->link_angle || !s->slide)
+        return diag_error(d, m->file, (mech_mark){0, 0}, "out of memory");
+    for (int l = 0; l < m->nlinks; l++) {
+        /* follow locked sliders to the link whose angle this one copies */
+        int k = l, hops = 0;
+        const mech_joint *lock;
+        while ((lock = locking_slider(m, k)) != NULL && hops++ <= m->nlinks)
+            k = lock->link[1];
+        if (hops > m->nlinks)
+            return diag_error(d, m->file, m->links[l].mark,
+                              "link '%s' is in a cycle of locked sliders: none of them can turn",
+                              m->links[l].name);
+        s->link_angle[l] = k == 0 ? c->zero
+                           : k == driver_link(m) ? expr_var(c, SYS_VAR_Q(s->n))
+                                                  : expr_var(c, s->link_var[k]);
+    }
+    for (int j = 0; j < m->njoints; j++)
+        s->slide[j] = m->joints[j].kind != MECH_JOINT_SLIDER ? -1
+                      : j == driver_slider(m) ? expr_var(c, SYS_VAR_Q(s->n))
+                                              : expr_var(c, s->joint_var[j]);
+    return MECH_OK;
+}
+
+/* length * (cos, sin)(angle + offset), written as the papers write it. */
+static void rotated(expr_ctx *c, double length, ex angle, double offset, ex *x, ex *y)
+{
+    ex k = expr_const(c, length);
+    const double pi = 3.14159265358979323846;
+    if (offset == pi || offset == -pi) {  /* atan2 gives exactly pi for (-r, 0) */
+        k = expr_const(c, -length);
+        offset = 0.0;
+    }
+    ex a = expr_add(c, angle, expr_const(c, offset));
+    *x = expr_mul(c, k, expr_cos(c, a));
+    *y = expr_mul(c, k, expr_sin(c, a));
+}
+
+static void term_vector(mech_system *s, const loop_term *t, ex *x, ex *y)
+{
+    const mech_model *m = s->model;
+    expr_ctx *c = &s->ex;
+    if (t->kind == TERM_BODY) {
+        const mech_link *l = &m->links[t->link];
+        double dx = l->points[t->p1].x - l->points[t->p0].x;
+        double dy = l->points[t->p1].y - l->points[t->p0].y;
+        rotated(c, hypot(dx, dy), s->link_angle[t->link], atan2(dy, dx), x, y);
+        return;
+    }
+    const mech_joint *j = &m->joints[t->joint];
+    ex ux, uy;
+    rotated(c, (double)t->sign, s->link_angle[j->link[1]], j->angle, &ux, &uy);
+    *x = expr_mul(c, s->slide[t->joint], ux);
+    *y = expr_mul(c, s->slide[t->joint], uy);
+}
+
+/* Sum v[0..n-1] as a balanced tree: depth log2(n) for long loops. */
+static ex balanced_sum(expr_ctx *c, ex *v, int n)
+{
+    if (n == 0)
+        return c->zero;
+    while (n > 1) {
+        int k = 0;
+        for (int i = 0; i + 1 < n; i += 2)
+            v[k++] = expr_add(c, v[i], v[i + 1]);
+        if (n % 2)
+            v[k++] = v[n - 1];
+        n = k;
+    }
+    return v[0];
+}
+
+static int build_residual(mech_system *s, mech_diag *d)
+{
+    const mech_model *m = s->model;
+    const loop_set *ls = &s->loops;
+    int rows = 2 * ls->nloops, maxterms = 1;
+    for (int k = 0; k < ls->nloops; k++)
+        if (ls->start[k + 1] - ls->start[k] > maxterms)
+            maxterms = ls->start[k + 1] - ls->start[k];
+    s->f = xcalloc((size_t)rows, sizeof *s->f);
+    ex *xs = xcalloc((size_t)maxterms, sizeof *xs), *ys = xcalloc((size_t)maxterms, sizeof *ys);
+    if (!s->f || !xs || !ys) {
+        free(xs);
+        free(ys);
+        return diag_error(d, m->file, (mech_mark){0, 0}, "out of memory");
+    }
+    for (int k = 0; k < ls->nloops; k++) {
+        int nt = 0;
+        for (int t = ls->start[k]; t < ls->start[k + 1]; t++, nt++)
+            term_vector(s, &ls->terms[t], &xs[nt], &ys[nt]);
+        s->f[2 * k] = balanced_sum(&s->ex, xs, nt);
+        s->f[2 * k + 1] = balanced_sum(&s->ex, ys, nt);
+    }
+    free(xs);
+    free(ys);
+    return MECH_OK;
+}
+
+/* ---- derivatives ---------------------------------------------------- */
+
+static int build_jacobian(mech_system *s, int *vars)
+{
+    int n = s->n, cap = 4 * n + 16, nnz = 0;
+    expr_ctx *c = &s->ex;
+    int *ti = xcalloc((size_t)cap, sizeof *ti), *tj = xcalloc((size_t)cap, sizeof *tj);
+    ex *tx = xcalloc((size_t)cap, sizeof *tx);
+    s->fq = xcalloc((size_t)n, sizeof *s->fq);
+    s->Jp = xcalloc((size_t)n + 1, sizeof *s->Jp);
+    if (!ti || !tj || !tx || !s->fq || !s->Jp)
+        goto oom;
+    for (int r = 0; r < n; r++) {
+        int nv = expr_vars(c, s->f[r], vars, SYS_NVARS(n));
+        s->fq[r] = c->zero;
+        for (int k = 0; k < nv; k++) {
+            ex dr = expr_diff(c, s->f[r], vars[k]);
+            if (vars[k] == SYS_VAR_Q(n)) {
+                s->fq[r] = dr;
+                continue;
+            }
+            if (expr_is_const(c, dr, 0.0))
+                continue;  /* structurally present, exactly zero */
+            if (nnz == cap) {
+                cap *= 2;
+                int *a = xrealloc_array(ti, (size_t)cap, sizeof *a);
+                if (a) ti = a;
+                int *b = xrealloc_array(tj, (size_t)cap, sizeof *b);
+                if (b) tj = b;
+                ex *x = xrealloc_array(tx, (size_t)cap, sizeof *x);
+                if (x) tx = x;
+                if (!a || !b || !x)
+                    goto oom;
+            }
+            ti[nnz] = r;
+            tj[nnz] = vars[k];
+            tx[nnz++] = dr;
+        }
+    }
+    /* triplets (row-major, rows ascending) -> compressed columns */
+    s->Ji = xcalloc((size_t)nnz, sizeof *s->Ji);
+    s->Jx = xcalloc((size_t)nnz, sizeof *s->Jx);
+    int *fill = xcalloc((size_t)n, sizeof *fill);
+    if (!s->Ji || !s->Jx || !fill) {
+        free(fill);
+        goto oom;
+    }
+    for (int k = 0; k < nnz; k++)
+        s->Jp[tj[k] + 1]++;
+    for (int j = 0; j < n; j++)
+        s->Jp[j + 1] += s->Jp[j];
+    for (int k = 0; k < nnz; k++) {
+        int at = s->Jp[tj[k]] + fill[tj[k]]++;
+        s->Ji[at] = ti[k];
+        s->Jx[at] = tx[k];
+    }
+    s->nnz = nnz;
+    free(fill);
+    free(ti);
+    free(tj);
+    free(tx);
+    return c->failed ? -1 : 0;
+oom:
+    free(ti);
+    free(tj);
+    free(tx);
+    return -1;
+}
+
+/* vel = -f_q qdot; acc = -(d/dt of (J xdot + f_q qdot) without the xddot term). */
+static int build_rates(mech_system *s, int *vars)
+{
+    int n = s->n;
+    expr_ctx *c = &s->ex;
+    ex qdot = expr_var(c, SYS_VAR_QDOT(n)), qddot = expr_var(c, SYS_VAR_QDDOT(n));
+    s->vel = xcalloc((size_t)n, sizeof *s->vel);
+    s->acc = xcalloc((size_t)n, sizeof *s->acc);
+    ex *row = xcalloc((size_t)n + 2, sizeof *row);     /* terms of one row */
+    int *rowlen = xcalloc((size_t)n, sizeof *rowlen);
+    if (!s->vel || !s->acc || !row || !rowlen) {
+        free(row);
+        free(rowlen);
+        return -1;
+    }
+    /* v_r = sum_j J_rj xdot_j + f_q,r qdot, gathered row by row from the CSC */
+    ex *v = xcalloc((size_t)n, sizeof *v);
+    if (!v) {
+        free(row);
+        free(rowlen);
+        return -1;
+    }
+    for (int r = 0; r < n; r++)
+        v[r] = c->zero;
+    for (int j = 0; j < n; j++)
+        for (int k = s->Jp[j]; k < s->Jp[j + 1]; k++) {
+            int r = s->Ji[k];
+            v[r] = expr_add(c, v[r], expr_mul(c, s->Jx[k], expr_var(c, SYS_VAR_XDOT(n, j))));
+        }
+    for (int r = 0; r < n; r++) {
+        s->vel[r] = expr_neg(c, expr_mul(c, s->fq[r], qdot));
+        ex vr = expr_add(c, v[r], expr_mul(c, s->fq[r], qdot));
+        int nv = expr_vars(c, vr, vars, SYS_NVARS(n)), nt = 0;
+        for (int k = 0; k < nv; k++) {
+            int var = vars[k];
+            ex rate;  /* d var / dt */
+            if (var < n)
+                rate = expr_var(c, SYS_VAR_XDOT(n, var));
+            else if (var == SYS_VAR_Q(n))
+                rate = qdot;
+            else
+                continue;  /* velocities: their rates are the unknown xddot or qddot */
+            row[nt++] = expr_neg(c, expr_mul(c, expr_diff(c, vr, var), rate));
+        }
+        row[nt++] = expr_neg(c, expr_mul(c, s->fq[r], qddot));
+        s->acc[r] = balanced_sum(c, row, nt);
+    }
+    free(v);
+    free(row);
+    free(rowlen);
+    return c->failed ? -1 : 0;
+}
+
+static int compile(mech_system *s)
+{
+    int n = s->n;
+    const ex *roots[NPHASES];
+    int nroots[NPHASES];
+    ex *pos = xcalloc((size_t)(n + s->nnz), sizeof *pos);
+    if (!pos)
+        return -1;
+    memcpy(pos, s->f, (size_t)n * sizeof *pos);
+    memcpy(pos + n, s->Jx, (size_t)s->nnz * sizeof *pos);
+    roots[PHASE_POSITION] = pos;
+    nroots[PHASE_POSITION] = n + s->nnz;
+    roots[PHASE_VELOCITY] = s->vel;
+    nroots[PHASE_VELOCITY] = n;
+    roots[PHASE_ACCELERATION] = s->acc;
+    nroots[PHASE_ACCELERATION] = n;
+    int rc = tape_compile(&s->tp, &s->ex, SYS_NVARS(n), NPHASES, roots, nroots);
+    free(pos);
+    return rc;
+}
+
+/* ---- public ----------------------------------------------------------- */
+
+void mech_system_free(mech_system **ps)
+{
+    mech_system *s = ps ? *ps : NULL;
+    if (!s)
+        return;
+    if (s->names)
+        for (int v = 0; v < SYS_NVARS(s->n); v++) {
+            free(s->names[v]);
+            free(s->latex[v]);
+        }
+    free(s->names);
+    free(s->latex);
+    free(s->unk_kind);
+    free(s->unk_index);
+    free(s->link_var);
+    free(s->joint_var);
+    free(s->link_angle);
+    free(s->slide);
+    loops_free(&s->loops);
+    expr_free(&s->ex);
+    free(s->f);
+    free(s->Jp);
+    free(s->Ji);
+    free(s->Jx);
+    free(s->fq);
+    free(s->vel);
+    free(s->acc);
+    tape_free(&s->tp);
+    free(s);
+    *ps = NULL;
+}
+
+int mech_system_new(const mech_model *m, mech_system **out, mech_diag *d)
+{
+    *out = NULL;
+    if (!m->has_driver)
+        return diag_error(d, m->file, (mech_mark){0, 0}, "the mechanism has no driver");
+    mech_system *s = xcalloc(1, sizeof *s);
+    if (!s || expr_init(&s->ex) < 0) {
+        free(s);
+        return diag_error(d, m->file, (mech_mark){0, 0}, "out of memory"), MECH_ENOMEM;
+    }
+    s->model = m;
+    int rc = MECH_ENOMEM;
+    int *vars = NULL;
+    if (assign_unknowns(s) < 0)
+        goto fail;
+    if ((rc = loops_build(m, &s->loops, d)) != MECH_OK)
+        goto fail;
+    if (2 * s->loops.nloops != s->n) {
+        rc = diag_error(d, m->file, m->driver.mark,
+                        "%d unknowns but %d loop equations (%d loops): the mechanism is %s",
+                        s->n, 2 * s->loops.nloops, s->loops.nloops,
+                        s->n > 2 * s->loops.nloops ? "under-constrained" : "over-constrained");
+        goto fail;
+    }
+    rc = MECH_ENOMEM;
+    vars = xcalloc((size_t)SYS_NVARS(s->n), sizeof *vars);
+    if (!vars || make_names(s) < 0)
+        goto fail;
+    if ((rc = link_angles(s, d)) != MECH_OK || (rc = build_residual(s, d)) != MECH_OK)
+        goto fail;
+    rc = MECH_ENOMEM;
+    if (build_jacobian(s, vars) < 0 || build_rates(s, vars) < 0 || compile(s) < 0)
+        goto fail;
+    free(vars);
+    *out = s;
+    return MECH_OK;
+fail:
+    if (rc == MECH_ENOMEM)
+        diag_error(d, m->file, (mech_mark){0, 0}, "out of memory");
+    free(vars);
+    mech_system_free(&s);
+    return rc;
+}
+
+int mech_system_size(const mech_system *s) { return s->n; }
+
+void sys_eval_position(mech_system *s, const double *x, double q, double *f, double *Jx)
+{
+    tape *t = &s->tp;
+    for (int i = 0; i < s->n; i++)
+        tape_set_var(t, i, x[i]);
+    tape_set_var(t, SYS_VAR_Q(s->n), q);
+    tape_run(t, PHASE_POSITION);
+    for (int r = 0; r < s->n; r++)
+        f[r] = tape_value(t, s->f[r]);
+    if (Jx)
+        for (int k = 0; k < s->nnz; k++)
+            Jx[k] = tape_value(t, s->Jx[k]);
+}
+
+void sys_eval_velocity_rhs(mech_system *s, double qdot, double *rhs)
+{
+    tape *t = &s->tp;
+    tape_set_var(t, SYS_VAR_QDOT(s->n), qdot);
+    tape_run(t, PHASE_VELOCITY);
+    for (int r = 0; r < s->n; r++)
+        rhs[r] = tape_value(t, s->vel[r]);
+}
+
+void sys_eval_accel_rhs(mech_system *s, const double *xdot, double qdot, double qddot, double *rhs)
+{
+    tape *t = &s->tp;
+    for (int i = 0; i < s->n; i++)
+        tape_set_var(t, SYS_VAR_XDOT(s->n, i), xdot[i]);
+    tape_set_var(t, SYS_VAR_QDOT(s->n), qdot);
+    tape_set_var(t, SYS_VAR_QDDOT(s->n), qddot);
+    tape_run(t, PHASE_ACCELERATION);
+    for (int r = 0; r < s->n; r++)
+        rhs[r] = tape_value(t, s->acc[r]);
+}

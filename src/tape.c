@@ -1,0 +1,146 @@
+/* src/tape.c: compile the DAG to a register program, and run it. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "internal.h"
+#include "tape.h"
+
+void tape_free(tape *t)
+{
+    free(t->reg);
+    free(t->ins);
+    free(t->var_reg);
+    free(t->node_reg);
+    memset(t, 0, sizeof *t);
+}
+
+static int op_of(expr_op op)
+{
+    switch (op) {
+    case EX_ADD: return TOP_ADD;
+    case EX_MUL: return TOP_MUL;
+    case EX_NEG: return TOP_NEG;
+    case EX_SIN: return TOP_SIN;
+    case EX_COS: return TOP_COS;
+    default: abort(); /* constants and variables are not instructions */
+    }
+}
+
+/* Post-order over the DAG from e (iterative: sums of long loops are deep). */
+typedef struct work_stack {
+    int *v;
+    size_t n, cap;
+} work_stack;
+
+static int push(work_stack *s, int e)
+{
+    if (s->n == s->cap) {
+        size_t cap = s->cap ? 2 * s->cap : 256;
+        int *v = xrealloc_array(s->v, cap, sizeof *v);
+        if (!v)
+            return -1;
+        s->v = v;
+        s->cap = cap;
+    }
+    s->v[s->n++] = e;
+    return 0;
+}
+
+static int emit(tape *t, const expr_ctx *c, ex root, work_stack *st, size_t *cap_ins)
+{
+    st->n = 0;
+    if (push(st, root) < 0)
+        return -1;
+    while (st->n > 0) {
+        ex e = st->v[st->n - 1];
+        if (t->node_reg[e] >= 0) {
+            st->n--;
+            continue;
+        }
+        const expr_node *n = &c->nodes[e];
+        if (n->op == EX_CONST || n->op == EX_VAR) {
+            t->node_reg[e] = t->nreg++;
+            if (n->op == EX_CONST)
+                t->reg[t->node_reg[e]] = n->value;
+            else
+                t->var_reg[n->var] = t->node_reg[e];
+            st->n--;
+            continue;
+        }
+        int pending = 0;
+        if (n->b >= 0 && t->node_reg[n->b] < 0) {
+            if (push(st, n->b) < 0)
+                return -1;
+            pending = 1;
+        }
+        if (t->node_reg[n->a] < 0) {
+            if (push(st, n->a) < 0)
+                return -1;
+            pending = 1;
+        }
+        if (pending)
+            continue;
+        if ((size_t)t->nins == *cap_ins) {
+            size_t cap = *cap_ins ? 2 * *cap_ins : 256;
+            tape_ins *ni = xrealloc_array(t->ins, cap, sizeof *ni);
+            if (!ni)
+                return -1;
+            t->ins = ni;
+            *cap_ins = cap;
+        }
+        t->node_reg[e] = t->nreg++;
+        t->ins[t->nins++] = (tape_ins){op_of(n->op), t->node_reg[e], t->node_reg[n->a],
+                                       n->b >= 0 ? t->node_reg[n->b] : 0};
+        st->n--;
+    }
+    return 0;
+}
+
+int tape_compile(tape *t, expr_ctx *c, int nvars, int nphases, const ex *const *roots,
+                 const int *nroots)
+{
+    memset(t, 0, sizeof *t);
+    size_t nodes = c->count, cap_ins = 0;
+    t->node_reg = xcalloc(nodes, sizeof *t->node_reg);
+    t->reg = xcalloc(nodes, sizeof *t->reg);        /* at most one register per node */
+    t->var_reg = xcalloc((size_t)nvars, sizeof *t->var_reg);
+    work_stack stack = {0};
+    if (!t->node_reg || !t->reg || !t->var_reg || nphases > TAPE_MAX_PHASES)
+        goto fail;
+    for (size_t i = 0; i < nodes; i++)
+        t->node_reg[i] = -1;
+    for (int v = 0; v < nvars; v++)
+        t->var_reg[v] = -1;
+    t->nvars = nvars;
+    t->nphases = nphases;
+    for (int k = 0; k < nphases; k++) {
+        t->phase_start[k] = t->nins;
+        for (int i = 0; i < nroots[k]; i++)
+            if (emit(t, c, roots[k][i], &stack, &cap_ins) < 0)
+                goto fail;
+    }
+    t->phase_start[nphases] = t->nins;
+    free(stack.v);
+    return 0;
+fail:
+    free(stack.v);
+    tape_free(t);
+    return -1;
+}
+
+void tape_run(tape *t, int phase)
+{
+    double *r = t->reg;
+    const tape_ins *ins = t->ins;
+    for (int i = t->phase_start[phase], end = t->phase_start[phase + 1]; i < end; i++) {
+        const tape_ins *p = &ins[i];
+        switch (p->op) {
+        case TOP_ADD: r[p->d] = r[p->a] + r[p->b]; break;
+        case TOP_MUL: r[p->d] = r[p->a] * r[p->b]; break;
+        case TOP_NEG: r[p->d] = -r[p->a]; break;
+        case TOP_SIN: r[p->d] = sin(r[p->a]); break;
+        case TOP_COS: r[p->d] = cos(r[p->a]); break;
+        }
+    }
+}

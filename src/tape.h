@@ -1,0 +1,52 @@
+/* src/tape.h: a flat register program compiled from the expression DAG.
+ * Every DAG node needed gets one register; constants are loaded once at
+ * compile time, variables are written by the caller, and each instruction
+ * computes one node from registers. Evaluation allocates nothing. */
+#ifndef MECH_TAPE_H
+#define MECH_TAPE_H
+
+#include "expr.h"
+
+/* ORDER TOP: tape_run switches on these. */
+typedef enum {
+    TOP_ADD, /* r[d] = r[a] + r[b] */
+    TOP_MUL, /* r[d] = r[a] * r[b] */
+    TOP_NEG, /* r[d] = -r[a] */
+    TOP_SIN, /* r[d] = sin(r[a]) */
+    TOP_COS  /* r[d] = cos(r[a]) */
+} tape_op;
+
+typedef struct tape_ins {
+    int op;
+    int d, a, b;
+} tape_ins;
+
+enum { TAPE_MAX_PHASES = 4 };
+
+typedef struct tape {
+    double *reg;        /* [nreg] registers */
+    int nreg;
+    tape_ins *ins;      /* [nins] instructions, grouped by phase */
+    int nins;
+    int phase_start[TAPE_MAX_PHASES + 1]; /* phase k: phase_start[k] .. phase_start[k+1]-1 */
+    int nphases;
+    int *var_reg;       /* [nvars] register of each variable (-1: not used) */
+    int nvars;
+    int *node_reg;      /* [DAG nodes] register of a node, -1 when not compiled */
+} tape;
+
+/* Compile phases of roots: roots[k][0..nroots[k]-1] for k < nphases. Nodes
+ * computed in an earlier phase are not recomputed later. */
+int tape_compile(tape *t, expr_ctx *c, int nvars, int nphases, const ex *const *roots,
+                 const int *nroots);
+void tape_free(tape *t);
+/* Run the instructions of one phase. */
+void tape_run(tape *t, int phase);
+static inline double tape_value(const tape *t, ex e) { return t->reg[t->node_reg[e]]; }
+static inline void tape_set_var(tape *t, int var, double v)
+{
+    if (t->var_reg[var] >= 0)
+        t->reg[t->var_reg[var]] = v;
+}
+
+#endif
