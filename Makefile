@@ -4,6 +4,7 @@
 #   make run        deps + build + the main job (see README)
 #   make test       deps + build + the full test suite
 #   make test-san   the test suite built with -fsanitize=address,undefined
+#   make bench      optimised benchmarks, printed as tables
 #   make install PREFIX=/usr/local
 #   make clean
 CC      ?= cc
@@ -29,7 +30,7 @@ LIB_OBJ  = $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o)
 TEST_SRC = $(wildcard tests/unit/*.c)
 TEST_OBJ = $(TEST_SRC:tests/unit/%.c=$(BUILD)/tests/%.o)
 
-.PHONY: all deps run test test-san check-mechanisms install clean
+.PHONY: all deps run test test-san bench install clean
 
 all: $(BUILD)/mech
 
@@ -70,6 +71,14 @@ test: deps
 test-san:
 	@$(MAKE) --no-print-directory test BUILD=build/san OPT="-O1 -g -fno-omit-frame-pointer" \
 	    SAN="-fsanitize=address,undefined -fno-sanitize-recover=all"
+
+# Benchmarks: optimised, no sanitizers; prints tables (docs/performance.md).
+bench:
+	@$(MAKE) --no-print-directory BUILD=build/bench OPT="-O2 -DNDEBUG" build/bench/bench-eval
+	build/bench/bench-eval mechanisms/*.yaml
+
+$(BUILD)/bench-eval: bench/bench_eval.c $(BUILD)/libmech.a $(HEADERS)
+	$(CC) $(CFLAGS) -Isrc -o $@ $< $(BUILD)/libmech.a $(LDLIBS)
 
 install: all
 	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib $(DESTDIR)$(PREFIX)/include

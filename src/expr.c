@@ -91,7 +91,24 @@ void expr_free(expr_ctx *c)
     memset(c, 0, sizeof *c);
 }
 
-ex expr_const(expr_ctx *c, double v) { return intern(c, EX_CONST, -1, -1, -1, v); }
+ex expr_const(expr_ctx *c, double v)
+{
+    return intern(c, EX_CONST, -1, -1, -1, v == 0.0 ? 0.0 : v);  /* -0 -> 0 */
+}
+
+/* sin and cos of a constant angle. The double nearest a multiple of pi/2
+ * (as "90 deg" becomes) stands for that multiple: its sine and cosine are
+ * exactly 0 or +-1, not 6e-17, so a vertical guide has no spurious term. */
+static double quadrant_exact(double v, int want_sin)
+{
+    const double half_pi = 1.57079632679489661923;
+    double r = v / half_pi, k = nearbyint(r);
+    if (fabs(r - k) > 4e-16 * fmax(1.0, fabs(k)) || fabs(k) > 1e6)
+        return want_sin ? sin(v) : cos(v);
+    long q = ((long)k % 4 + 4) % 4;  /* quadrant */
+    static const double s[4] = {0, 1, 0, -1}, co[4] = {1, 0, -1, 0};
+    return want_sin ? s[q] : co[q];
+}
 ex expr_var(expr_ctx *c, int var) { return intern(c, EX_VAR, var, -1, -1, 0.0); }
 
 static int is_const(const expr_ctx *c, ex e) { return c->nodes[e].op == EX_CONST; }
@@ -177,14 +194,14 @@ ex expr_mul(expr_ctx *c, ex a, ex b)
 ex expr_sin(expr_ctx *c, ex a)
 {
     if (is_const(c, a))
-        return expr_const(c, sin(cval(c, a)));
+        return expr_const(c, quadrant_exact(cval(c, a), 1));
     return intern(c, EX_SIN, -1, a, -1, 0.0);
 }
 
 ex expr_cos(expr_ctx *c, ex a)
 {
     if (is_const(c, a))
-        return expr_const(c, cos(cval(c, a)));
+        return expr_const(c, quadrant_exact(cval(c, a), 0));
     return intern(c, EX_COS, -1, a, -1, 0.0);
 }
 

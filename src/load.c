@@ -48,6 +48,12 @@ typedef struct loader {
     name_map point_map;   /* point name -> id */
     name_map link_map;    /* link name -> index */
     name_map joint_map;   /* joint name -> index */
+    /* Follow-on errors are not reported: one mistake, one message. */
+    unsigned char *link_failed; /* [links allocated] errors were reported about the link's
+                                   points or joints: skip checks that would only echo them */
+    int links_bad;        /* 'links' missing or unreadable: names of links are not known */
+    int points_bad;       /* some link's points unreadable: names of points are not known */
+    name_map bad_params;  /* parameters whose definition failed (keys borrowed from the tree) */
 } loader;
 
 static int find_point(const loader *ld, const char *name) { return name_map_get(&ld->point_map, name); }
@@ -77,41 +83,116 @@ static int want_kind(loader *ld, const ynode *n, ynode_kind kind, const char *wh
     return 0;
 }
 
-/* Check a mapping's keys: scalars, no duplicates, all in `allowed`.
- * Returns 1 when the mapping can be read (even with unknown keys). */
-static int check_keys(loader *ld, const ynode *map, const char *const *allowed, size_t nallowed,
-                      const char *where)
+static int is_allowed(const char *key, const char *const *allowed, size_t nallowed)
 {
-    if (!want_kind(ld, map, YNODE_MAP, where))
+    for (size_t a = 0; a < nallowed; a++)
+        if (strcmp(allowed[a], key) == 0)
+            return 1;
+    return 0;
+}
+
+/* Check a mapping's keys: scalars, no duplicates, and either all in `allowed`
+ * (a mapping of keywords) or, when `allowed` is NULL, names of `noun`s (a
+ * mapping such as the links or the points of a link; `where` may be NULL).
+ * Returns 1 when the mapping can be read (even with unknown keys). */
+static int check_map(loader *ld, const ynode *map, const char *const *allowed, size_t nallowed,
+                     const char *where, const char *noun)
+{
+    if (!want_kind(ld, map, YNODE_MAP, where ? where : noun))
         return 0;
     for (size_t i = 0; i < map->n; i++) {
         const ynode *k = map->items[2 * i];
         if (k->kind != YNODE_SCALAR) {
-            err(ld, k, "a key in %s must be a plain name", where);
+            err(ld, k, "a key in %s must be a plain name", where ? where : noun);
             continue;
         }
         for (size_t j = 0; j < i; j++) {
             const ynode *o = map->items[2 * j];
             if (o->kind == YNODE_SCALAR && strcmp(o->text, k->text) == 0) {
-                err(ld, k, "duplicate key '%s' in %s (first given at line %d)", k->text, where,
-                    o->mark.line);
+                if (noun)
+                    err(ld, k, "duplicate %s '%s'%s%s (first given at line %d)", noun, k->text,
+                        where ? " in " : "", where ? where : "", o->mark.line);
+                else
+                    err(ld, k, "duplicate key '%s' in %s (first given at line %d)", k->text,
+                        where, o->mark.line);
                 break;
             }
         }
-        if (!allowed)
-            continue;
-        size_t a = 0;
-        while (a < nallowed && strcmp(allowed[a], k->text) != 0)
-            a++;
-        if (a < nallowed)
+        if (!allowed || is_allowed(k->text, allowed, nallowed))
             continue;
         const char *near = nearest_name(k->text, allowed, nallowed);
-        if (near)
+        if (near) {
             err(ld, k, "unknown key '%s' in %s (did you mean '%s'?)", k->text, where, near);
-        else
-            err(ld, k, "unknown key '%s' in %s", k->text, where);
+            continue;
+        }
+        char list[400];
+        size_t n = 0;
+        list[0] = '\0';
+        for (size_t a = 0; a < nallowed && n < sizeof list; a++)
+            n += (size_t)snprintf(list + n, sizeof list - n, "%s%s", a ? ", " : "", allowed[a]);
+        err(ld, k, "unknown key '%s' in %s (expected %s%s)", k->text, where,
+            nallowed == 1 ? "" : "one of: ", list);
     }
     return 1;
+}
+
+static int check_keys(loader *ld, const ynode *map, const char *const *allowed, size_t nallowed,
+                      const char *where)
+{
+    return check_map(ld, map, allowed, nallowed, where, NULL);
+}
+
+/* A key of `map` that is not allowed but is a likely typo of `key` (already
+ * reported as such): then `key` is not "missing" as well. */
+static int misspelt(const ynode *map, const char *key, const char *const *allowed,
+                    size_t nallowed)
+{
+    for (size_t i = 0; map && map->kind == YNODE_MAP && i < map->n; i++) {
+        const ynode *k = map->items[2 * i];
+        if (k->kind != YNODE_SCALAR || is_allowed(k->text, allowed, nallowed))
+            continue;
+        const char *near = nearest_name(k->text, allowed, nallowed);
+        if (near && strcmp(near, key) == 0)
+            return 1;
+    }
+    return 0;
+}
+
+/* The key node of `key` in a mapping (for messages about the key itself). */
+static const ynode *key_of(const ynode *map, const char *key)
+{
+    for (size_t i = 0; map && map->kind == YNODE_MAP && i < map->n; i++) {
+        const ynode *k = map->items[2 * i];
+        if (k->kind == YNODE_SCALAR && strcmp(k->text, key) == 0)
+            return k;
+    }
+    return NULL;
+}
+
+/* Does an expression use a parameter whose own definition failed? Then its
+ * error would only repeat that one. */
+static int uses_bad_param(const loader *ld, const char *text)
+{
+    if (ld->bad_params.count == 0)
+        return 0;
+    for (const char *s = text; *s;) {
+        if (!(isalpha((unsigned char)*s) || *s == '_')) {
+            s++;
+            continue;
+        }
+        size_t n = 0;
+        while (isalnum((unsigned char)s[n]) || s[n] == '_')
+            n++;
+        char word[MAX_NAME + 1];
+        if (n <= MAX_NAME) {
+            memcpy(word, s, n);
+            word[n] = '\0';
+            if (name_map_get(&ld->bad_params, word) >= 0)
+                return 1;
+        }
+        s += n;
+    }
+    return 0;
 }
 
 static int valid_name(const char *s)
@@ -163,6 +244,8 @@ static int get_quantity(loader *ld, const ynode *n, quantity q, const char *what
     size_t pos = 0;
     if (quantity_eval(n->text, q, &ld->env, out, msg, sizeof msg, &pos) == 0)
         return 1;
+    if (uses_bad_param(ld, n->text))
+        return 0;
     mech_mark at = n->mark;
     if (!strchr(n->text, '\n'))
         at.col += (int)pos + (n->quoted ? 1 : 0);
@@ -206,23 +289,37 @@ static int get_bool(loader *ld, const ynode *n, const char *what, int *out)
 
 static int get_vec2(loader *ld, const ynode *n, quantity q, const char *what, double out[2])
 {
-    if (n->kind != YNODE_SEQ || n->n != 2) {
-        err(ld, n, "%s must be a list of two values [x, y]", what);
+    if (n->kind != YNODE_SEQ) {
+        err(ld, n, "%s must be a list of two values [x, y], not %s", what,
+            ynode_kind_name(n->kind));
+        return 0;
+    }
+    if (n->n != 2) {
+        err(ld, n, "%s must be a list of two values [x, y], not of %zu", what, n->n);
         return 0;
     }
     int ok = get_quantity(ld, n->items[0], q, what, &out[0]);
     return get_quantity(ld, n->items[1], q, what, &out[1]) && ok;
 }
 
-/* Look up a name among candidates and say the nearest one when missing. */
-static void err_unknown(loader *ld, const ynode *n, const char *kind, const char *name,
-                        const char *const *cands, size_t ncands)
+/* Report a name that is not among the candidates: say the nearest one, or
+ * list them all when there are few (`kinds` is the plural of `kind`). */
+static void err_unknown(loader *ld, const ynode *n, const char *kind, const char *kinds,
+                        const char *name, const char *const *cands, size_t ncands)
 {
     const char *near = nearest_name(name, cands, ncands);
     if (near)
-        err(ld, n, "unknown %s '%s' (did you mean '%s'?)", kind, name, near);
-    else
-        err(ld, n, "unknown %s '%s'", kind, name);
+        return (void)err(ld, n, "unknown %s '%s' (did you mean '%s'?)", kind, name, near);
+    if (ncands == 0)
+        return (void)err(ld, n, "unknown %s '%s' (there are no %s)", kind, name, kinds);
+    if (ncands > 12)
+        return (void)err(ld, n, "unknown %s '%s'", kind, name);
+    char list[12 * (MAX_NAME + 2) + 1];
+    size_t len = 0;
+    list[0] = '\0';
+    for (size_t i = 0; i < ncands && len < sizeof list; i++)
+        len += (size_t)snprintf(list + len, sizeof list - len, "%s%s", i ? ", " : "", cands[i]);
+    err(ld, n, "unknown %s '%s' (the %s are: %s)", kind, name, kinds, list);
 }
 
 static int find_link_or_report(loader *ld, const ynode *n, const char *what)
@@ -231,12 +328,12 @@ static int find_link_or_report(loader *ld, const ynode *n, const char *what)
     if (!name)
         return -1;
     int li = find_link(ld, name);
-    if (li >= 0)
+    if (li >= 0 || ld->links_bad)
         return li;
     const char **names = xcalloc((size_t)ld->m->nlinks, sizeof *names);
     for (int i = 0; names && i < ld->m->nlinks; i++)
         names[i] = ld->m->links[i].name;
-    err_unknown(ld, n, "link", name, names, names ? (size_t)ld->m->nlinks : 0);
+    err_unknown(ld, n, "link", "links", name, names, names ? (size_t)ld->m->nlinks : 0);
     free(names);
     return -1;
 }
@@ -247,8 +344,8 @@ static int find_point_or_report(loader *ld, const ynode *n, const char *what)
     if (!name)
         return -1;
     int id = find_point(ld, name);
-    if (id < 0)
-        err_unknown(ld, n, "point", name, (const char *const *)ld->m->point_names,
+    if (id < 0 && !ld->links_bad && !ld->points_bad)
+        err_unknown(ld, n, "point", "points", name, (const char *const *)ld->m->point_names,
                     (size_t)ld->m->npoint_names);
     return id;
 }
@@ -276,28 +373,39 @@ static void load_units(loader *ld, const ynode *map)
         }
         const quantity_info *qi = quantity_get((quantity)q);
         if (!dim_equal(d, qi->d)) {
+            const char *noun = NULL;
+            for (int o = 0; o < NQUANTITIES; o++)
+                if (dim_equal(d, quantity_get((quantity)o)->d))
+                    noun = quantity_get((quantity)o)->noun;
             char u[64];
             dim_format(d, u, sizeof u);
-            err(ld, v, "'%s' is not a unit of %s (it is in %s; %s is in %s)", v->text, k->text, u,
-                k->text, qi->si_unit);
+            if (noun)
+                err(ld, v, "'%s' is not a unit of %s (it measures %s; %s is in %s)", v->text,
+                    k->text, noun, k->text, qi->si_unit);
+            else
+                err(ld, v, "'%s' is not a unit of %s (it is in %s; %s is in %s)", v->text,
+                    k->text, u, k->text, qi->si_unit);
             continue;
         }
         ld->units.scale[q] = scale;
     }
 }
 
-static int reserved_name(const char *s)
+/* What a name already means in an expression, or NULL if it is free. */
+static const char *reserved_name(const char *s)
 {
-    static const char *const words[] = {"pi", "sqrt", "sin", "cos", "tan", "atan2"};
+    static const char *const words[] = {"sqrt", "sin", "cos", "tan", "atan2"};
+    if (strcmp(s, "pi") == 0)
+        return "the constant";
     for (size_t i = 0; i < COUNT(words); i++)
         if (strcmp(s, words[i]) == 0)
-            return 1;
-    return unit_is_name(s, strlen(s));
+            return "the function";
+    return unit_is_name(s, strlen(s)) ? "the unit" : NULL;
 }
 
 static void load_parameters(loader *ld, const ynode *map)
 {
-    if (!check_keys(ld, map, NULL, 0, "parameters"))
+    if (!check_map(ld, map, NULL, 0, NULL, "parameter"))
         return;
     mech_model *m = ld->m;
     m->params = xcalloc(map->n, sizeof *m->params);
@@ -311,8 +419,10 @@ static void load_parameters(loader *ld, const ynode *map)
         const char *name = get_name(ld, k, "parameter name");
         if (!name)
             continue;
-        if (reserved_name(name)) {
-            err(ld, k, "parameter name '%s' is a unit or function name; choose another", name);
+        const char *taken = reserved_name(name);
+        if (taken) {
+            err(ld, k, "parameter name '%s' is already %s '%s' in expressions; choose another "
+                       "name", name, taken, name);
             continue;
         }
         if (ymap_get(map, name) != v)
@@ -323,6 +433,9 @@ static void load_parameters(loader *ld, const ynode *map)
         char msg[256];
         size_t pos = 0;
         if (quantity_eval_param(v->text, &ld->env, &p, msg, sizeof msg, &pos) < 0) {
+            int echo = uses_bad_param(ld, v->text);
+            if (name_map_put(&ld->bad_params, k->text, 1) < 0 || echo)
+                continue;
             mech_mark at = v->mark;
             at.col += (int)pos + (v->quoted ? 1 : 0);
             diag_error(ld->d, ld->file, at, "parameter '%s': %s", name, msg);
@@ -410,37 +523,51 @@ static int load_point_coords(loader *ld, const mech_link *l, const ynode *v, con
     return ok;
 }
 
-static void load_points(loader *ld, mech_link *l, const ynode *map)
+/* The points of a link; returns 0 when some point had an error. A point with
+ * wrong coordinates is kept (at 0, 0) so that its name still joins links and
+ * the error is not echoed by every use of the name. */
+static int load_points(loader *ld, mech_link *l, const ynode *map)
 {
     char where[128];
-    snprintf(where, sizeof where, "the points of link '%s'", l->name);
-    if (!check_keys(ld, map, NULL, 0, where))
-        return;
+    snprintf(where, sizeof where, "link '%s'", l->name);
+    if (map->kind != YNODE_MAP) {
+        ld->points_bad = 1;
+        return err(ld, map, "the points of link '%s' must be a mapping from point name to "
+                            "coordinates (such as 'A: [20, 0]'), not %s", l->name,
+                   ynode_kind_name(map->kind)), 0;
+    }
+    size_t errors = ld->d->nerrors;
+    check_map(ld, map, NULL, 0, where, "point");
     if (map->n > MAX_POINTS_PER_LINK) {
         err(ld, map, "link '%s' has %zu points; at most %d", l->name, map->n, MAX_POINTS_PER_LINK);
-        return;
+        return 0;
     }
     l->points = xcalloc(map->n, sizeof *l->points);
     if (!l->points) {
         err(ld, map, "out of memory");
-        return;
+        return 0;
     }
     for (size_t i = 0; i < map->n; i++) {
         const ynode *k = map->items[2 * i], *v = map->items[2 * i + 1];
         const char *name = get_name(ld, k, "point name");
+        if (!name)
+            ld->points_bad = 1;
         if (!name || ymap_get(map, name) != v)
             continue;  /* invalid or duplicate (reported) */
         char what[128];
         snprintf(what, sizeof what, "point '%s' of link '%s'", name, l->name);
         mech_point *p = &l->points[l->npoints];
         if (!load_point_coords(ld, l, v, what, &p->x, &p->y))
-            continue;
+            p->x = p->y = 0;
         p->name = xstrdup(name);
         p->id = intern_point(ld, name);
         p->mark = k->mark;
         l->npoints++;
     }
+    return ld->d->nerrors == errors;
 }
+
+static const char *const link_keys[] = {"points", "symbol", "mass", "center", "inertia"};
 
 static void load_mass(loader *ld, mech_link *l, const ynode *map)
 {
@@ -449,6 +576,8 @@ static void load_mass(loader *ld, mech_link *l, const ynode *map)
     if (!mass && !center && !inertia)
         return;
     char what[128];
+    if (!mass && misspelt(map, "mass", link_keys, COUNT(link_keys)))
+        return;  /* reported as a typo */
     if (!mass) {
         err(ld, center ? center : inertia, "link '%s' has '%s' but no 'mass'", l->name,
             center ? "center" : "inertia");
@@ -459,6 +588,9 @@ static void load_mass(loader *ld, mech_link *l, const ynode *map)
         return;
     if (l->mass < 0)
         err(ld, mass, "%s is negative", what);
+    if ((!center && misspelt(map, "center", link_keys, COUNT(link_keys))) ||
+        (!inertia && misspelt(map, "inertia", link_keys, COUNT(link_keys))))
+        return;
     if (!center || !inertia) {
         err(ld, mass, "link '%s' has a mass but no '%s' (give both center and inertia)", l->name,
             center ? "inertia" : "center");
@@ -499,24 +631,35 @@ static void load_ground(loader *ld, const ynode *map)
         name_map_put(&ld->link_map, g->name, 0);
     if (map) {
         g->mark = map->mark;
-        load_points(ld, g, map);
+        if (!load_points(ld, g, map))
+            ld->link_failed[0] = 1;
     }
 }
 
 static void load_link(loader *ld, mech_link *l, const ynode *k, const ynode *v)
 {
-    static const char *const keys[] = {"points", "symbol", "mass", "center", "inertia"};
     l->name = xstrdup(k->text);
     l->mark = k->mark;
+    if (!l->name)
+        return (void)err(ld, k, "out of memory");
     char where[128];
     snprintf(where, sizeof where, "link '%s'", l->name);
-    if (!check_keys(ld, v, keys, COUNT(keys), where))
-        return;
+    unsigned char *failed = &ld->link_failed[l - ld->m->links];
+    if (v->kind != YNODE_MAP) {
+        *failed = 1;
+        return (void)err(ld, v, "link '%s' must be a mapping with its 'points' (and optionally "
+                                "'mass', 'center', 'inertia', 'symbol'), not %s", l->name,
+                         ynode_kind_name(v->kind));
+    }
+    check_keys(ld, v, link_keys, COUNT(link_keys), where);
     const ynode *points = ymap_get(v, "points"), *sym = ymap_get(v, "symbol");
-    if (!points)
-        err(ld, v, "link '%s' has no 'points'", l->name);
-    else
-        load_points(ld, l, points);
+    if (!points) {
+        *failed = 1;
+        if (!misspelt(v, "points", link_keys, COUNT(link_keys)))
+            err(ld, k, "link '%s' has no 'points'", l->name);
+    } else if (!load_points(ld, l, points)) {
+        *failed = 1;
+    }
     if (sym)
         l->symbol = get_string(ld, sym, "symbol", 32);
     load_mass(ld, l, v);
@@ -525,9 +668,15 @@ static void load_link(loader *ld, mech_link *l, const ynode *k, const ynode *v)
 static void load_links(loader *ld, const ynode *map)
 {
     mech_model *m = ld->m;
-    if (!check_keys(ld, map, NULL, 0, "links"))
-        return;
+    if (map->kind != YNODE_MAP) {
+        ld->links_bad = 1;
+        return (void)err(ld, map, "'links' must be a mapping from each link's name to its "
+                                  "points (such as 'crank: {points: {O: [0, 0], A: [20, 0]}}'), "
+                                  "not %s", ynode_kind_name(map->kind));
+    }
+    check_map(ld, map, NULL, 0, NULL, "link");
     if (map->n == 0) {
+        ld->links_bad = 1;
         err(ld, map, "'links' is empty: a mechanism needs at least one moving link");
         return;
     }
@@ -604,7 +753,9 @@ static int get_friction(loader *ld, const ynode *map, mech_joint *j)
     if (r && get_quantity(ld, r, Q_LENGTH, "pin radius", &j->pin_radius) && j->pin_radius < 0)
         err(ld, r, "pin radius is negative");
     if (j->friction > 0 && j->kind == MECH_JOINT_REVOLUTE && !r)
-        return err(ld, f, "revolute joint '%s' has friction but no 'pin_radius'", j->name), 0;
+        return err(ld, key_of(map, "friction"), "revolute joint '%s' has friction but no "
+                                                "'pin_radius' (the friction moment needs the "
+                                                "pin radius)", j->name), 0;
     return 1;
 }
 
@@ -667,7 +818,7 @@ static void load_revolute(loader *ld, const ynode *map)
     get_friction(ld, map, j);
 }
 
-static void load_slider(loader *ld, const ynode *map)
+static int load_slider_joint(loader *ld, const ynode *map)
 {
     static const char *const keys[] = {"slider", "link", "on", "through", "angle",
                                        "rotation", "name", "symbol", "friction"};
@@ -677,48 +828,47 @@ static void load_slider(loader *ld, const ynode *map)
                 *through = ymap_get(map, "through"), *ln = ymap_get(map, "link"),
                 *ang = ymap_get(map, "angle"), *rot = ymap_get(map, "rotation");
     const char *missing = !on ? "on" : !through ? "through" : !ang ? "angle" : NULL;
-    if (missing) {
-        err(ld, map, "slider joint is missing '%s' (%s)", missing,
-            !on ? "the link that carries the guide line"
-                : !through ? "a point of the guide link on the line" : "the line's direction");
-        return;
-    }
+    if (missing)
+        return err(ld, map, "slider joint is missing '%s' (%s)", missing,
+                   !on ? "the link that carries the guide line"
+                       : !through ? "a point of the guide link on the line"
+                                  : "the line's direction"), 0;
     int id = find_point_or_report(ld, pn, "slider point");
     int guide = find_link_or_report(ld, on, "guide link");
     if (id < 0 || guide < 0)
-        return;
+        return 0;
     int mover = -1;
     if (ln) {
         mover = find_link_or_report(ld, ln, "sliding link");
         if (mover < 0)
-            return;
+            return 0;
         if (model_point_in_link(&m->links[mover], id) < 0)
-            return (void)err(ld, ln, "link '%s' has no point '%s'", m->links[mover].name, pn->text);
+            return err(ld, ln, "link '%s' has no point '%s'", m->links[mover].name, pn->text), 0;
     } else {
         int nc = 0;
         for (int li = 0; li < m->nlinks; li++)
             if (li != guide && model_point_in_link(&m->links[li], id) >= 0)
                 mover = li, nc++;
         if (nc != 1)
-            return (void)err(ld, pn, "point '%s' is on %d links; say which one slides with "
-                                     "'link: name'", pn->text, nc);
+            return err(ld, pn, "point '%s' is on %d links; say which one slides with "
+                               "'link: name'", pn->text, nc), 0;
     }
     if (mover == guide)
-        return (void)err(ld, on, "a slider's link and its guide ('on') must differ");
+        return err(ld, on, "a slider's link and its guide ('on') must differ"), 0;
     if (model_point_in_link(&m->links[guide], id) >= 0)
-        return (void)err(ld, pn, "the guide link '%s' also has a point '%s'; the sliding point "
-                                 "must be a point of the moving link only", m->links[guide].name,
-                         pn->text);
+        return err(ld, pn, "the guide link '%s' also has a point '%s'; the sliding point "
+                           "must be a point of the moving link only", m->links[guide].name,
+                   pn->text), 0;
     int tid = find_point_or_report(ld, through, "'through' point");
     if (tid < 0)
-        return;
+        return 0;
     int tp = model_point_in_link(&m->links[guide], tid);
     if (tp < 0)
-        return (void)err(ld, through, "'through: %s' must be a point of the guide link '%s'",
-                         through->text, m->links[guide].name);
+        return err(ld, through, "'through: %s' must be a point of the guide link '%s'",
+                   through->text, m->links[guide].name), 0;
     mech_joint *j = new_joint(ld);
     if (!j)
-        return (void)err(ld, map, "out of memory");
+        return err(ld, map, "out of memory"), 0;
     j->kind = MECH_JOINT_SLIDER;
     j->is_explicit = 1;
     j->mark = map->mark;
@@ -741,6 +891,20 @@ static void load_slider(loader *ld, const ynode *map)
     if (sym)
         j->symbol = get_string(ld, sym, "symbol", 32);
     get_friction(ld, map, j);
+    return 1;
+}
+
+/* A slider that could not be made leaves its block with a single point:
+ * that link is not also reported as having too few points. */
+static void load_slider(loader *ld, const ynode *map)
+{
+    if (load_slider_joint(ld, map))
+        return;
+    const ynode *pn = ymap_get(map, "slider");
+    int id = pn && pn->kind == YNODE_SCALAR ? find_point(ld, pn->text) : -1;
+    for (int li = 0; id >= 0 && li < ld->m->nlinks; li++)
+        if (model_point_in_link(&ld->m->links[li], id) >= 0)
+            ld->link_failed[li] = 1;
 }
 
 static void load_joints(loader *ld, const ynode *seq)
@@ -875,7 +1039,7 @@ static void check_link_points(loader *ld)
     mech_model *m = ld->m;
     for (int li = 1; li < m->nlinks; li++) {
         const mech_link *l = &m->links[li];
-        if (l->npoints >= 2 || !l->name)
+        if (l->npoints >= 2 || !l->name || ld->link_failed[li])
             continue;
         int slides = 0;
         for (int ji = 0; ji < m->njoints; ji++)
@@ -916,7 +1080,7 @@ static int slider_by_name(loader *ld, const ynode *n, const char *what)
     for (int i = 0; names && i < m->njoints; i++)
         if (m->joints[i].kind == MECH_JOINT_SLIDER)
             names[k++] = m->joints[i].name;
-    err_unknown(ld, n, "slider", name, names, k);
+    err_unknown(ld, n, "slider", "sliders", name, names, k);
     free(names);
     return -1;
 }
@@ -948,7 +1112,7 @@ static void load_range(loader *ld, const ynode *n, quantity q, mech_driver *dr)
     long s;
     int ok = get_quantity(ld, from, q, what, &a);
     ok = get_quantity(ld, to, q, what, &b) && ok;
-    ok = get_count(ld, steps, "steps", 1, MAX_STEPS, &s) && ok;
+    ok = get_count(ld, steps, "'steps'", 1, MAX_STEPS, &s) && ok;
     if (!ok)
         return;
     dr->values = xcalloc((size_t)s + 1, sizeof *dr->values);
@@ -971,17 +1135,32 @@ static void load_driver(loader *ld, const ynode *map)
     const ynode *ln = ymap_get(map, "link"), *sn = ymap_get(map, "slider"),
                 *ang = ymap_get(map, "angle"), *disp = ymap_get(map, "displacement"),
                 *speed = ymap_get(map, "speed"), *acc = ymap_get(map, "acceleration");
-    if ((ln != NULL) == (sn != NULL))
-        return (void)err(ld, map, "the driver needs exactly one of 'link: NAME' (a crank angle) "
-                                  "or 'slider: NAME' (a slider displacement)");
+    if (!ln && !sn)
+        return (void)err(ld, map, "the driver needs 'link: NAME' (a link turned through "
+                                  "'angle') or 'slider: NAME' (a slider moved through "
+                                  "'displacement')");
+    if (ln && sn) {
+        const ynode *kl = key_of(map, "link"), *ks = key_of(map, "slider");
+        const ynode *second = kl->mark.line > ks->mark.line ||
+                              (kl->mark.line == ks->mark.line && kl->mark.col > ks->mark.col)
+                                  ? kl : ks;
+        return (void)err(ld, second, "the driver has both 'link' and 'slider'; give one: "
+                                     "'link: NAME' to turn a link or 'slider: NAME' to move a "
+                                     "slider");
+    }
     quantity pos = ln ? Q_ANGLE : Q_LENGTH;
     if (ln) {
         dr->kind = MECH_DRIVE_ANGLE;
         dr->index = find_link_or_report(ld, ln, "driver link");
         if (dr->index == 0)
-            return (void)err(ld, ln, "the ground cannot be the driver");
-        if (disp)
-            err(ld, disp, "a crank driver takes 'angle', not 'displacement'");
+            return (void)err(ld, ln, "the ground is fixed and cannot be the driver; name the "
+                                     "link that the motor turns");
+        if (disp) {
+            err(ld, key_of(map, "displacement"), "a link driver takes 'angle', not "
+                                                 "'displacement' (that is for a slider driver)");
+            if (!ang)
+                return;
+        }
         for (int ji = 0; dr->index > 0 && ji < m->njoints; ji++)
             if (m->joints[ji].kind == MECH_JOINT_SLIDER && m->joints[ji].locked &&
                 m->joints[ji].link[0] == dr->index)
@@ -991,8 +1170,12 @@ static void load_driver(loader *ld, const ynode *map)
     } else {
         dr->kind = MECH_DRIVE_SLIDER;
         dr->index = slider_by_name(ld, sn, "driver slider");
-        if (ang)
-            err(ld, ang, "a slider driver takes 'displacement', not 'angle'");
+        if (ang) {
+            err(ld, key_of(map, "angle"), "a slider driver takes 'displacement', not 'angle' "
+                                          "(that is for a link driver)");
+            if (!disp)
+                return;
+        }
     }
     if (dr->index < 0)
         return;
@@ -1012,7 +1195,7 @@ static void load_driver(loader *ld, const ynode *map)
 static void load_initial(loader *ld, const ynode *map)
 {
     mech_model *m = ld->m;
-    if (!check_keys(ld, map, NULL, 0, "initial"))
+    if (!check_map(ld, map, NULL, 0, "'initial'", "initial guess for"))
         return;
     m->guesses = xcalloc(map->n, sizeof *m->guesses);
     if (!m->guesses)
@@ -1047,7 +1230,7 @@ static void load_initial(loader *ld, const ynode *map)
             for (int j = 0; names && j < m->njoints; j++)
                 if (m->joints[j].kind == MECH_JOINT_SLIDER)
                     names[c++] = m->joints[j].name;
-            err_unknown(ld, k, "link or slider", name, names, c);
+            err_unknown(ld, k, "link or slider", "moving links and sliders", name, names, c);
             free(names);
         }
     }
@@ -1143,8 +1326,8 @@ static void load_loop(loader *ld, const ynode *n, mech_loop *lp)
         const char *name = n->kind == YNODE_SEQ ? get_name(ld, item, "loop point") : names[i];
         lp->marks[i] = item->mark;
         int id = name ? find_point(ld, name) : -1;
-        if (name && id < 0)
-            err_unknown(ld, item, "point", name, (const char *const *)m->point_names,
+        if (name && id < 0 && !ld->links_bad && !ld->points_bad)
+            err_unknown(ld, item, "point", "points", name, (const char *const *)m->point_names,
                         (size_t)m->npoint_names);
         ok = ok && id >= 0;
         lp->points[i] = id;
@@ -1158,8 +1341,10 @@ static void load_loop(loader *ld, const ynode *n, mech_loop *lp)
     if (len < 4)
         err(ld, n, "a loop must visit at least three points and return to the first (e.g. [A, B, C, A])");
     else if (lp->points[0] != lp->points[len - 1])
-        err(ld, n, "loop does not close: it starts at '%s' and ends at '%s'",
-            m->point_names[lp->points[0]], m->point_names[lp->points[len - 1]]);
+        diag_error(ld->d, ld->file, lp->marks[len - 1],
+                   "loop does not close: it starts at '%s' but ends at '%s' (end it with '%s')",
+                   m->point_names[lp->points[0]], m->point_names[lp->points[len - 1]],
+                   m->point_names[lp->points[0]]);
 }
 
 static void load_loops(loader *ld, const ynode *seq)
@@ -1335,7 +1520,7 @@ static void load_document(loader *ld, const ynode *root)
     const ynode *v;
     static const char *const required[] = {"name", "ground", "links", "driver"};
     for (size_t i = 0; i < COUNT(required); i++)
-        if (!ymap_get(root, required[i]))
+        if (!ymap_get(root, required[i]) && !misspelt(root, required[i], keys, COUNT(keys)))
             err(ld, root, "missing '%s' (a mechanism file needs name, ground, links and driver)",
                 required[i]);
     if ((v = ymap_get(root, "name")))
@@ -1351,7 +1536,8 @@ static void load_document(loader *ld, const ynode *root)
     const ynode *links = ymap_get(root, "links");
     size_t nlinks = 1 + (links && links->kind == YNODE_MAP ? links->n : 0);
     m->links = xcalloc(nlinks, sizeof *m->links);
-    if (!m->links)
+    ld->link_failed = xcalloc(nlinks, sizeof *ld->link_failed);
+    if (!m->links || !ld->link_failed)
         return (void)err(ld, root, "out of memory");
     m->nlinks = 1;
     if ((v = ymap_get(root, "ground")))
@@ -1360,6 +1546,8 @@ static void load_document(loader *ld, const ynode *root)
         load_ground(ld, NULL);
     if (links)
         load_links(ld, links);
+    else
+        ld->links_bad = 1;
     if ((v = ymap_get(root, "joints")))
         load_joints(ld, v);
     add_implicit_revolutes(ld);
@@ -1399,10 +1587,15 @@ int mech_load_string(const char *text, size_t len, const char *name, mech_model 
         return diag_error(d, name, (mech_mark){0, 0}, "out of memory"), MECH_ENOMEM;
     }
     ld.m->file = xstrdup(name);
-    if (want_kind(&ld, root, YNODE_MAP, "a mechanism file"))
+    if (root->kind != YNODE_MAP)
+        err(&ld, root, "a mechanism file must be a mapping of keys ('name:', 'ground:', "
+                       "'links:', 'driver:', ...), not %s", ynode_kind_name(root->kind));
+    else
         load_document(&ld, root);
     ytree_free(root);
     free(ld.params);
+    free(ld.link_failed);
+    name_map_free(&ld.bad_params);
     name_map_free(&ld.point_map);
     name_map_free(&ld.link_map);
     name_map_free(&ld.joint_map);

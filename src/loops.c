@@ -208,18 +208,37 @@ fail:
 
 /* ---- loops from the file -------------------------------------------- */
 
-/* The revolute joint between links a and b at point name id, or -1. */
-static int revolute_between(const mech_model *m, int a, int b, int id)
+/* Record in row[] the crossing from link a to link b at pin `id`: the
+ * revolutes at that point joining them, directly or through other links on
+ * the same pin (three links on one pin are joined by two revolutes). Returns
+ * 0 when no chain of revolutes at `id` joins a and b. Pins hold few links,
+ * so a search over the joints at the point is cheap. */
+static int add_crossing(const mech_model *m, int a, int b, int id, double *row)
 {
-    for (int j = 0; j < m->njoints; j++) {
-        const mech_joint *jt = &m->joints[j];
-        if (jt->kind != MECH_JOINT_REVOLUTE)
-            continue;
-        if (((jt->link[0] == a && jt->link[1] == b) || (jt->link[0] == b && jt->link[1] == a)) &&
-            m->links[jt->link[0]].points[jt->point[0]].id == id)
-            return j;
+    enum { MAXPIN = 64 };
+    int link[MAXPIN], via[MAXPIN], prev[MAXPIN], nl = 0;  /* BFS over links on the pin */
+    link[nl] = a, via[nl] = -1, prev[nl++] = -1;
+    for (int head = 0; head < nl; head++) {
+        if (link[head] == b) {
+            for (int k = head; via[k] >= 0; k = prev[k]) {
+                const mech_joint *j = &m->joints[via[k]];
+                row[via[k]] += j->link[1] == link[k] ? 1.0 : -1.0;  /* crossed link[0] -> link[1] */
+            }
+            return 1;
+        }
+        for (int ji = 0; ji < m->njoints && nl < MAXPIN; ji++) {
+            const mech_joint *j = &m->joints[ji];
+            if (j->kind != MECH_JOINT_REVOLUTE || m->links[j->link[0]].points[j->point[0]].id != id)
+                continue;
+            int other = j->link[0] == link[head] ? j->link[1] : j->link[1] == link[head] ? j->link[0] : -1;
+            int seen = other < 0;
+            for (int k = 0; k < nl && !seen; k++)
+                seen = link[k] == other;
+            if (!seen)
+                link[nl] = other, via[nl] = ji, prev[nl++] = head;
+        }
     }
-    return -1;
+    return 0;
 }
 
 /* One step P -> Q: the links it starts and ends on, and the terms. */
@@ -282,29 +301,23 @@ static int walk_loop(const mech_model *m, const mech_loop *lp, term_buf *b, doub
         if (s == 0)
             first_link = sl;
         else if (prev_link >= 0 && prev_link != sl) {
-            int j = revolute_between(m, prev_link, sl, P);
-            if (j < 0) {
+            if (!add_crossing(m, prev_link, sl, P, row)) {
                 diag_error(d, m->file, lp->marks[s],
                            "loop passes from link '%s' to link '%s' at '%s', but no joint joins "
                            "them there", m->links[prev_link].name, m->links[sl].name,
                            m->point_names[P]);
                 ok = 0;
-            } else {
-                row[j] += m->joints[j].link[0] == prev_link ? 1.0 : -1.0;
             }
         }
         prev_link = el;
     }
     if (ok && prev_link != first_link) {
-        int j = revolute_between(m, prev_link, first_link, lp->points[0]);
-        if (j < 0) {
+        if (!add_crossing(m, prev_link, first_link, lp->points[0], row)) {
             diag_error(d, m->file, lp->marks[nsteps],
                        "loop closes from link '%s' to link '%s' at '%s', but no joint joins them "
                        "there", m->links[prev_link].name, m->links[first_link].name,
                        m->point_names[lp->points[0]]);
             ok = 0;
-        } else {
-            row[j] += m->joints[j].link[0] == prev_link ? 1.0 : -1.0;
         }
     }
     return ok ? MECH_OK : MECH_EINPUT;

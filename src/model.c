@@ -128,25 +128,141 @@ static int report_dangling(const mech_model *m, const int *njoints_of, mech_diag
     return found;
 }
 
-/* Rigid sub-structures: two links joined twice, or three links pinned in a
- * triangle. Returns 1 when one was named. */
-static int report_rigid(const mech_model *m, mech_diag *d)
+/* Freedoms a joint removes between its two links. */
+static int joint_constraints(const mech_joint *j)
 {
-    int found = 0;
-    for (int a = 0; a < m->njoints && found < 3; a++)
-        for (int b = a + 1; b < m->njoints && found < 3; b++) {
-            const mech_joint *ja = &m->joints[a], *jb = &m->joints[b];
-            int same = (ja->link[0] == jb->link[0] && ja->link[1] == jb->link[1]) ||
-                       (ja->link[0] == jb->link[1] && ja->link[1] == jb->link[0]);
-            if (same) {
-                diag_note(d, m->file, jb->mark,
-                          "links '%s' and '%s' are joined twice (joints '%s' and '%s'): together "
-                          "they are one rigid body", m->links[ja->link[0]].name,
-                          m->links[ja->link[1]].name, ja->name, jb->name);
-                found++;
+    return j->kind == MECH_JOINT_SLIDER && !j->locked ? 1 : 2;
+}
+
+typedef struct link_pair {
+    int a, b;    /* link indices, a < b */
+    int joint;   /* first joint between them */
+    int second;  /* another joint between them, or -1 */
+    int cons;    /* freedoms removed by all the joints between them */
+} link_pair;
+
+static int cmp_pair(const void *x, const void *y)
+{
+    const link_pair *p = x, *q = y;
+    if (p->a != q->a)
+        return p->a < q->a ? -1 : 1;
+    if (p->b != q->b)
+        return p->b < q->b ? -1 : 1;
+    return p->joint < q->joint ? -1 : p->joint > q->joint;
+}
+
+static int cmp_int(const void *x, const void *y)
+{
+    int a = *(const int *)x, b = *(const int *)y;
+    return a < b ? -1 : a > b;
+}
+
+/* Three links pinned to each other in a triangle: one rigid body. */
+static void note_triangle(const mech_model *m, const link_pair *e[3], mech_diag *d)
+{
+    int l[3] = {e[0]->a, e[0]->b, e[1]->a == e[0]->a || e[1]->a == e[0]->b ? e[1]->b : e[1]->a};
+    int j[3] = {e[0]->joint, e[1]->joint, e[2]->joint};
+    qsort(l, 3, sizeof *l, cmp_int);
+    qsort(j, 3, sizeof *j, cmp_int);
+    diag_note(d, m->file, m->joints[j[2]].mark,
+              "links '%s', '%s' and '%s' are pinned to each other in a triangle (joints '%s', "
+              "'%s' and '%s'): together they are one rigid body", m->links[l[0]].name,
+              m->links[l[1]].name, m->links[l[2]].name, m->joints[j[0]].name,
+              m->joints[j[1]].name, m->joints[j[2]].name);
+}
+
+/* Rigid sub-structures that explain an over-constraint: two links joined by
+ * joints that leave them no relative motion, or three links pinned to each
+ * other in a triangle. Notes name at most three; O(J log J + J^1.5). */
+static void report_rigid(const mech_model *m, mech_diag *d)
+{
+    int nj = m->njoints, np = 0, found = 0;
+    link_pair *pairs = xcalloc((size_t)nj, sizeof *pairs);
+    int *deg = xcalloc((size_t)m->nlinks, sizeof *deg);
+    int *start = xcalloc((size_t)m->nlinks + 1, sizeof *start);
+    int *out = xcalloc((size_t)nj, sizeof *out);      /* pair index, by lower-ranked end */
+    int *mark = xcalloc((size_t)m->nlinks, sizeof *mark);  /* u + 1 when adjacent to u */
+    int *via = xcalloc((size_t)m->nlinks, sizeof *via);    /* that pair's index */
+    if (!pairs || !deg || !start || !out || !mark || !via)
+        goto done;
+    /* one entry per pair of links, with the freedoms its joints remove */
+    for (int i = 0; i < nj; i++) {
+        const mech_joint *jt = &m->joints[i];
+        int a = jt->link[0] < jt->link[1] ? jt->link[0] : jt->link[1];
+        int b = jt->link[0] < jt->link[1] ? jt->link[1] : jt->link[0];
+        pairs[i] = (link_pair){a, b, i, -1, joint_constraints(jt)};
+    }
+    qsort(pairs, (size_t)nj, sizeof *pairs, cmp_pair);
+    for (int i = 0; i < nj; i++) {
+        link_pair *last = np ? &pairs[np - 1] : NULL;
+        if (last && last->a == pairs[i].a && last->b == pairs[i].b) {
+            if (last->second < 0)
+                last->second = pairs[i].joint;
+            last->cons += pairs[i].cons;
+        } else {
+            pairs[np++] = pairs[i];
+        }
+    }
+    for (int i = 0; i < np && found < 3; i++) {
+        const link_pair *p = &pairs[i];
+        if (p->second < 0 || p->cons < 3)
+            continue;
+        const mech_joint *ja = &m->joints[p->joint], *jb = &m->joints[p->second];
+        diag_note(d, m->file, jb->mark,
+                  "links '%s' and '%s' are joined twice (joints '%s' and '%s'): together they "
+                  "are one rigid body", m->links[p->a].name, m->links[p->b].name, ja->name,
+                  jb->name);
+        found++;
+    }
+    /* triangles of pairs that are each pinned once: list them with every
+     * edge directed from the lower-ranked end (degree, then index) */
+    for (int i = 0; i < np; i++)
+        if (pairs[i].cons == 2)
+            deg[pairs[i].a]++, deg[pairs[i].b]++;
+#define LOWER(u, v) (deg[u] < deg[v] || (deg[u] == deg[v] && (u) < (v)))
+    for (int i = 0; i < np; i++)
+        if (pairs[i].cons == 2)
+            start[(LOWER(pairs[i].a, pairs[i].b) ? pairs[i].a : pairs[i].b) + 1]++;
+    for (int v = 0; v < m->nlinks; v++)
+        start[v + 1] += start[v];
+    {
+        int *fill = mark;  /* borrowed, reset below */
+        for (int i = 0; i < np; i++)
+            if (pairs[i].cons == 2) {
+                int u = LOWER(pairs[i].a, pairs[i].b) ? pairs[i].a : pairs[i].b;
+                out[start[u] + fill[u]++] = i;
+            }
+        memset(mark, 0, (size_t)m->nlinks * sizeof *mark);
+    }
+    for (int u = 0; u < m->nlinks && found < 3; u++) {
+        for (int k = start[u]; k < start[u + 1]; k++) {
+            const link_pair *e = &pairs[out[k]];
+            int v = e->a == u ? e->b : e->a;
+            mark[v] = u + 1;
+            via[v] = out[k];
+        }
+        for (int k = start[u]; k < start[u + 1] && found < 3; k++) {
+            const link_pair *e = &pairs[out[k]];
+            int v = e->a == u ? e->b : e->a;
+            for (int t = start[v]; t < start[v + 1] && found < 3; t++) {
+                const link_pair *f = &pairs[out[t]];
+                int w = f->a == v ? f->b : f->a;
+                if (mark[w] == u + 1) {
+                    const link_pair *tri[3] = {e, f, &pairs[via[w]]};
+                    note_triangle(m, tri, d);
+                    found++;
+                }
             }
         }
-    return found;
+    }
+#undef LOWER
+done:
+    free(pairs);
+    free(deg);
+    free(start);
+    free(out);
+    free(mark);
+    free(via);
 }
 
 static void count_joints(const mech_model *m, mech_summary *s, int *njoints_of)
@@ -189,21 +305,25 @@ int mech_check(const mech_model *m, mech_summary *s, mech_diag *d)
     int dangling = report_dangling(m, njoints_of, d);
     if (connected && !dangling && s->mobility != s->ndrivers) {
         mech_mark at = m->has_driver ? m->driver.mark : (mech_mark){0, 0};
-        if (s->mobility > s->ndrivers) {
+        int excess = s->mobility - s->ndrivers, abs_excess = excess < 0 ? -excess : excess;
+        char gruebler[128];
+        snprintf(gruebler, sizeof gruebler, "%d degree%s of freedom (Gruebler: 3*(%d-1) - 2*%d "
+                 "- %d = %d) but %d driver, so %d unknown%s for %d loop equations",
+                 s->mobility, s->mobility == 1 || s->mobility == -1 ? "" : "s", m->nlinks,
+                 s->nrevolute + s->nprismatic, s->npin_in_slot, s->mobility, s->ndrivers,
+                 s->nunknowns, s->nunknowns == 1 ? "" : "s", s->nequations);
+        if (excess > 0) {
             diag_error(d, m->file, at,
-                       "under-constrained: the mechanism has %d degrees of freedom "
-                       "(Gruebler: 3*(%d-1) - 2*%d - %d) but %d driver; %d unknowns for %d loop "
-                       "equations. Add a joint or a link, or lock a slider",
-                       s->mobility, m->nlinks, s->nrevolute + s->nprismatic, s->npin_in_slot,
-                       s->ndrivers, s->nunknowns, s->nequations);
+                       "under-constrained: the mechanism has %s; %d more degree%s of freedom "
+                       "must be fixed (add a link or a joint%s)", gruebler, abs_excess,
+                       abs_excess == 1 ? "" : "s",
+                       s->npin_in_slot ? ", or lock a slider's rotation" : "");
         } else {
             diag_error(d, m->file, at,
-                       "over-constrained: the mechanism has %d degree%s of freedom "
-                       "(Gruebler: 3*(%d-1) - 2*%d - %d) but %d driver; %d unknowns for %d loop "
-                       "equations. Remove a joint or free a slider's rotation",
-                       s->mobility, s->mobility == 1 || s->mobility == -1 ? "" : "s", m->nlinks,
-                       s->nrevolute + s->nprismatic, s->npin_in_slot, s->ndrivers,
-                       s->nunknowns, s->nequations);
+                       "over-constrained: the mechanism has %s; its joints remove %d degree%s "
+                       "of freedom too many (remove a joint%s)", gruebler, abs_excess,
+                       abs_excess == 1 ? "" : "s",
+                       s->nprismatic ? ", or free a slider's rotation" : "");
             report_rigid(m, d);
         }
     }
