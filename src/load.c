@@ -518,9 +518,11 @@ static int load_point_coords(loader *ld, const mech_link *l, const ynode *v, con
             ok = 0;
         }
     }
+    if (!ok)
+        return 0;  /* r or a may be unset */
     *x = x0 + r * cos(a);
     *y = y0 + r * sin(a);
-    return ok;
+    return 1;
 }
 
 /* The points of a link; returns 0 when some point had an error. A point with

@@ -145,6 +145,44 @@ Test(load_files, every_file_loads_and_checks)
     cr_expect_geq(nfiles, 2, "mechanisms/ holds at least fourbar.yaml and slider-crank.yaml");
 }
 
+/* The complete examples of docs/format.md (section 15): every ```yaml block
+ * after the heading "## 15." must load and check, so the documentation
+ * cannot drift from the loader. */
+Test(load_files, documented_examples_load_and_check)
+{
+    FILE *f = fopen("docs/format.md", "rb");
+    cr_assert_not_null(f, "docs/format.md not found (run from the repository root)");
+    static char doc[1 << 18];
+    size_t n = fread(doc, 1, sizeof doc - 1, f);
+    fclose(f);
+    doc[n] = '\0';
+    const char *s = strstr(doc, "\n## 15.");
+    cr_assert_not_null(s, "no section 15 in docs/format.md");
+    const char *end = strstr(s + 1, "\n## ");
+    int nexamples = 0;
+    while ((s = strstr(s, "```yaml\n")) != NULL && (!end || s < end)) {
+        s += strlen("```yaml\n");
+        const char *close = strstr(s, "\n```");
+        cr_assert_not_null(close, "unclosed ```yaml block");
+        char name[64];
+        snprintf(name, sizeof name, "docs/format.md example %d", ++nexamples);
+        mech_diag d;
+        mech_diag_init(&d);
+        mech_model *m = NULL;
+        int rc = mech_load_string(s, (size_t)(close - s) + 1, name, &m, &d);
+        cr_expect_eq(rc, MECH_OK, "%s does not load:%s", name, diag_text(&d));
+        if (rc == MECH_OK) {
+            mech_summary sum;
+            rc = mech_check(m, &sum, &d);
+            cr_expect_eq(rc, MECH_OK, "%s fails mech_check:%s", name, diag_text(&d));
+        }
+        mech_model_free(&m);
+        mech_diag_free(&d);
+        s = close + 4;
+    }
+    cr_expect_eq(nexamples, 2, "section 15 has the four-bar and the slider-crank");
+}
+
 /* ---- Gruebler-Kutzbach counts ---------------------------------------------- */
 
 static const char FOURBAR[] =
@@ -415,12 +453,9 @@ Test(mobility, triangle_is_rigid)
     mech_model_free(&m);
 }
 
-/* src/model.c report_rigid() promises to name "three links pinned in a
- * triangle" as a rigid sub-structure (its comment), but only two links joined
- * twice are detected; the triangle gets the over-constrained error with no
- * note saying which links form the rigid triangle. Disabled until model.c
- * implements it (or the comment is corrected). */
-Test(mobility, triangle_is_named_as_rigid, .disabled = true)
+/* The over-constrained error is followed by a note naming the rigid
+ * triangle (src/model.c report_rigid). */
+Test(mobility, triangle_is_named_as_rigid)
 {
     mech_model *m = load_ok("triangle", TRIANGLE);
     mech_diag d;
@@ -429,6 +464,12 @@ Test(mobility, triangle_is_named_as_rigid, .disabled = true)
     mech_check(m, &s, &d);
     int k = diag_find(&d, "triangle");
     cr_expect_geq(k, 0, "no note names the rigid triangle:%s", diag_text(&d));
+    if (k >= 0) {
+        cr_expect_eq(d.entries[k].severity, MECH_SEV_NOTE);
+        cr_expect(strstr(d.entries[k].message, "'ground'") && strstr(d.entries[k].message, "'a'") &&
+                      strstr(d.entries[k].message, "'b'"),
+                  "%s", d.entries[k].message);
+    }
     mech_diag_free(&d);
     mech_model_free(&m);
 }
