@@ -103,7 +103,8 @@ static int check_map(loader *ld, const ynode *map, const char *const *allowed, s
     for (size_t i = 0; i < map->n; i++) {
         const ynode *k = map->items[2 * i];
         if (k->kind != YNODE_SCALAR) {
-            err(ld, k, "a key in %s must be a plain name", where ? where : noun);
+            if (!noun)  /* else the caller reports it as an invalid name */
+                err(ld, k, "a key in %s must be a plain name", where);
             continue;
         }
         for (size_t j = 0; j < i; j++) {
@@ -405,7 +406,7 @@ static const char *reserved_name(const char *s)
 
 static void load_parameters(loader *ld, const ynode *map)
 {
-    if (!check_map(ld, map, NULL, 0, NULL, "parameter"))
+    if (!check_map(ld, map, NULL, 0, "'parameters'", "parameter"))
         return;
     mech_model *m = ld->m;
     m->params = xcalloc(map->n, sizeof *m->params);

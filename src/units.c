@@ -3,9 +3,9 @@
  *
  * Grammar of a quantity expression (docs/format.md, "Values and units"):
  *   expr   := term  (('+' | '-') term)*
- *   term   := power (('*' | '/') power)*
- *   power  := unary ('^' ['-'] integer)?
- *   unary  := '-' unary | '+' unary | atom
+ *   term   := unary (('*' | '/') unary)*
+ *   unary  := '-' unary | '+' unary | power
+ *   power  := atom ('^' ['-'] integer)?
  *   atom   := number [unit] | name | func '(' expr [',' expr] ')' | '(' expr ')'
  *   unit   := uname ['^' ['-'] integer] (('*' | '/') uname ['^' ['-'] integer])*
  * A bare number (no unit) is "bare": it takes the file's default unit of
@@ -402,7 +402,7 @@ static qval call_function(qparser *p, const char *name, size_t n, const char *at
             return a;
         }
         double r = IS("sin") ? sin(a.v) : IS("cos") ? cos(a.v) : tan(a.v);
-        return (qval){r, {{0, 0, 0, 0}}, 0};
+        return make_bare(r);  /* a pure number: 100 * cos(60) takes the default length unit */
     }
 #undef IS
     qfail(p, at, "unknown function '%.*s' (known: sqrt, sin, cos, tan, atan2)", (int)n, name);
@@ -431,8 +431,8 @@ static qval parse_atom(qparser *p)
             p->s = after + 1;
             return call_function(p, at, n, at);
         }
-        if (n == 2 && memcmp(at, "pi", 2) == 0)
-            return (qval){PI, {{0, 0, 0, 0}}, 1};
+        if (n == 2 && memcmp(at, "pi", 2) == 0)  /* pi rad: angle: pi/2 is 90 deg whatever the default */
+            return (qval){PI, quantity_table[Q_ANGLE].d, 0};
         for (int i = 0; i < p->env->nparams; i++) {
             const expr_param *q = &p->env->params[i];
             if (strlen(q->name) == n && memcmp(q->name, at, n) == 0)
@@ -456,6 +456,9 @@ static qval parse_atom(qparser *p)
     return parse_number(p);
 }
 
+static qval parse_power(qparser *p);
+
+/* unary := ('-' | '+') unary | power, so -r^2 is -(r^2) */
 static qval parse_unary(qparser *p)
 {
     p->s = skip_space(p->s);
@@ -471,7 +474,7 @@ static qval parse_unary(qparser *p)
         if (neg)
             v.v = -v.v;
     } else {
-        v = parse_atom(p);
+        v = parse_power(p);
     }
     p->depth--;
     return v;
@@ -479,7 +482,7 @@ static qval parse_unary(qparser *p)
 
 static qval parse_power(qparser *p)
 {
-    qval a = parse_unary(p);
+    qval a = parse_atom(p);
     const char *at = skip_space(p->s);
     int e;
     int r = parse_exponent(&p->s, &e);
@@ -496,13 +499,13 @@ static qval parse_power(qparser *p)
 
 static qval parse_term(qparser *p)
 {
-    qval a = parse_power(p);
+    qval a = parse_unary(p);
     for (;;) {
         const char *at = skip_space(p->s);
         if (p->failed || (*at != '*' && *at != '/'))
             return a;
         p->s = at + 1;
-        qval b = parse_power(p);
+        qval b = parse_unary(p);
         if (*at == '*') {
             a.v *= b.v;
         } else {
@@ -556,7 +559,6 @@ int quantity_eval(const char *text, quantity want, const expr_env *env, double *
         *value = v.v * env->units->scale[want];
         return 0;
     }
-    /* an angle is also accepted where a pure number is not expected: rad is 1 */
     if (!dim_equal(v.d, qi->d)) {
         char got[96];
         describe_dim(v.d, got, sizeof got);
