@@ -25,7 +25,9 @@ CFLAGS  = $(CFLAGS_BASE) $(OPT) $(SAN) -Iinclude $(YAML_CFLAGS) $(KLU_CFLAGS)
 LDLIBS  = $(YAML_LIBS) $(KLU_LIBS) -lm
 LDFLAGS = $(SAN)
 
-LIB_SRC  = $(filter-out src/main.c,$(wildcard src/*.c))
+CMD_SRC  = src/main.c $(wildcard src/cmd_*.c)
+CMD_OBJ  = $(CMD_SRC:src/%.c=$(BUILD)/obj/%.o)
+LIB_SRC  = $(filter-out $(CMD_SRC),$(wildcard src/*.c))
 LIB_OBJ  = $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o)
 TEST_SRC = $(wildcard tests/unit/*.c)
 TEST_OBJ = $(TEST_SRC:tests/unit/%.c=$(BUILD)/tests/%.o)
@@ -43,7 +45,7 @@ $(BUILD)/libmech.a: $(LIB_OBJ)
 	rm -f $@
 	ar rcs $@ $^
 
-$(BUILD)/mech: $(BUILD)/obj/main.o $(BUILD)/libmech.a
+$(BUILD)/mech: $(CMD_OBJ) $(BUILD)/libmech.a
 	$(CC) $(LDFLAGS) -o $@ $^ $(LDLIBS)
 
 $(BUILD)/tests/%.o: tests/unit/%.c $(HEADERS) | $(BUILD)/tests

@@ -233,6 +233,97 @@ typedef enum { MECH_FORMAT_TEXT, MECH_FORMAT_LATEX } mech_format;
  * velocity and acceleration right-hand sides. */
 void mech_system_print(const mech_system *s, mech_format fmt, FILE *out);
 
+/* ------------------------------------------------------------------ */
+/* Solving: positions, velocities, accelerations over the driver sweep */
+/* (src/solve.c; the numerical method is in docs/solver.md).           */
+
+/* What to compute (bits). Accelerations need velocities, velocities need
+ * positions; asking for more implies the lower levels. */
+enum {
+    MECH_WANT_POSITION = 1,
+    MECH_WANT_VELOCITY = 2,
+    MECH_WANT_ACCELERATION = 4,
+    MECH_WANT_ALL = 7
+};
+
+typedef struct mech_solve_options {
+    double tol;        /* Newton tolerance relative to the largest length (default 1e-12) */
+    int max_iter;      /* Newton iterations per step before giving up (default 50) */
+    double min_rcond;  /* a converged position with a smaller reciprocal condition
+                          estimate (klu_rcond, equilibrated) is singular (default 1e-8) */
+    int want;          /* MECH_WANT_* bits (default MECH_WANT_ALL) */
+    int all_blocks;    /* 1: solve every unknown, also those no output needs */
+    int diagnostics;   /* 1: add the columns iterations, residual, rcond */
+    int has_range;     /* 1: sweep from..to in `steps` intervals instead of the file's */
+    double from, to;   /* driver positions, SI (rad or m) */
+    int steps;
+    FILE *log;         /* when not NULL: which blocks are solved, and why (--verbose) */
+} mech_solve_options;
+
+void mech_solve_options_default(mech_solve_options *o);
+
+/* A table of results: named columns with units, one row per driver step. */
+typedef struct mech_column {
+    char *name;        /* "q", "B.x", "coupler.omega", "x_B.s", ...; owned */
+    char *unit;        /* "m", "rad/s", "-", ...; owned */
+} mech_column;
+
+typedef struct mech_table {
+    mech_column *columns;  /* [ncolumns] */
+    int ncolumns;
+    double *values;        /* [nrows * ncolumns], row-major */
+    int nrows;
+} mech_table;
+
+void mech_table_free(mech_table *t);
+/* Index of the column called `name`, or -1. */
+int mech_table_column(const mech_table *t, const char *name);
+/* Value of column `col` in row `row`. */
+static inline double mech_table_get(const mech_table *t, int row, int col)
+{
+    return t->values[(size_t)row * (size_t)t->ncolumns + (size_t)col];
+}
+
+/* How a sweep went. */
+typedef struct mech_solve_stats {
+    int steps;               /* rows solved */
+    long iterations;         /* Newton iterations, all steps */
+    int max_iterations;      /* worst step */
+    double worst_residual;   /* largest converged closure residual, m */
+    double min_rcond;        /* smallest reciprocal pivot ratio (klu_rcond) */
+    double worst_rcond_q;    /* driver position where min_rcond occurred */
+    int factorizations;      /* full klu_factor calls */
+    int refactorizations;    /* klu_refactor calls */
+    int nunknowns;           /* unknowns of the mechanism */
+    int nsolved;             /* unknowns actually solved (the needed blocks) */
+    int nblocks;             /* blocks of the block triangular form */
+    int nblocks_solved;
+    double seconds;          /* wall time of the sweep (not of loading) */
+} mech_solve_stats;
+
+/* Solve the driver sweep of a checked model. On success *out holds one row
+ * per driver position with the outputs the model asks for (points: x, y, vx,
+ * vy, ax, ay; links: angle, omega, alpha; sliders: s, v, a; SI units). On
+ * failure returns MECH_ESOLVE (or MECH_EINPUT for an invalid system), d says
+ * what happened and where (driver position, loop, unknowns), and *out holds
+ * the rows solved before the failure. `stats` may be NULL. */
+int mech_solve(const mech_model *m, const mech_solve_options *o, mech_table *out,
+               mech_solve_stats *stats, mech_diag *d);
+
+/* Parse a driver position from the command line: bare numbers are degrees
+ * (is_angle) or millimetres, or give a unit ("2.0864 rad", "0.15 m"). */
+int mech_parse_value(const char *text, int is_angle, double *si, char *err, size_t errsize);
+
+/* Replace the model's kinematic outputs by a comma-separated list of point,
+ * moving-link and slider names; on an unknown name returns MECH_EINPUT with
+ * a message in err (the model is unchanged). */
+int mech_select_outputs(mech_model *m, const char *list, char *err, size_t errsize);
+
+/* Write a table as CSV (header "name [unit]"), to a temporary file in the
+ * same directory renamed over `path` when complete; "-" writes to stdout.
+ * Returns MECH_OK or MECH_EIO (with a message in d). */
+int mech_table_write_csv(const mech_table *t, const char *path, mech_diag *d);
+
 /* Exit codes of the `mech` program. */
 enum {
     MECH_EXIT_OK = 0,

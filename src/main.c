@@ -4,7 +4,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "mech.h"
+#include "commands.h"
+#include "compare.h"
 
 typedef struct command {
     const char *name;
@@ -15,6 +16,7 @@ typedef struct command {
 
 static int cmd_check(int argc, char **argv);
 static int cmd_equations(int argc, char **argv);
+static int cmd_compare_entry(int argc, char **argv);
 
 static const command commands[] = {
     {"check", cmd_check, "validate mechanism files and print their structure",
@@ -43,6 +45,9 @@ static const command commands[] = {
      "  -h, --help       show this help\n"
      "\n"
      "exit status: 0 printed, 2 invalid file or usage, 3 the file cannot be read\n"},
+    {"solve", cmd_solve, "solve positions, velocities and accelerations over the driver range",
+     cmd_solve_help},
+    {"compare", cmd_compare_entry, "compare a result CSV with a golden CSV", NULL},
 };
 #define NCOMMANDS (sizeof commands / sizeof commands[0])
 
@@ -67,7 +72,7 @@ static void print_usage(FILE *out)
             "  3  a file could not be read or written\n");
 }
 
-static int wants_help(const char *arg)
+int cmd_wants_help(const char *arg)
 {
     return strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0;
 }
@@ -109,7 +114,7 @@ static int cmd_check(int argc, char **argv)
 {
     int quiet = 0, nfiles = 0, status = MECH_EXIT_OK;
     for (int i = 1; i < argc; i++) {
-        if (wants_help(argv[i])) {
+        if (cmd_wants_help(argv[i])) {
             fputs(commands[0].help, stdout);
             return MECH_EXIT_OK;
         }
@@ -148,8 +153,7 @@ static int cmd_check(int argc, char **argv)
     return status;
 }
 
-/* Load and check one file; prints diagnostics. Returns an exit code. */
-static int load_checked(const char *path, mech_model **m)
+int cmd_load_checked(const char *path, mech_model **m)
 {
     mech_diag d;
     mech_diag_init(&d);
@@ -170,7 +174,7 @@ static int cmd_equations(int argc, char **argv)
     mech_format fmt = MECH_FORMAT_TEXT;
     const char *file = NULL;
     for (int i = 1; i < argc; i++) {
-        if (wants_help(argv[i])) {
+        if (cmd_wants_help(argv[i])) {
             fputs(commands[1].help, stdout);
             return MECH_EXIT_OK;
         }
@@ -200,7 +204,7 @@ static int cmd_equations(int argc, char **argv)
         return MECH_EXIT_INPUT;
     }
     mech_model *m = NULL;
-    int code = load_checked(file, &m);
+    int code = cmd_load_checked(file, &m);
     if (code != MECH_EXIT_OK)
         return code;
     mech_diag d;
@@ -216,16 +220,23 @@ static int cmd_equations(int argc, char **argv)
     return rc == MECH_OK ? MECH_EXIT_OK : MECH_EXIT_INPUT;
 }
 
+/* compare prints its own help (src/compare.c) */
+static int cmd_compare_entry(int argc, char **argv) { return cmd_compare(argc, argv); }
+
 int main(int argc, char **argv)
 {
     if (argc < 2) {
         print_usage(stderr);
         return MECH_EXIT_INPUT;
     }
-    if (wants_help(argv[1]) || strcmp(argv[1], "help") == 0) {
+    if (cmd_wants_help(argv[1]) || strcmp(argv[1], "help") == 0) {
         if (argc > 2)
             for (size_t i = 0; i < NCOMMANDS; i++)
                 if (strcmp(argv[2], commands[i].name) == 0) {
+                    if (!commands[i].help) {
+                        char *args[] = {argv[2], (char *)"--help", NULL};
+                        return commands[i].run(2, args);
+                    }
                     fputs(commands[i].help, stdout);
                     return MECH_EXIT_OK;
                 }

@@ -333,3 +333,68 @@ int mech_check(const mech_model *m, mech_summary *s, mech_diag *d)
     free(njoints_of);
     return d->nerrors > before ? MECH_EINPUT : MECH_OK;
 }
+
+/* ---- outputs chosen on the command line -------------------------------- */
+
+/* Every point, link and slider name, for "did you mean". */
+static const char **all_names(const mech_model *m, int *count)
+{
+    const char **v = xcalloc((size_t)(m->npoint_names + m->nlinks + m->njoints) + 1, sizeof *v);
+    int n = 0;
+    for (int i = 0; v && i < m->npoint_names; i++)
+        v[n++] = m->point_names[i];
+    for (int i = 1; v && i < m->nlinks; i++)
+        v[n++] = m->links[i].name;
+    for (int i = 0; v && i < m->njoints; i++)
+        if (m->joints[i].kind == MECH_JOINT_SLIDER)
+            v[n++] = m->joints[i].name;
+    *count = n;
+    return v;
+}
+
+int mech_select_outputs(mech_model *m, const char *list, char *err, size_t errsize)
+{
+    size_t len = strlen(list);
+    char *copy = xstrdup(list);
+    mech_outputs o = {0};
+    o.points = xcalloc(len + 1, sizeof *o.points);
+    o.links = xcalloc(len + 1, sizeof *o.links);
+    o.sliders = xcalloc(len + 1, sizeof *o.sliders);
+    o.forces = m->outputs.forces;
+    int rc = MECH_OK;
+    if (!copy || !o.points || !o.links || !o.sliders) {
+        snprintf(err, errsize, "out of memory");
+        rc = MECH_ENOMEM;
+    }
+    for (char *save = NULL, *w = copy ? strtok_r(copy, ", ", &save) : NULL; w && rc == MECH_OK;
+         w = strtok_r(NULL, ", ", &save)) {
+        int k;
+        if ((k = mech_find_point(m, w)) >= 0)
+            o.points[o.npoints++] = k;
+        else if ((k = mech_find_link(m, w)) > 0)
+            o.links[o.nlinks++] = k;
+        else if ((k = mech_find_joint(m, w)) >= 0 && m->joints[k].kind == MECH_JOINT_SLIDER)
+            o.sliders[o.nsliders++] = k;
+        else {
+            int n;
+            const char **names = all_names(m, &n);
+            const char *near = names ? nearest_name(w, names, (size_t)n) : NULL;
+            snprintf(err, errsize, "'%s' is not a point, moving link or slider of %s%s%s%s", w,
+                     m->file, near ? " (did you mean '" : "", near ? near : "", near ? "'?)" : "");
+            free(names);
+            rc = MECH_EINPUT;
+        }
+    }
+    free(copy);
+    if (rc != MECH_OK) {
+        free(o.points);
+        free(o.links);
+        free(o.sliders);
+        return rc;
+    }
+    free(m->outputs.points);
+    free(m->outputs.links);
+    free(m->outputs.sliders);
+    m->outputs = o;
+    return MECH_OK;
+}

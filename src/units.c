@@ -584,3 +584,15 @@ int quantity_eval_param(const char *text, const expr_env *env, expr_param *out, 
     out->bare = v.bare;
     return 0;
 }
+
+int mech_parse_value(const char *text, int is_angle, double *si, char *err, size_t errsize)
+{
+    unit_defaults u;
+    unit_defaults_init(&u);
+    u.scale[Q_ANGLE] = 3.14159265358979323846 / 180.0;  /* bare angles: degrees */
+    u.scale[Q_LENGTH] = 1e-3;                            /* bare lengths: millimetres */
+    expr_env env = {&u, NULL, 0};
+    size_t pos;
+    return quantity_eval(text, is_angle ? Q_ANGLE : Q_LENGTH, &env, si, err, errsize, &pos) == 0
+               ? MECH_OK : MECH_EINPUT;
+}

@@ -1,0 +1,241 @@
+/* src/cmd_solve.c: `mech solve`, the driver sweep on the command line.
+ * Parses options into mech_solve_options, runs mech_solve, writes the CSV
+ * (whole or not at all) and the statistics. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "commands.h"
+
+const char cmd_solve_help[] =
+    "usage: mech solve FILE [-o OUT.csv] [--from A --to B --steps N] [--tol T]\n"
+    "                  [--outputs NAME,...] [--level positions|velocities|accelerations]\n"
+    "                  [--diagnostics] [--stats] [--verbose] [--all]\n"
+    "\n"
+    "Solve positions, velocities and accelerations of the mechanism at every\n"
+    "driver position and write one CSV row per position: the driver position q,\n"
+    "then per output point x, y, vx, vy, ax, ay; per link angle, omega, alpha;\n"
+    "per slider s, v, a. SI units; each header cell is 'name [unit]'.\n"
+    "Only the unknowns the outputs need are solved (see --verbose).\n"
+    "\n"
+    "options:\n"
+    "  -o, --output FILE   write the CSV to FILE (written to a temporary file and\n"
+    "                      renamed when complete; default: standard output)\n"
+    "  --from A --to B     sweep the driver from A to B instead of the file's range;\n"
+    "  --steps N           N intervals (N+1 rows, default 360). Bare numbers are\n"
+    "                      degrees (crank) or millimetres (slider); units are\n"
+    "                      allowed: --from 2.0864rad, --to 0.2m\n"
+    "  --tol T             Newton tolerance relative to the largest length of the\n"
+    "                      mechanism (default 1e-12)\n"
+    "  --max-iter N        Newton iterations per step before giving up (default 50)\n"
+    "  --min-rcond R       reciprocal condition below which a position is reported\n"
+    "                      singular (default 1e-8)\n"
+    "  --outputs LIST      comma-separated point, link and slider names to output\n"
+    "                      instead of the file's outputs\n"
+    "  --level L           positions, velocities or accelerations (default): the\n"
+    "                      highest derivative computed\n"
+    "  --diagnostics       add the columns iterations, residual [m], rcond\n"
+    "  --stats             print iterations per step, worst residual, smallest\n"
+    "                      rcond and time per step to standard error\n"
+    "  --verbose           say which blocks of equations are solved and why\n"
+    "  --all               solve every unknown, also those no output needs\n"
+    "  -h, --help          show this help\n"
+    "\n"
+    "exit status: 0 solved, 1 the mechanism cannot be solved somewhere in the range\n"
+    "(the message gives the driver position, the loop and the unknowns involved;\n"
+    "no output is written), 2 invalid file or usage, 3 a file cannot be read or written\n";
+
+typedef struct solve_args {
+    const char *file, *out, *from, *to, *outputs;
+    int steps, stats, verbose;
+    mech_solve_options opt;
+} solve_args;
+
+static int usage_error(const char *fmt, const char *arg)
+{
+    fputs("mech solve: ", stderr);
+    fprintf(stderr, fmt, arg);
+    fputs(" (see 'mech solve --help')\n", stderr);
+    return MECH_EXIT_INPUT;
+}
+
+static int parse_number(const char *text, double *v)
+{
+    char *end;
+    *v = strtod(text, &end);
+    return end != text && *end == '\0';
+}
+
+static const char *const value_options[] = {"-o", "--output", "--from", "--to", "--outputs",
+                                           "--steps", "--tol", "--max-iter", "--min-rcond",
+                                           "--level"};
+
+static int takes_value(const char *arg)
+{
+    for (size_t i = 0; i < sizeof value_options / sizeof value_options[0]; i++)
+        if (strcmp(arg, value_options[i]) == 0)
+            return 1;
+    return 0;
+}
+
+/* One option with its value; returns -1 to go on, else the exit status. */
+static int parse_valued(solve_args *a, const char *arg, const char *val)
+{
+    double num;
+    if (strcmp(arg, "-o") == 0 || strcmp(arg, "--output") == 0)
+        a->out = val;
+    else if (strcmp(arg, "--from") == 0)
+        a->from = val;
+    else if (strcmp(arg, "--to") == 0)
+        a->to = val;
+    else if (strcmp(arg, "--outputs") == 0)
+        a->outputs = val;
+    else if (strcmp(arg, "--steps") == 0) {
+        if (!parse_number(val, &num) || num < 1 || num > 1e8 || num != (int)num)
+            return usage_error("--steps needs a whole number from 1 to 1e8, not '%s'", val);
+        a->steps = (int)num;
+    } else if (strcmp(arg, "--tol") == 0) {
+        if (!parse_number(val, &num) || !(num > 0 && num < 1))
+            return usage_error("--tol needs a number between 0 and 1, not '%s'", val);
+        a->opt.tol = num;
+    } else if (strcmp(arg, "--max-iter") == 0) {
+        if (!parse_number(val, &num) || num < 1 || num > 10000 || num != (int)num)
+            return usage_error("--max-iter needs a whole number from 1 to 10000, not '%s'", val);
+        a->opt.max_iter = (int)num;
+    } else if (strcmp(arg, "--min-rcond") == 0) {
+        if (!parse_number(val, &num) || !(num > 0 && num < 1))
+            return usage_error("--min-rcond needs a number between 0 and 1, not '%s'", val);
+        a->opt.min_rcond = num;
+    } else if (strncmp(val, "position", 8) == 0) {  /* --level */
+        a->opt.want = MECH_WANT_POSITION;
+    } else if (strncmp(val, "velocit", 7) == 0) {
+        a->opt.want = MECH_WANT_POSITION | MECH_WANT_VELOCITY;
+    } else if (strncmp(val, "acceleration", 12) == 0) {
+        a->opt.want = MECH_WANT_ALL;
+    } else {
+        return usage_error("--level is positions, velocities or accelerations, not '%s'", val);
+    }
+    return -1;
+}
+
+/* Returns -1 to go on, else the exit status. */
+static int parse_args(int argc, char **argv, solve_args *a)
+{
+    mech_solve_options_default(&a->opt);
+    for (int i = 1; i < argc; i++) {
+        const char *arg = argv[i];
+        int code = -1;
+        if (cmd_wants_help(arg)) {
+            fputs(cmd_solve_help, stdout);
+            return MECH_EXIT_OK;
+        }
+        if (takes_value(arg)) {
+            if (i + 1 >= argc)
+                return usage_error("option '%s' needs a value", arg);
+            code = parse_valued(a, arg, argv[++i]);
+        } else if (strcmp(arg, "--stats") == 0)
+            a->stats = 1;
+        else if (strcmp(arg, "--verbose") == 0 || strcmp(arg, "-v") == 0)
+            a->verbose = 1;
+        else if (strcmp(arg, "--diagnostics") == 0)
+            a->opt.diagnostics = 1;
+        else if (strcmp(arg, "--all") == 0)
+            a->opt.all_blocks = 1;
+        else if (arg[0] == '-' && arg[1] != '\0')
+            return usage_error("unknown option '%s'", arg);
+        else if (a->file)
+            return usage_error("one file at a time ('%s' is a second file)", arg);
+        else
+            a->file = arg;
+        if (code >= 0)
+            return code;
+    }
+    if (!a->file)
+        return usage_error("%s", "no file given (usage: mech solve FILE [-o OUT.csv] ...)");
+    if ((a->from != NULL) != (a->to != NULL))
+        return usage_error("%s", "--from and --to go together");
+    return -1;
+}
+
+/* Apply --from/--to/--steps and --outputs to the loaded model. */
+static int apply_overrides(solve_args *a, mech_model *m)
+{
+    char err[256];
+    int is_angle = m->driver.kind == MECH_DRIVE_ANGLE;
+    if (a->from) {
+        if (mech_parse_value(a->from, is_angle, &a->opt.from, err, sizeof err) != MECH_OK)
+            return fprintf(stderr, "mech solve: --from '%s': %s\n", a->from, err), MECH_EXIT_INPUT;
+        if (mech_parse_value(a->to, is_angle, &a->opt.to, err, sizeof err) != MECH_OK)
+            return fprintf(stderr, "mech solve: --to '%s': %s\n", a->to, err), MECH_EXIT_INPUT;
+        a->opt.has_range = 1;
+        a->opt.steps = a->steps > 0 ? a->steps : 360;
+    } else if (a->steps > 0) {
+        /* new spacing over the file's range */
+        a->opt.has_range = 1;
+        a->opt.from = m->driver.values[0];
+        a->opt.to = m->driver.values[m->driver.nvalues - 1];
+        a->opt.steps = a->steps;
+    }
+    if (a->outputs && mech_select_outputs(m, a->outputs, err, sizeof err) != MECH_OK)
+        return fprintf(stderr, "mech solve: --outputs: %s\n", err), MECH_EXIT_INPUT;
+    return -1;
+}
+
+static void print_stats(const mech_model *m, const mech_solve_stats *st, FILE *out)
+{
+    int angle = m->driver.kind == MECH_DRIVE_ANGLE;
+    double per = st->steps ? st->seconds / st->steps : 0.0;
+    fprintf(out, "%s: %d steps, %d of %d unknowns solved (%d of %d blocks)\n", m->file,
+            st->steps, st->nsolved, st->nunknowns, st->nblocks_solved, st->nblocks);
+    fprintf(out, "  Newton iterations  %.2f per step, at most %d\n",
+            st->steps ? (double)st->iterations / st->steps : 0.0, st->max_iterations);
+    fprintf(out, "  worst residual     %.3g m\n", st->worst_residual);
+    if (st->steps)
+        fprintf(out, "  smallest rcond     %.3g at q = %.6g %s\n", st->min_rcond,
+                angle ? st->worst_rcond_q * 57.29577951308232 : st->worst_rcond_q * 1e3,
+                angle ? "deg" : "mm");
+    fprintf(out, "  factorizations     %d full, %d refactor\n", st->factorizations,
+            st->refactorizations);
+    fprintf(out, "  time               %.3g s, %.3g us per step\n", st->seconds, per * 1e6);
+}
+
+int cmd_solve(int argc, char **argv)
+{
+    solve_args a = {0};
+    int code = parse_args(argc, argv, &a);
+    if (code >= 0)
+        return code;
+    mech_model *m = NULL;
+    if ((code = cmd_load_checked(a.file, &m)) != MECH_EXIT_OK)
+        return code;
+    if ((code = apply_overrides(&a, m)) >= 0) {
+        mech_model_free(&m);
+        return code;
+    }
+    if (a.verbose)
+        a.opt.log = stderr;
+    mech_diag d;
+    mech_diag_init(&d);
+    mech_table t = {0};
+    mech_solve_stats st;
+    int rc = mech_solve(m, &a.opt, &t, &st, &d);
+    mech_diag_print(&d, stderr);
+    if (rc == MECH_ESOLVE)
+        fprintf(stderr, "mech solve: %d of the sweep's positions were solved before this; "
+                "%s\n", t.nrows, a.out ? "no output file written" : "no output written");
+    mech_diag_free(&d);
+    if (a.stats)
+        print_stats(m, &st, stderr);
+    code = rc == MECH_OK ? MECH_EXIT_OK
+           : rc == MECH_ESOLVE ? MECH_EXIT_SOLVE : MECH_EXIT_INPUT;
+    if (rc == MECH_OK) {
+        mech_diag_init(&d);
+        if (mech_table_write_csv(&t, a.out ? a.out : "-", &d) != MECH_OK)
+            code = MECH_EXIT_IO;
+        mech_diag_print(&d, stderr);
+        mech_diag_free(&d);
+    }
+    mech_table_free(&t);
+    mech_model_free(&m);
+    return code;
+}

@@ -1,0 +1,17 @@
+/* src/commands.h: the `mech` subcommands (src/main.c dispatches; each
+ * cmd_*.c holds one command's option parsing and output). */
+#ifndef MECH_COMMANDS_H
+#define MECH_COMMANDS_H
+
+#include "mech.h"
+
+/* "-h" or "--help" */
+int cmd_wants_help(const char *arg);
+/* Load and check one file, printing diagnostics; returns an exit status
+ * (MECH_EXIT_OK with *m set, else *m is NULL). */
+int cmd_load_checked(const char *path, mech_model **m);
+
+extern const char cmd_solve_help[];
+int cmd_solve(int argc, char **argv);
+
+#endif

@@ -1,0 +1,55 @@
+/* src/kinematics.h: from solved unknowns to link frames and point motion.
+ *
+ * The loop equations give link angles and slider displacements; the frame
+ * origin of every link follows by walking a spanning tree of the joints
+ * from the ground (breadth first, so each point is reached by the shortest
+ * chain of links). Velocities and accelerations use the rigid-body and
+ * sliding-point formulas, exact for the solved rates. */
+#ifndef MECH_KINEMATICS_H
+#define MECH_KINEMATICS_H
+
+#include "system.h"
+
+typedef struct kin_tree {
+    const mech_model *model;
+    int n;              /* unknowns of the system; variable n is the driver q */
+    int *order;         /* [norder] links in breadth-first order, ground excluded */
+    int norder;
+    int *parent_joint;  /* [nlinks] joint to the parent link (-1: ground, unreachable) */
+    int *parent_link;   /* [nlinks] */
+    int *depth;         /* [nlinks] joints from the ground */
+    int *angle_var;     /* [nlinks] variable of the link angle: -1 zero (ground), 0..n */
+    int *slide_var;     /* [njoints] variable of a slider's displacement, else -1 */
+    int *point_link;    /* [npoint_names] the carrier link of a point name nearest the ground */
+    int *point_index;   /* [npoint_names] the point's index in that link */
+    unsigned char *active; /* [nlinks] frames to compute (kin_mark_point/link) */
+} kin_tree;
+
+/* Positions, velocities and accelerations of every active link frame. */
+typedef struct kin_state {
+    double *th, *om, *al;   /* [nlinks] angle, angular velocity, angular acceleration */
+    double *o, *vo, *ao;    /* [2 nlinks] frame origin and its rates */
+} kin_state;
+
+int kin_tree_build(kin_tree *t, const mech_system *s);
+void kin_tree_free(kin_tree *t);
+
+/* Variables (unknowns 0..n-1) a quantity depends on: sets need[v] = 1 and
+ * activates the link frames involved. */
+void kin_need_point(kin_tree *t, int name_id, unsigned char *need);
+void kin_need_link(kin_tree *t, int link, unsigned char *need);
+
+int kin_state_init(kin_state *st, const mech_model *m);
+void kin_state_free(kin_state *st);
+
+/* Frames of the active links. pos, vel, acc hold the variables 0..n (n is
+ * the driver); vel and acc may be NULL (rates not computed). */
+void kin_update(const kin_tree *t, kin_state *st, const double *pos, const double *vel,
+                const double *acc);
+
+/* Position p[2], velocity v[2], acceleration a[2] of a point name (v or a may
+ * be NULL when not computed). */
+void kin_point(const kin_tree *t, const kin_state *st, int name_id, double *p, double *v,
+               double *a);
+
+#endif

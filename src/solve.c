@@ -1,0 +1,498 @@
+/* src/solve.c: the numerical core (docs/solver.md).
+ *
+ * Set-up, once per mechanism: choose the unknowns the outputs need (the
+ * blocks of the block triangular form that contain them, and every block
+ * those depend on), compile an evaluator of just those rows, and let KLU
+ * analyse the pattern of their Jacobian.
+ * Per driver position: Newton with damping on the closure residual, with
+ * klu_refactor (a fresh klu_factor when the pivots degrade); then dx/dq and
+ * d2x/dq2 by two solves with the converged factors. Columns are
+ * equilibrated before every factorisation, so klu_rcond measures the
+ * geometry, not the units. */
+#include <btf.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "solve.h"
+
+enum { PHASE_POSITION, PHASE_VELOCITY, PHASE_ACCELERATION, NPHASES };
+
+/* A Newton step longer than this (rad, or lref for slides) is shortened:
+ * beyond it the linearisation says little. */
+static const double MAX_STEP = 1.0;
+
+/* ---- set-up ------------------------------------------------------------ */
+
+/* The largest distance between two points of one link (or of the ground),
+ * the length scale of tolerances and slide columns. */
+static double largest_length(const mech_model *m)
+{
+    double L = 0.0;
+    for (int l = 0; l < m->nlinks; l++) {
+        const mech_link *k = &m->links[l];
+        for (int i = 0; i < k->npoints; i++) {
+            if (l == 0)
+                L = fmax(L, hypot(k->points[i].x, k->points[i].y));
+            for (int j = i + 1; j < k->npoints; j++)
+                L = fmax(L, hypot(k->points[i].x - k->points[j].x, k->points[i].y - k->points[j].y));
+        }
+    }
+    return L > 0.0 ? L : 1.0;
+}
+
+/* Unknowns some output (or a branch condition) depends on. */
+static void needed_unknowns(solver *sv, unsigned char *need)
+{
+    const mech_model *m = sv->m;
+    const mech_outputs *o = &m->outputs;
+    if (sv->opt.all_blocks || o->forces) {
+        memset(need, 1, (size_t)sv->n);
+        for (int l = 1; l < m->nlinks; l++)
+            sv->tree.active[l] = 1;
+        return;
+    }
+    for (int i = 0; i < o->npoints; i++)
+        kin_need_point(&sv->tree, o->points[i], need);
+    for (int i = 0; i < o->nlinks; i++)
+        kin_need_link(&sv->tree, o->links[i], need);
+    for (int i = 0; i < o->nsliders; i++) {
+        int var = sv->tree.slide_var[o->sliders[i]];
+        if (var >= 0 && var < sv->n)
+            need[var] = 1;
+    }
+    for (int b = 0; b < m->nbranches; b++)
+        for (int k = 0; k < 3; k++)
+            kin_need_point(&sv->tree, m->branches[b].point[k], need);
+}
+
+/* Short name of an unknown for messages. */
+static const char *unknown_name(const solver *sv, int var) { return sv->sys->names[var]; }
+
+static void log_blocks(const solver *sv, const int *P, const int *Q, const int *R,
+                       const unsigned char *solve_block, const unsigned char *need)
+{
+    FILE *log = sv->opt.log;
+    fprintf(log, "blocks: %d unknowns in %d blocks of the block triangular form; solving %d\n",
+            sv->n, sv->nblocks, sv->nblocks_solved);
+    for (int b = sv->nblocks - 1; b >= 0; b--) {  /* solution order: last block first */
+        int wanted = 0;
+        for (int k = R[b]; k < R[b + 1]; k++)
+            wanted |= need[Q[k]];
+        fprintf(log, "  block %d (%d equation%s, loops", sv->nblocks - b, R[b + 1] - R[b],
+                R[b + 1] - R[b] == 1 ? "" : "s");
+        int last = -1;
+        for (int k = R[b]; k < R[b + 1]; k++)
+            if (P[k] / 2 != last)
+                fprintf(log, " %d", (last = P[k] / 2) + 1);
+        fprintf(log, "):");
+        for (int k = R[b]; k < R[b + 1]; k++)
+            fprintf(log, " %s", unknown_name(sv, Q[k]));
+        fprintf(log, " -- %s\n", !solve_block[b] ? "skipped, no output needs it"
+                                 : wanted        ? "solved, outputs need it"
+                                                 : "solved, a needed block depends on it");
+    }
+}
+
+/* Blocks to solve: those holding a needed unknown, then (the form is upper
+ * block triangular, rows of block b only reach columns of blocks >= b)
+ * every block reached from a block already chosen. */
+static int choose_blocks(solver *sv, const unsigned char *need, unsigned char *row_on,
+                         unsigned char *col_on)
+{
+    const mech_system *s = sv->sys;
+    int n = sv->n, nmatch = 0;
+    int *P = xcalloc((size_t)n, sizeof *P), *Q = xcalloc((size_t)n, sizeof *Q);
+    int *R = xcalloc((size_t)n + 1, sizeof *R), *W = xcalloc(5 * (size_t)n, sizeof *W);
+    int *blk = xcalloc((size_t)n, sizeof *blk), *rowpos = xcalloc((size_t)n, sizeof *rowpos);
+    unsigned char *solve_block = xcalloc((size_t)n + 1, 1);
+    int rc = -1;
+    if (!P || !Q || !R || !W || !blk || !rowpos || !solve_block)
+        goto done;
+    double work;
+    sv->nblocks = btf_order(n, s->Jp, s->Ji, 0.0, &work, P, Q, R, &nmatch, W);
+    if (nmatch < n) {
+        rc = 1;  /* structurally singular: caller reports */
+        goto done;
+    }
+    for (int b = 0; b < sv->nblocks; b++)
+        for (int k = R[b]; k < R[b + 1]; k++) {
+            blk[Q[k]] = b;       /* block of each unknown */
+            rowpos[P[k]] = b;    /* block of each equation */
+        }
+    for (int v = 0; v < n; v++)
+        if (need[v])
+            solve_block[blk[v]] = 1;
+    /* rows in block order: propagate from low blocks to the higher ones they reach */
+    for (int b = 0; b < sv->nblocks; b++) {
+        if (!solve_block[b])
+            continue;
+        for (int k = R[b]; k < R[b + 1]; k++)
+            row_on[P[k]] = 1;
+        for (int c = 0; c < n; c++)  /* columns touching this block's rows */
+            for (int p = s->Jp[c]; p < s->Jp[c + 1]; p++)
+                if (rowpos[s->Ji[p]] == b)
+                    solve_block[blk[c]] = 1;
+    }
+    sv->nblocks_solved = 0;
+    for (int b = 0; b < sv->nblocks; b++)
+        if (solve_block[b]) {
+            sv->nblocks_solved++;
+            for (int k = R[b]; k < R[b + 1]; k++)
+                col_on[Q[k]] = 1;
+        }
+    if (sv->opt.log)
+        log_blocks(sv, P, Q, R, solve_block, need);
+    rc = 0;
+done:
+    free(P);
+    free(Q);
+    free(R);
+    free(W);
+    free(blk);
+    free(rowpos);
+    free(solve_block);
+    return rc;
+}
+
+/* Pattern of the solved rows and columns, and the tape computing them. */
+static int compile_subset(solver *sv, const unsigned char *row_on, const unsigned char *col_on)
+{
+    const mech_system *s = sv->sys;
+    int n = sv->n, ns = 0, nr = 0;
+    int *rowmap = xcalloc((size_t)n + 1, sizeof *rowmap);
+    sv->col = xcalloc((size_t)n + 1, sizeof *sv->col);
+    sv->row = xcalloc((size_t)n + 1, sizeof *sv->row);
+    sv->Ap = xcalloc((size_t)n + 1, sizeof *sv->Ap);
+    if (!rowmap || !sv->col || !sv->row || !sv->Ap) {
+        free(rowmap);
+        return -1;
+    }
+    for (int r = 0; r < n; r++) {
+        rowmap[r] = row_on[r] ? nr : -1;
+        if (row_on[r])
+            sv->row[nr++] = r;
+    }
+    for (int c = 0; c < n; c++)
+        if (col_on[c])
+            sv->col[ns++] = c;
+    sv->ns = ns;
+    int nnz = 0;
+    for (int k = 0; k < ns; k++)
+        for (int p = s->Jp[sv->col[k]]; p < s->Jp[sv->col[k] + 1]; p++)
+            nnz += rowmap[s->Ji[p]] >= 0;
+    sv->nnz = nnz;
+    sv->Ai = xcalloc((size_t)nnz + 1, sizeof *sv->Ai);
+    sv->Ax = xcalloc((size_t)nnz + 1, sizeof *sv->Ax);
+    sv->proot = xcalloc((size_t)(ns + nnz) + 1, sizeof *sv->proot);
+    sv->vroot = xcalloc((size_t)ns + 1, sizeof *sv->vroot);
+    sv->aroot = xcalloc((size_t)ns + 1, sizeof *sv->aroot);
+    if (!sv->Ai || !sv->Ax || !sv->proot || !sv->vroot || !sv->aroot) {
+        free(rowmap);
+        return -1;
+    }
+    for (int i = 0; i < ns; i++) {
+        sv->proot[i] = s->f[sv->row[i]];
+        sv->vroot[i] = s->vel[sv->row[i]];
+        sv->aroot[i] = s->acc[sv->row[i]];
+    }
+    int at = 0;
+    for (int k = 0; k < ns; k++) {
+        sv->Ap[k] = at;
+        for (int p = s->Jp[sv->col[k]]; p < s->Jp[sv->col[k] + 1]; p++)
+            if (rowmap[s->Ji[p]] >= 0) {
+                sv->Ai[at] = rowmap[s->Ji[p]];
+                sv->proot[ns + at++] = s->Jx[p];
+            }
+    }
+    sv->Ap[ns] = at;
+    free(rowmap);
+    const ex *roots[NPHASES] = {sv->proot, sv->vroot, sv->aroot};
+    int nroots[NPHASES] = {ns + nnz, ns, ns};
+    int nph = sv->level & MECH_WANT_ACCELERATION ? 3 : sv->level & MECH_WANT_VELOCITY ? 2 : 1;
+    /* dx/dq feeds the predictor even for positions only: keep the velocity phase */
+    if (nph < 2)
+        nph = 2;
+    return tape_compile(&sv->tp, &sv->sys->ex, SYS_NVARS(n), nph, roots, nroots);
+}
+
+static int alloc_state(solver *sv)
+{
+    size_t n1 = (size_t)sv->n + 1, ns = (size_t)sv->ns + 1;
+    sv->pos = xcalloc(n1, sizeof *sv->pos);
+    sv->vel = xcalloc(n1, sizeof *sv->vel);
+    sv->acc = xcalloc(n1, sizeof *sv->acc);
+    sv->x = xcalloc(ns, sizeof *sv->x);
+    sv->xq = xcalloc(ns, sizeof *sv->xq);
+    sv->xqq = xcalloc(ns, sizeof *sv->xqq);
+    sv->f = xcalloc(ns, sizeof *sv->f);
+    sv->dx = xcalloc(ns, sizeof *sv->dx);
+    sv->xt = xcalloc(ns, sizeof *sv->xt);
+    sv->ft = xcalloc(ns, sizeof *sv->ft);
+    sv->cscale = xcalloc(ns, sizeof *sv->cscale);
+    sv->label = xcalloc(512, 1);
+    if (!sv->pos || !sv->vel || !sv->acc || !sv->x || !sv->xq || !sv->xqq || !sv->f ||
+        !sv->dx || !sv->xt || !sv->ft || !sv->cscale || !sv->label)
+        return -1;
+    return kin_state_init(&sv->ks, sv->m) == MECH_OK ? 0 : -1;
+}
+
+static int level_of(int want)
+{
+    if (want & MECH_WANT_ACCELERATION)
+        return MECH_WANT_ALL;
+    if (want & MECH_WANT_VELOCITY)
+        return MECH_WANT_POSITION | MECH_WANT_VELOCITY;
+    return MECH_WANT_POSITION;
+}
+
+int solver_init(solver *sv, const mech_model *m, const mech_solve_options *o, mech_diag *d)
+{
+    memset(sv, 0, sizeof *sv);
+    sv->m = m;
+    sv->opt = *o;
+    sv->level = level_of(o->want ? o->want : MECH_WANT_ALL);
+    int rc = mech_system_new(m, &sv->sys, d);
+    if (rc != MECH_OK)
+        return rc;
+    sv->n = sv->sys->n;
+    sv->lref = largest_length(m);
+    if (!(sv->opt.tol > 0.0))
+        sv->opt.tol = 1e-12;
+    if (!(sv->opt.min_rcond > 0.0))
+        sv->opt.min_rcond = 1e-8;
+    sv->ftol = sv->opt.tol * sv->lref;
+    if (kin_tree_build(&sv->tree, sv->sys) != MECH_OK)
+        return diag_error(d, m->file, (mech_mark){0, 0}, "out of memory"), MECH_ENOMEM;
+    unsigned char *need = xcalloc((size_t)sv->n + 1, 1), *row_on = xcalloc((size_t)sv->n + 1, 1),
+                  *col_on = xcalloc((size_t)sv->n + 1, 1);
+    rc = MECH_ENOMEM;
+    if (need && row_on && col_on) {
+        needed_unknowns(sv, need);
+        int b = choose_blocks(sv, need, row_on, col_on);
+        if (b > 0)
+            rc = diag_error(d, m->file, m->driver.mark,
+                            "the loop equations are structurally singular: some unknown "
+                            "appears in no equation that could determine it (see 'mech equations')");
+        else if (b == 0 && compile_subset(sv, row_on, col_on) == 0 && alloc_state(sv) == 0)
+            rc = MECH_OK;
+    }
+    free(need);
+    free(row_on);
+    free(col_on);
+    if (rc == MECH_ENOMEM)
+        return diag_error(d, m->file, (mech_mark){0, 0}, "out of memory"), MECH_ENOMEM;
+    if (rc != MECH_OK)
+        return rc;
+    klu_defaults(&sv->common);
+    if (sv->ns > 0) {
+        sv->sym = klu_analyze(sv->ns, sv->Ap, sv->Ai, &sv->common);
+        if (!sv->sym)
+            return diag_error(d, m->file, (mech_mark){0, 0}, "KLU cannot analyse the Jacobian "
+                              "(status %d)", sv->common.status), MECH_ENOMEM;
+    }
+    return MECH_OK;
+}
+
+void solver_free(solver *sv)
+{
+    if (sv->num)
+        klu_free_numeric(&sv->num, &sv->common);
+    if (sv->sym)
+        klu_free_symbolic(&sv->sym, &sv->common);
+    tape_free(&sv->tp);
+    kin_state_free(&sv->ks);
+    kin_tree_free(&sv->tree);
+    mech_system_free(&sv->sys);
+    void *blocks[] = {sv->col, sv->row, sv->Ap, sv->Ai, sv->Ax, sv->cscale, sv->proot,
+                      sv->vroot, sv->aroot, sv->pos, sv->vel, sv->acc, sv->x, sv->xq,
+                      sv->xqq, sv->f, sv->dx, sv->xt, sv->ft, sv->label};
+    for (size_t i = 0; i < sizeof blocks / sizeof blocks[0]; i++)
+        free(blocks[i]);
+    memset(sv, 0, sizeof *sv);
+}
+
+/* ---- one driver position ------------------------------------------------ */
+
+double vec_norm_inf(const double *v, int n)
+{
+    double r = 0.0;
+    for (int i = 0; i < n; i++)
+        r = fmax(r, fabs(v[i]));
+    return r;
+}
+
+/* Size of a change of the unknowns: angles in rad, slides in units of lref. */
+double solver_step_size(const solver *sv, const double *dx)
+{
+    double r = 0.0;
+    for (int i = 0; i < sv->ns; i++) {
+        double v = fabs(dx[i]);
+        if (sv->sys->unk_kind[sv->col[i]] == UNK_SLIDE)
+            v /= sv->lref;
+        r = fmax(r, v);
+    }
+    return r;
+}
+
+/* f (and the raw Jacobian in Ax) at x, q; returns |f|inf. */
+static double evaluate(solver *sv, const double *x, double q, double *f)
+{
+    tape *t = &sv->tp;
+    for (int i = 0; i < sv->ns; i++)
+        tape_set_var(t, sv->col[i], x[i]);
+    tape_set_var(t, SYS_VAR_Q(sv->n), q);
+    tape_run(t, PHASE_POSITION);
+    for (int i = 0; i < sv->ns; i++)
+        f[i] = tape_value(t, sv->proot[i]);
+    for (int k = 0; k < sv->nnz; k++)
+        sv->Ax[k] = tape_value(t, sv->proot[sv->ns + k]);
+    sv->factored = 0;
+    return vec_norm_inf(f, sv->ns);
+}
+
+/* Scale every column to unit largest entry (J C), remembering C. */
+static void equilibrate(solver *sv)
+{
+    for (int k = 0; k < sv->ns; k++) {
+        double big = 0.0;
+        for (int p = sv->Ap[k]; p < sv->Ap[k + 1]; p++)
+            big = fmax(big, fabs(sv->Ax[p]));
+        double c = big > 0.0 && isfinite(big) ? 1.0 / big : 1.0;
+        sv->cscale[k] = c;
+        for (int p = sv->Ap[k]; p < sv->Ap[k + 1]; p++)
+            sv->Ax[p] *= c;
+    }
+}
+
+static int fresh_factor(solver *sv)
+{
+    if (sv->num)
+        klu_free_numeric(&sv->num, &sv->common);
+    sv->num = klu_factor(sv->Ap, sv->Ai, sv->Ax, sv->sym, &sv->common);
+    sv->stats_factor++;
+    if (!sv->num)
+        return -1;
+    klu_rcond(sv->sym, sv->num, &sv->common);
+    sv->rcond = sv->rcond_factor = sv->common.rcond;
+    return 0;
+}
+
+/* Factor the Jacobian in Ax: refactor with the old pivots while they hold. */
+static int factor(solver *sv)
+{
+    equilibrate(sv);
+    for (int p = 0; p < sv->nnz; p++)
+        if (!isfinite(sv->Ax[p]))
+            return -1;
+    if (sv->num && klu_refactor(sv->Ap, sv->Ai, sv->Ax, sv->sym, sv->num, &sv->common)) {
+        sv->stats_refactor++;
+        klu_rcond(sv->sym, sv->num, &sv->common);
+        sv->rcond = sv->common.rcond;
+        /* pivots chosen for another position have degraded: pivot afresh */
+        if (!(sv->rcond >= 1e-3 * sv->rcond_factor) && fresh_factor(sv) < 0)
+            return -1;
+    } else if (fresh_factor(sv) < 0) {
+        return -1;
+    }
+    sv->factored = 1;
+    return 0;
+}
+
+/* Solve J y = b in place (b := dx), undoing the column scaling. */
+static void solve_in_place(solver *sv, double *b)
+{
+    klu_solve(sv->sym, sv->num, sv->ns, 1, b, &sv->common);
+    for (int i = 0; i < sv->ns; i++)
+        b[i] *= sv->cscale[i];
+}
+
+step_status solver_newton(solver *sv, double q)
+{
+    int ns = sv->ns;
+    sv->iters = 0;
+    if (ns == 0) {
+        sv->resid = 0.0;
+        sv->rcond = 1.0;
+        return STEP_OK;
+    }
+    double r = evaluate(sv, sv->x, q, sv->f), prev_step = INFINITY;
+    int max_iter = sv->opt.max_iter > 0 ? sv->opt.max_iter : 50;
+    const double xtol = sv->opt.tol;
+    for (int it = 0;; it++) {
+        if (!isfinite(r))
+            return STEP_NO_ASSEMBLY;
+        if (factor(sv) < 0)
+            return STEP_SINGULAR;
+        memcpy(sv->dx, sv->f, (size_t)ns * sizeof *sv->dx);
+        solve_in_place(sv, sv->dx);
+        double step = solver_step_size(sv, sv->dx);
+        /* converged: residual small, and the step too, or no longer shrinking
+           (the rounding floor of an ill-conditioned position) */
+        if (r <= sv->ftol && (step <= xtol || step >= 0.9 * prev_step)) {
+            sv->resid = r;
+            sv->iters = it;
+            return sv->rcond < sv->opt.min_rcond ? STEP_SINGULAR : STEP_OK;
+        }
+        if (it == max_iter) {
+            sv->resid = r;
+            sv->iters = it;
+            return STEP_NO_ASSEMBLY;
+        }
+        double lambda = step > MAX_STEP ? MAX_STEP / step : 1.0, rt;
+        for (;;) {  /* damping: halve the step while the residual grows */
+            for (int i = 0; i < ns; i++)
+                sv->xt[i] = sv->x[i] - lambda * sv->dx[i];
+            rt = evaluate(sv, sv->xt, q, sv->ft);
+            if (rt <= r || rt <= sv->ftol || lambda < 1.0 / 1024)
+                break;
+            lambda *= 0.5;
+        }
+        memcpy(sv->x, sv->xt, (size_t)ns * sizeof *sv->x);
+        memcpy(sv->f, sv->ft, (size_t)ns * sizeof *sv->f);
+        r = rt;
+        prev_step = lambda == 1.0 ? step : INFINITY;
+        sv->iters = it + 1;
+    }
+}
+
+int solver_rates(solver *sv)
+{
+    if (sv->ns == 0)
+        return 0;
+    tape *t = &sv->tp;
+    /* geometric rates (qdot = 1, qddot = 0); solver_publish scales them */
+    tape_set_var(t, SYS_VAR_QDOT(sv->n), 1.0);
+    tape_run(t, PHASE_VELOCITY);
+    for (int i = 0; i < sv->ns; i++)
+        sv->xq[i] = tape_value(t, sv->vroot[i]);
+    solve_in_place(sv, sv->xq);
+    if (!(sv->level & MECH_WANT_ACCELERATION))
+        return 0;
+    for (int i = 0; i < sv->ns; i++)
+        tape_set_var(t, SYS_VAR_XDOT(sv->n, sv->col[i]), sv->xq[i]);
+    tape_set_var(t, SYS_VAR_QDDOT(sv->n), 0.0);
+    tape_run(t, PHASE_ACCELERATION);
+    for (int i = 0; i < sv->ns; i++)
+        sv->xqq[i] = tape_value(t, sv->aroot[i]);
+    solve_in_place(sv, sv->xqq);
+    return 0;
+}
+
+/* xdot = x_q qd and xddot = x_qq qd^2 + x_q qdd (the loop equations do not
+ * depend on time explicitly). */
+void solver_publish(solver *sv, double q, double qd, double qdd)
+{
+    int n = sv->n;
+    sv->pos[n] = q;
+    sv->vel[n] = qd;
+    sv->acc[n] = qdd;
+    for (int i = 0; i < sv->ns; i++) {
+        int c = sv->col[i];
+        sv->pos[c] = sv->x[i];
+        sv->vel[c] = sv->xq[i] * qd;
+        sv->acc[c] = sv->xqq[i] * qd * qd + sv->xq[i] * qdd;
+    }
+    kin_update(&sv->tree, &sv->ks, sv->pos, sv->level & MECH_WANT_VELOCITY ? sv->vel : NULL,
+               sv->level & MECH_WANT_ACCELERATION ? sv->acc : NULL);
+}

@@ -1,0 +1,78 @@
+/* src/solve.h: the numerical core shared by the sweep and (later) forces:
+ * the subset of unknowns to solve, its KLU factors, and one driver
+ * position's Newton solve with velocity and acceleration solves. */
+#ifndef MECH_SOLVE_H
+#define MECH_SOLVE_H
+
+#include <klu.h>
+
+#include "kinematics.h"
+#include "system.h"
+
+typedef enum {
+    STEP_OK,
+    STEP_NO_ASSEMBLY,  /* Newton does not converge: the loops cannot close */
+    STEP_SINGULAR,     /* converged (or stuck) where the Jacobian is singular */
+    STEP_JUMP,         /* converged far from the prediction: possibly another branch */
+    STEP_BRANCH,       /* converged on the other side of a declared branch */
+    STEP_NOMEM
+} step_status;
+
+typedef struct solver {
+    mech_system *sys;          /* owned */
+    const mech_model *m;
+    mech_solve_options opt;
+    int level;                 /* MECH_WANT_* bits actually computed */
+    double lref;               /* largest length of the mechanism, m */
+    double ftol;               /* residual tolerance, m */
+
+    /* the solved subset: blocks of the block triangular form that outputs need */
+    int n;                     /* all unknowns */
+    int ns;                    /* unknowns solved */
+    int *col;                  /* [ns] unknown of each solved column */
+    int *row;                  /* [ns] equation of each solved row */
+    int nblocks, nblocks_solved;
+    int *Ap, *Ai;              /* [ns+1], [nnz] pattern of the solved Jacobian */
+    double *Ax;                /* [nnz] values, columns equilibrated */
+    int nnz;
+    double *cscale;            /* [ns] column scaling of the last factorisation */
+    tape tp;                   /* evaluator of the solved rows only */
+    ex *proot, *vroot, *aroot; /* roots of the three phases */
+
+    klu_common common;
+    klu_symbolic *sym;
+    klu_numeric *num;
+    double rcond, rcond_factor;/* now, and after the last full factorisation */
+    int factored;              /* num holds factors of the current x */
+
+    double *pos, *vel, *acc;   /* [n+1] variable values (n = driver), SI */
+    double *x;                 /* [ns] current solved unknowns */
+    double *xq, *xqq;          /* [ns] dx/dq and d2x/dq2 at x */
+    double *f, *dx, *xt, *ft;  /* [ns] work */
+    double resid;              /* |f|inf at x */
+    int iters;                 /* Newton iterations of the last solve */
+    int stats_factor, stats_refactor;
+
+    kin_tree tree;
+    kin_state ks;
+    char *label;               /* scratch for messages */
+} solver;
+
+int solver_init(solver *sv, const mech_model *m, const mech_solve_options *o, mech_diag *d);
+void solver_free(solver *sv);
+
+/* Newton from sv->x at driver position q; on STEP_OK the factors are those
+ * of the converged Jacobian. */
+step_status solver_newton(solver *sv, double q);
+/* dx/dq and d2x/dq2 at the converged position (as far as sv->level needs). */
+int solver_rates(solver *sv);
+/* Scatter x, and the rates for driver speed qd and acceleration qdd, into
+ * pos, vel, acc and update the link frames. */
+void solver_publish(solver *sv, double q, double qd, double qdd);
+
+/* |v|inf, and the size of a change of the solved unknowns (angles in rad,
+ * slides in units of lref). */
+double vec_norm_inf(const double *v, int n);
+double solver_step_size(const solver *sv, const double *dx);
+
+#endif
