@@ -1,7 +1,7 @@
 # Makefile for libmech and the `mech` command line.
 #   make            build build/libmech.a and build/mech (warnings are errors)
 #   make deps       install missing Debian packages (apt-get; tools/deps.sh)
-#   make run        deps + build + the main job (see README)
+#   make run        deps + build + the main job: solve the Stirling engine
 #   make test       deps + build + the full test suite
 #   make test-san   the test suite built with -fsanitize=address,undefined
 #   make bench      optimised benchmarks, printed as tables
@@ -60,10 +60,13 @@ $(BUILD)/obj $(BUILD)/tests:
 deps:
 	@sh tools/deps.sh
 
-# The main job: validate every mechanism file (until the solver exists).
+# The main job: solve the Stirling engine of the first paper over one crank
+# revolution (positions, velocities, accelerations) into build/stirling.csv.
 run: deps
 	@$(MAKE) --no-print-directory all
-	$(BUILD)/mech check mechanisms/*.yaml
+	$(BUILD)/mech check -q mechanisms/*.yaml
+	$(BUILD)/mech solve mechanisms/stirling.yaml -o $(BUILD)/stirling.csv --stats
+	@echo "wrote $(BUILD)/stirling.csv"
 
 test: deps
 	@$(MAKE) --no-print-directory $(BUILD)/mech $(BUILD)/unit-tests

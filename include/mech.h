@@ -250,7 +250,7 @@ typedef struct mech_solve_options {
     double tol;        /* Newton tolerance relative to the largest length (default 1e-12) */
     int max_iter;      /* Newton iterations per step before giving up (default 50) */
     double min_rcond;  /* a converged position with a smaller reciprocal condition
-                          estimate (klu_rcond, equilibrated) is singular (default 1e-8) */
+                          estimate (klu_rcond, equilibrated) is singular (default 1e-6) */
     int want;          /* MECH_WANT_* bits (default MECH_WANT_ALL) */
     int all_blocks;    /* 1: solve every unknown, also those no output needs */
     int diagnostics;   /* 1: add the columns iterations, residual, rcond */

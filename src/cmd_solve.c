@@ -29,7 +29,7 @@ const char cmd_solve_help[] =
     "                      mechanism (default 1e-12)\n"
     "  --max-iter N        Newton iterations per step before giving up (default 50)\n"
     "  --min-rcond R       reciprocal condition below which a position is reported\n"
-    "                      singular (default 1e-8)\n"
+    "                      singular (default 1e-6)\n"
     "  --outputs LIST      comma-separated point, link and slider names to output\n"
     "                      instead of the file's outputs\n"
     "  --level L           positions, velocities or accelerations (default): the\n"

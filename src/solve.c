@@ -260,7 +260,7 @@ int solver_init(solver *sv, const mech_model *m, const mech_solve_options *o, me
     if (!(sv->opt.tol > 0.0))
         sv->opt.tol = 1e-12;
     if (!(sv->opt.min_rcond > 0.0))
-        sv->opt.min_rcond = 1e-8;
+        sv->opt.min_rcond = 1e-6;
     sv->ftol = sv->opt.tol * sv->lref;
     if (kin_tree_build(&sv->tree, sv->sys) != MECH_OK)
         return diag_error(d, m->file, (mech_mark){0, 0}, "out of memory"), MECH_ENOMEM;
@@ -285,6 +285,11 @@ int solver_init(solver *sv, const mech_model *m, const mech_solve_options *o, me
     if (rc != MECH_OK)
         return rc;
     klu_defaults(&sv->common);
+    /* Every row is a length in metres already, and columns are equilibrated
+       per factorisation; KLU's row scaling would blow a row that is small
+       for a geometric reason (a dead centre) up to 1 and hide the
+       singularity from klu_rcond. */
+    sv->common.scale = 0;
     if (sv->ns > 0) {
         sv->sym = klu_analyze(sv->ns, sv->Ap, sv->Ai, &sv->common);
         if (!sv->sym)

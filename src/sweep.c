@@ -40,7 +40,8 @@ typedef struct sweep {
     int row_iters;             /* Newton iterations spent on the current row */
     double fail_q;             /* where the last rejected attempt was */
     step_status fail_status;
-    double fail_resid;
+    double fail_resid;         /* residual and worst loop of the first rejected attempt */
+    int fail_loop;
 } sweep;
 
 static double now_seconds(void)
@@ -80,12 +81,17 @@ static const char *loop_label(const solver *sv, int k, char *buf, size_t size)
             at += (size_t)snprintf(buf + at, size - at, "%s%s", i ? "-" : "",
                                    m->point_names[m->loops[k].points[i]]);
     } else {
-        const char *first = NULL;
+        const char *first = NULL;  /* the point each term starts from */
         for (int t = ls->start[k]; t < ls->start[k + 1] && at < size; t++) {
             const loop_term *lt = &ls->terms[t];
-            if (lt->kind != TERM_BODY)
-                continue;
-            const char *p = m->links[lt->link].points[lt->p0].name;
+            const char *p;
+            if (lt->kind == TERM_BODY) {
+                p = m->links[lt->link].points[lt->p0].name;
+            } else {
+                const mech_joint *j = &m->joints[lt->joint];
+                int side = lt->sign > 0 ? 1 : 0;  /* + runs guide point -> mover */
+                p = m->links[j->link[side]].points[j->point[side]].name;
+            }
             first = first ? first : p;
             at += (size_t)snprintf(buf + at, size - at, "%s-", p);
         }
@@ -316,6 +322,7 @@ static step_status advance(sweep *w, double q, double hmin)
 {
     double h = q - w->qc;
     step_status s = STEP_OK;
+    w->fail_status = STEP_OK;
     while (w->qc != q) {
         double remaining = q - w->qc;
         double qn = fabs(remaining) <= fabs(h) * (1.0 + 1e-12) ? q : w->qc + h;
@@ -328,9 +335,12 @@ static step_status advance(sweep *w, double q, double hmin)
                 h *= 2.0;  /* recover the step after a difficulty */
             continue;
         }
+        if (w->fail_status == STEP_OK) {
+            w->fail_resid = vec_norm_inf(w->sv.f, w->sv.ns);
+            w->fail_loop = worst_loop(&w->sv);
+        }
         w->fail_q = qn;
         w->fail_status = s;
-        w->fail_resid = vec_norm_inf(w->sv.f, w->sv.ns);
         if (s == STEP_NOMEM || fabs(h) <= hmin)
             return s;
         h *= 0.5;
@@ -466,7 +476,7 @@ static void report_failure(sweep *w, double q_row, double hrow)
     char qa[64], qb[64], qc[64], lb[256];
     double upper = w->qc, fq = w->fail_q;
     step_status s = w->fail_status;
-    int loop = worst_loop(sv);
+    int loop = w->fail_loop;
     double resid = w->fail_resid;
     if (s == STEP_SINGULAR) {
         report_singular(w, fq);
@@ -615,7 +625,7 @@ void mech_solve_options_default(mech_solve_options *o)
     memset(o, 0, sizeof *o);
     o->tol = 1e-12;
     o->max_iter = 50;
-    o->min_rcond = 1e-8;
+    o->min_rcond = 1e-6;
     o->want = MECH_WANT_ALL;
 }
 

@@ -124,5 +124,67 @@ for f in mechanisms/*.yaml; do
     fi
 done
 
+# ---- mech solve ---------------------------------------------------------
+
+# has_line FILE PATTERN LABEL: pass when FILE has a line matching PATTERN
+has_line() {
+    if grep -q -- "$2" "$1"; then pass; else fail "$3: no line matching '$2' in $(head -c 300 "$1")"; fi
+}
+
+if run "mech solve --help" 0 "$MECH" solve --help; then
+    has_line "$tmp/out" '^usage: mech solve' "mech solve --help"
+fi
+
+if run "mech solve fourbar" 0 "$MECH" solve mechanisms/fourbar.yaml -o "$tmp/fb.csv" --stats; then
+    rows=$(wc -l <"$tmp/fb.csv")
+    [ "$rows" -eq 362 ] && pass || fail "mech solve fourbar: $rows lines, expected 362 (header + 361 rows)"
+    has_line "$tmp/fb.csv" '^q \[rad\],A\.x \[m\],A\.y \[m\],A\.vx \[m/s\]' "fourbar header"
+    has_line "$tmp/err" 'Newton iterations' "mech solve --stats"
+    ls "$tmp"/fb.csv.tmp* >/dev/null 2>&1 && fail "a temporary file was left beside the output" || pass
+fi
+
+if run "mech solve to stdout" 0 "$MECH" solve mechanisms/slider-crank.yaml --level positions; then
+    has_line "$tmp/out" '^q \[rad\],A\.x \[m\],A\.y \[m\],B\.x' "positions-only header"
+    grep -q 'vx\|\.omega\|\.a \[' "$tmp/out" && fail "--level positions printed rates" || pass
+fi
+
+if run "mech solve --from/--to/--steps" 0 "$MECH" solve mechanisms/fourbar.yaml --from 0 --to 90 --steps 9 -o "$tmp/r.csv"; then
+    rows=$(wc -l <"$tmp/r.csv")
+    [ "$rows" -eq 11 ] && pass || fail "--steps 9: $rows lines, expected 11"
+    last=$(tail -n 1 "$tmp/r.csv" | cut -d, -f1)
+    case $last in 1.570796326794896*) pass ;; *) fail "--to 90: last q is $last, expected pi/2 rad" ;; esac
+fi
+
+if run "mech solve --outputs --verbose" 0 "$MECH" solve mechanisms/stirling.yaml --outputs D --verbose -o "$tmp/d.csv"; then
+    has_line "$tmp/err" 'skipped, no output needs it' "--verbose block report"
+    has_line "$tmp/d.csv" '^q \[rad\],D\.x \[m\],D\.y \[m\],D\.vx \[m/s\],D\.vy \[m/s\],D\.ax \[m/s^2\],D\.ay \[m/s^2\]$' "--outputs D header"
+fi
+
+if run "mech solve --outputs typo" 2 "$MECH" solve mechanisms/fourbar.yaml --outputs cuopler; then
+    has_line "$tmp/err" "did you mean 'coupler'" "--outputs typo"
+fi
+
+run "mech solve bad option" 2 "$MECH" solve mechanisms/fourbar.yaml --frobnicate && pass
+run "mech solve --steps 0" 2 "$MECH" solve mechanisms/fourbar.yaml --steps 0 && pass
+run "mech solve --from without --to" 2 "$MECH" solve mechanisms/fourbar.yaml --from 10 && pass
+run "mech solve --from with a wrong unit" 2 "$MECH" solve mechanisms/fourbar.yaml --from 10kg --to 20 && pass
+run "mech solve missing file" 3 "$MECH" solve "$tmp/nonexistent.yaml" && pass
+run "mech solve unwritable output" 3 "$MECH" solve mechanisms/fourbar.yaml -o "$tmp/no/such/dir/x.csv" && pass
+
+echo "keep me" >"$tmp/old.csv"
+if run "mech solve non-Grashof" 1 "$MECH" solve tests/solve/non-grashof.yaml -o "$tmp/old.csv"; then
+    has_line "$tmp/err" 'cannot assemble at driver angle = 143 deg.*assembles for driver angle from -142.83[0-9]* deg to 142.83[0-9]* deg' "non-Grashof message"
+    [ "$(cat "$tmp/old.csv")" = "keep me" ] && pass || fail "a failed solve overwrote the output file"
+fi
+
+if run "mech solve dead centre" 1 "$MECH" solve tests/solve/dead-centre.yaml -o "$tmp/dc.csv"; then
+    has_line "$tmp/err" 'singular position at driver displacement = 180 mm.*th_crank, th_rod' "dead-centre message"
+    [ -e "$tmp/dc.csv" ] && fail "a failed solve wrote an output file" || pass
+fi
+
+for f in mechanisms/*.yaml; do
+    run "mech solve $f" 0 "$MECH" solve "$f" -o "$tmp/all.csv" && pass
+done
+
 echo "cli: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]
