@@ -79,10 +79,14 @@ test-san:
 
 # Benchmarks: optimised, no sanitizers; prints tables (docs/performance.md).
 bench:
-	@$(MAKE) --no-print-directory BUILD=build/bench OPT="-O2 -DNDEBUG" build/bench/bench-eval
+	@$(MAKE) --no-print-directory BUILD=build/bench OPT="-O2 -DNDEBUG" build/bench/bench-eval build/bench/bench-solve
 	build/bench/bench-eval mechanisms/*.yaml
+	build/bench/bench-solve mechanisms/*.yaml
 
 $(BUILD)/bench-eval: bench/bench_eval.c $(BUILD)/libmech.a $(HEADERS)
+	$(CC) $(CFLAGS) -Isrc -o $@ $< $(BUILD)/libmech.a $(LDLIBS)
+
+$(BUILD)/bench-solve: bench/bench_solve.c $(BUILD)/libmech.a $(HEADERS)
 	$(CC) $(CFLAGS) -Isrc -o $@ $< $(BUILD)/libmech.a $(LDLIBS)
 
 install: all

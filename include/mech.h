@@ -298,7 +298,8 @@ typedef struct mech_solve_stats {
     int nsolved;             /* unknowns actually solved (the needed blocks) */
     int nblocks;             /* blocks of the block triangular form */
     int nblocks_solved;
-    double seconds;          /* wall time of the sweep (not of loading) */
+    double setup_seconds;    /* wall time to build the system, choose blocks, analyse */
+    double seconds;          /* wall time of the sweep itself (all rows) */
 } mech_solve_stats;
 
 /* Solve the driver sweep of a checked model. On success *out holds one row

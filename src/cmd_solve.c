@@ -196,7 +196,8 @@ static void print_stats(const mech_model *m, const mech_solve_stats *st, FILE *o
                 angle ? "deg" : "mm");
     fprintf(out, "  factorizations     %d full, %d refactor\n", st->factorizations,
             st->refactorizations);
-    fprintf(out, "  time               %.3g s, %.3g us per step\n", st->seconds, per * 1e6);
+    fprintf(out, "  time               %.3g us per step (sweep %.3g s, set-up %.3g s)\n",
+            per * 1e6, st->seconds, st->setup_seconds);
 }
 
 int cmd_solve(int argc, char **argv)

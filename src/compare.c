@@ -10,9 +10,9 @@
  * limit on the length of a line or the number of columns (getline grows its
  * buffer). Both files are read whole, then compared column by column. */
 #include <errno.h>
-#include <stdarg.h>
 #include <limits.h>
 #include <math.h>
+#include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -40,8 +40,8 @@ typedef struct csv_reader {
     int *cols;         /* [nfields] their 1-based columns */
     size_t nfields, fields_cap;
     size_t rows_cap;   /* rows allocated in the table's values */
-    int header_line;
-    mech_diag *d;
+    int header_line;   /* line number of the header, for messages */
+    mech_diag *d;      /* where errors go */
 } csv_reader;
 
 static int is_blank(char c)
@@ -68,7 +68,7 @@ static int error_at(csv_reader *r, int col, const char *fmt, ...)
 }
 
 /* Read the next line into r->line, without its \n or \r\n. Returns 1 for a
- * line, 0 at the end of the file, MECH_EIO or MECH_ENOMEM (recorded). */
+ * line, 0 at the end of the file, MECH_EIO (recorded) or MECH_ENOMEM. */
 static int read_line(csv_reader *r)
 {
     errno = 0;
@@ -419,7 +419,6 @@ static int col_failed(const col_result *c)
 {
     return c->o < 0 || c->unit_differs || c->first_bad != NO_ROW;
 }
-
 
 /* The state of one comparison. */
 typedef struct cmp {

@@ -670,7 +670,7 @@ static void finish_stats(sweep *w, int rows, double t0)
 {
     mech_solve_stats *st = w->st;
     st->steps = rows;
-    st->seconds = now_seconds() - t0;
+    st->seconds = now_seconds() - t0;  /* t0: after the set-up */
     st->factorizations = w->sv.stats_factor;
     st->refactorizations = w->sv.stats_refactor;
     st->nunknowns = w->sv.n;
@@ -696,6 +696,7 @@ int mech_solve(const mech_model *m, const mech_solve_options *o, mech_table *out
         return diag_error(d, m->file, (mech_mark){0, 0}, "the mechanism has no driver");
     double t0 = now_seconds();
     int rc = solver_init(&w.sv, m, o, d), nvalues = 0;
+    w.st->setup_seconds = now_seconds() - t0;
     double *values = NULL;
     if (rc == MECH_OK) {
         rc = MECH_ENOMEM;
@@ -707,6 +708,7 @@ int mech_solve(const mech_model *m, const mech_solve_options *o, mech_table *out
             diag_error(d, m->file, (mech_mark){0, 0}, "out of memory");
     }
     w.qd = m->driver.speed;
+    t0 = now_seconds();
     w.qdd = m->driver.accel;
     int row = 0;
     for (; rc == MECH_OK && row < nvalues; row++) {
