@@ -72,6 +72,7 @@ test: deps
 	@$(MAKE) --no-print-directory $(BUILD)/mech $(BUILD)/unit-tests
 	$(BUILD)/unit-tests --jobs 2
 	MECH=$(BUILD)/mech sh tests/cli.sh
+	MECH=$(BUILD)/mech sh tests/cli_compare.sh
 
 test-san:
 	@$(MAKE) --no-print-directory test BUILD=build/san OPT="-O1 -g -fno-omit-frame-pointer" \

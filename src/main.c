@@ -16,7 +16,6 @@ typedef struct command {
 
 static int cmd_check(int argc, char **argv);
 static int cmd_equations(int argc, char **argv);
-static int cmd_compare_entry(int argc, char **argv);
 
 static const command commands[] = {
     {"check", cmd_check, "validate mechanism files and print their structure",
@@ -47,7 +46,7 @@ static const command commands[] = {
      "exit status: 0 printed, 2 invalid file or usage, 3 the file cannot be read\n"},
     {"solve", cmd_solve, "solve positions, velocities and accelerations over the driver range",
      cmd_solve_help},
-    {"compare", cmd_compare_entry, "compare a result CSV with a golden CSV", NULL},
+    {"compare", cmd_compare, "compare a result CSV with a golden CSV", compare_help},
 };
 #define NCOMMANDS (sizeof commands / sizeof commands[0])
 
@@ -220,9 +219,6 @@ static int cmd_equations(int argc, char **argv)
     return rc == MECH_OK ? MECH_EXIT_OK : MECH_EXIT_INPUT;
 }
 
-/* compare prints its own help (src/compare.c) */
-static int cmd_compare_entry(int argc, char **argv) { return cmd_compare(argc, argv); }
-
 int main(int argc, char **argv)
 {
     if (argc < 2) {
@@ -233,10 +229,6 @@ int main(int argc, char **argv)
         if (argc > 2)
             for (size_t i = 0; i < NCOMMANDS; i++)
                 if (strcmp(argv[2], commands[i].name) == 0) {
-                    if (!commands[i].help) {
-                        char *args[] = {argv[2], (char *)"--help", NULL};
-                        return commands[i].run(2, args);
-                    }
                     fputs(commands[i].help, stdout);
                     return MECH_EXIT_OK;
                 }

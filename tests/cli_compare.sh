@@ -1,0 +1,197 @@
+#!/bin/sh
+# tests/cli_compare.sh: `mech compare`: exit statuses, the verdict, the
+# FILE:LINE:COLUMN of malformed files, --help (docs/compare.md).
+# Run from the repository root:  MECH=build/mech sh tests/cli_compare.sh
+# Prints one line per failure, then "cli-compare: N passed, M failed"; exits 1
+# if anything failed.
+MECH=${MECH:-build/mech}
+if [ ! -x "$MECH" ]; then
+    echo "cli-compare: $MECH is not an executable (build it first, or set MECH)" >&2
+    exit 2
+fi
+
+tmp=${TMPDIR:-/tmp}/mech-cli-compare.$$
+mkdir "$tmp" || exit 2
+trap 'rm -rf "$tmp"' EXIT
+trap 'exit 2' INT TERM HUP
+
+passed=0
+failed=0
+pass() { passed=$((passed + 1)); }
+fail() { failed=$((failed + 1)); echo "FAIL: $*"; }
+
+# run LABEL STATUS COMMAND...: run COMMAND with stdout in $tmp/out and stderr
+# in $tmp/err; 0 when it exits with STATUS, else report a failure and 1.
+run() {
+    label=$1 want=$2
+    shift 2
+    "$@" >"$tmp/out" 2>"$tmp/err"
+    status=$?
+    if [ "$status" -ne "$want" ]; then
+        fail "$label: exit status $status, expected $want (stderr: $(head -n 1 "$tmp/err"))"
+        return 1
+    fi
+    return 0
+}
+
+# expect LABEL FILE LINE: pass when FILE has the exact line LINE.
+expect() {
+    if grep -qxF -- "$3" "$2"; then
+        pass
+    else
+        fail "$1: no line '$3' in $(basename "$2"): $(tail -n 1 "$2")"
+    fi
+}
+
+# ---- the files -------------------------------------------------------------
+
+cat >"$tmp/golden.csv" <<'EOF'
+# mech solve fourbar.yaml
+q [rad],B.x [m],B.vx [m/s]
+0,100,0.5
+0.1,100,-0.25
+0.2,100,nan
+EOF
+cp "$tmp/golden.csv" "$tmp/same.csv"
+# B.x of row 3 is 1.01e-7 away: just outside 1e-12 + 1e-9*100; an extra column
+cat >"$tmp/near.csv" <<'EOF'
+q [rad],B.x [m],B.vx [m/s],iterations [-]
+0,100,0.5,3
+0.1,100.000000099,-0.25,3
+0.2,100.000000101,nan,4
+EOF
+printf 'q [rad],B.x [m],B.vx [m/s],iterations [-]\n0,100,0.5,3\n0.1,100,-0.25,3\n0.2,100,nan,4\n' >"$tmp/wide.csv"
+printf 'q [rad],B.x [m],B.vx [m/s]\r\n0,100,0.5\r\n0.1,100,-0.25\r\n' >"$tmp/short.csv"
+printf 'q [rad],B.x [mm],B.vx [m/s]\n0,100,0.5\n0.1,100,-0.25\n0.2,100,nan\n' >"$tmp/mm.csv"
+printf 'q [rad],B.x [m],B.vx [m/s]\n0,100,0.5\n0.1,1OO,-0.25\n0.2,100\n' >"$tmp/bad.csv"
+
+# ---- help and usage --------------------------------------------------------
+
+if run "mech compare --help" 0 "$MECH" compare --help; then
+    if grep -q '^usage: mech compare ' "$tmp/out" && grep -q '^options:' "$tmp/out" &&
+        grep -q '^exit status:' "$tmp/out" && grep -q 'default 1e-9' "$tmp/out"; then
+        pass
+    else
+        fail "mech compare --help: no usage line, options, defaults or exit status"
+    fi
+fi
+
+if run "mech help compare" 0 "$MECH" help compare; then
+    if grep -q '^usage: mech compare ' "$tmp/out"; then
+        pass
+    else
+        fail "mech help compare: no 'usage: mech compare' line"
+    fi
+fi
+
+if run "mech --help" 0 "$MECH" --help; then
+    if grep -q '^  compare ' "$tmp/out"; then
+        pass
+    else
+        fail "mech --help: compare is not listed"
+    fi
+fi
+
+run "mech compare (no files)" 2 "$MECH" compare && pass
+run "mech compare (one file)" 2 "$MECH" compare "$tmp/same.csv" && pass
+run "mech compare (three files)" 2 "$MECH" compare "$tmp/same.csv" "$tmp/same.csv" "$tmp/same.csv" && pass
+run "mech compare --frob" 2 "$MECH" compare --frob "$tmp/same.csv" "$tmp/golden.csv" && pass
+run "mech compare --rtol -1" 2 "$MECH" compare --rtol -1 "$tmp/same.csv" "$tmp/golden.csv" && pass
+run "mech compare --atol x" 2 "$MECH" compare --atol x "$tmp/same.csv" "$tmp/golden.csv" && pass
+run "mech compare --rtol (no value)" 2 "$MECH" compare "$tmp/same.csv" "$tmp/golden.csv" --rtol && pass
+
+# ---- 0: the files match ------------------------------------------------------
+
+if run "identical" 0 "$MECH" compare "$tmp/same.csv" "$tmp/golden.csv"; then
+    expect "identical" "$tmp/out" "compare: 3 columns, 3 rows: all within rtol 1e-09 atol 1e-12"
+fi
+
+if run "--rtol 1e-8" 0 "$MECH" compare --rtol 1e-8 "$tmp/near.csv" "$tmp/golden.csv"; then
+    expect "--rtol 1e-8" "$tmp/out" "extra in OUT (not compared): iterations [-]"
+fi
+
+run "--atol=2e-7" 0 "$MECH" compare --atol=2e-7 "$tmp/near.csv" "$tmp/golden.csv" && pass
+
+if run "--columns q,B.vx" 0 "$MECH" compare --columns q,B.vx "$tmp/near.csv" "$tmp/golden.csv"; then
+    if grep -q '^B\.x ' "$tmp/out"; then
+        fail "--columns q,B.vx: B.x is compared"
+    else
+        pass
+    fi
+fi
+
+# ---- 1: the files differ -----------------------------------------------------
+
+if run "just outside rtol" 1 "$MECH" compare "$tmp/near.csv" "$tmp/golden.csv"; then
+    expect "just outside rtol" "$tmp/out" \
+        "compare: 1 of 3 columns differs (first: B.x at row 3: 100.000000101 vs 100)"
+    if grep -q '^B\.x  *m  .*  3  FAIL$' "$tmp/out"; then
+        pass
+    else
+        fail "just outside rtol: B.x line: $(grep '^B\.x ' "$tmp/out")"
+    fi
+fi
+
+if run "row counts" 1 "$MECH" compare "$tmp/short.csv" "$tmp/golden.csv"; then
+    if grep -q '^compare: row counts differ: OUT has 2 rows, GOLDEN has 3' "$tmp/out"; then
+        pass
+    else
+        fail "row counts: verdict $(tail -n 1 "$tmp/out")"
+    fi
+fi
+
+if run "unit" 1 "$MECH" compare "$tmp/mm.csv" "$tmp/golden.csv"; then
+    if grep -q '^B\.x .*FAIL (unit \[mm\] in OUT)$' "$tmp/out"; then
+        pass
+    else
+        fail "unit: B.x line: $(grep '^B\.x ' "$tmp/out")"
+    fi
+fi
+
+if run "missing column" 1 "$MECH" compare "$tmp/golden.csv" "$tmp/wide.csv"; then
+    expect "missing column" "$tmp/out" "compare: 1 of 4 columns differs (first: iterations missing from OUT)"
+fi
+
+# ---- 2: malformed files, bad --columns ---------------------------------------
+
+if run "malformed" 2 "$MECH" compare "$tmp/bad.csv" "$tmp/golden.csv"; then
+    expect "malformed" "$tmp/err" "$tmp/bad.csv:3:5: error: '1OO' in column 'B.x' is not a number"
+    expect "malformed" "$tmp/err" \
+        "$tmp/bad.csv:4:8: error: row has 2 fields, expected 3 as in the header (line 1)"
+    if [ -s "$tmp/out" ]; then
+        fail "malformed: something on stdout: $(head -n 1 "$tmp/out")"
+    else
+        pass
+    fi
+fi
+
+if run "--columns B.vy" 2 "$MECH" compare --columns B.vy "$tmp/same.csv" "$tmp/golden.csv"; then
+    expect "--columns B.vy" "$tmp/err" \
+        "$tmp/golden.csv: error: --columns: no column 'B.vy' (did you mean 'B.vx'?)"
+fi
+
+# ---- 3: unreadable files -------------------------------------------------------
+
+if run "missing file" 3 "$MECH" compare "$tmp/none.csv" "$tmp/golden.csv"; then
+    if grep -q "^$tmp/none.csv: error: cannot open" "$tmp/err"; then
+        pass
+    else
+        fail "missing file: the message does not name the file: $(head -n 1 "$tmp/err")"
+    fi
+fi
+
+run "directory" 3 "$MECH" compare "$tmp/same.csv" "$tmp" && pass
+
+# ---- a solver round trip, when `mech solve` exists -------------------------------
+
+if "$MECH" solve --help >/dev/null 2>&1 && [ -f mechanisms/fourbar.yaml ]; then
+    if "$MECH" solve mechanisms/fourbar.yaml -o "$tmp/a.csv" 2>"$tmp/err" &&
+        "$MECH" solve mechanisms/fourbar.yaml -o "$tmp/b.csv" 2>"$tmp/err"; then
+        run "solve twice, compare" 0 "$MECH" compare "$tmp/a.csv" "$tmp/b.csv" && pass
+    else
+        fail "mech solve mechanisms/fourbar.yaml: $(head -n 1 "$tmp/err")"
+    fi
+fi
+
+echo "cli-compare: $passed passed, $failed failed"
+[ "$failed" -eq 0 ]
