@@ -7,7 +7,7 @@
  * Per driver position: Newton with damping on the closure residual, with
  * klu_refactor (a fresh klu_factor when the pivots degrade); then dx/dq and
  * d2x/dq2 by two solves with the converged factors. Columns are
- * equilibrated before every factorisation, so klu_rcond measures the
+ * equilibrated before every factorisation, so the condition estimate measures the
  * geometry, not the units. */
 #include <btf.h>
 #include <math.h>
@@ -288,8 +288,11 @@ int solver_init(solver *sv, const mech_model *m, const mech_solve_options *o, me
     /* Every row is a length in metres already, and columns are equilibrated
        per factorisation; KLU's row scaling would blow a row that is small
        for a geometric reason (a dead centre) up to 1 and hide the
-       singularity from klu_rcond. */
+       singularity from the condition estimate. */
     sv->common.scale = 0;
+    /* Diagonal preference only within a factor 10 of the largest pivot
+       candidate (KLU's default 1e-3 allows growth of 1e3 per column). */
+    sv->common.tol = 0.1;
     if (sv->ns > 0) {
         sv->sym = klu_analyze(sv->ns, sv->Ap, sv->Ai, &sv->common);
         if (!sv->sym)
@@ -379,7 +382,7 @@ static int fresh_factor(solver *sv)
     if (!sv->num)
         return -1;
     klu_rcond(sv->sym, sv->num, &sv->common);
-    sv->rcond = sv->rcond_factor = sv->common.rcond;
+    sv->pivot_ratio = sv->pivot_ratio_factor = sv->common.rcond;
     return 0;
 }
 
@@ -393,15 +396,28 @@ static int factor(solver *sv)
     if (sv->num && klu_refactor(sv->Ap, sv->Ai, sv->Ax, sv->sym, sv->num, &sv->common)) {
         sv->stats_refactor++;
         klu_rcond(sv->sym, sv->num, &sv->common);
-        sv->rcond = sv->common.rcond;
+        sv->pivot_ratio = sv->common.rcond;
         /* pivots chosen for another position have degraded: pivot afresh */
-        if (!(sv->rcond >= 1e-3 * sv->rcond_factor) && fresh_factor(sv) < 0)
+        if (!(sv->pivot_ratio >= 1e-3 * sv->pivot_ratio_factor) && fresh_factor(sv) < 0)
             return -1;
     } else if (fresh_factor(sv) < 0) {
         return -1;
     }
     sv->factored = 1;
     return 0;
+}
+
+/* Reciprocal 1-norm condition estimate of the equilibrated Jacobian
+ * (klu_condest, Hager's method: a few solves). klu_rcond's pivot ratio is
+ * not a condition estimate: pivoting that prefers the diagonal can make it
+ * 1e-6 at a perfectly regular position. */
+static double condition(solver *sv)
+{
+    if (klu_condest(sv->Ap, sv->Ax, sv->sym, sv->num, &sv->common) && sv->common.condest > 0.0)
+        sv->rcond = 1.0 / sv->common.condest;
+    else
+        sv->rcond = 0.0;
+    return sv->rcond;
 }
 
 /* Solve J y = b in place (b := dx), undoing the column scaling. */
@@ -437,7 +453,7 @@ step_status solver_newton(solver *sv, double q)
         if (r <= sv->ftol && (step <= xtol || step >= 0.9 * prev_step)) {
             sv->resid = r;
             sv->iters = it;
-            return sv->rcond < sv->opt.min_rcond ? STEP_SINGULAR : STEP_OK;
+            return condition(sv) < sv->opt.min_rcond ? STEP_SINGULAR : STEP_OK;
         }
         if (it == max_iter) {
             sv->resid = r;

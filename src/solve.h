@@ -42,7 +42,9 @@ typedef struct solver {
     klu_common common;
     klu_symbolic *sym;
     klu_numeric *num;
-    double rcond, rcond_factor;/* now, and after the last full factorisation */
+    double rcond;              /* 1 / klu_condest at the last converged position */
+    double pivot_ratio;        /* klu_rcond (min/max pivot) now, and after the last */
+    double pivot_ratio_factor; /* full factorisation: refactor or pivot afresh */
     int factored;              /* num holds factors of the current x */
 
     double *pos, *vel, *acc;   /* [n+1] variable values (n = driver), SI */
