@@ -1,6 +1,6 @@
 /* src/compare.c: `mech compare`, a solver output CSV against a golden CSV.
  *
- * The CSV read here is what the solver writes (docs/compare.md):
+ * The CSV read here is what the solver writes (docs/cli.md, section mech compare):
  *   file    = { skipped } header { row | skipped }
  *   skipped = a blank line, or a comment: first non-blank character '#'
  *   header  = field { ',' field }       field = NAME [blanks] '[' UNIT ']'

@@ -6,7 +6,7 @@
  *     |out - golden| <= atol + rtol * |golden|
  * (NaN matches only NaN, inf only an inf of the same sign), printing one line
  * per column and a verdict. compare_csv_files() does both for two paths, and
- * cmd_compare() is the command line on top of it (docs/compare.md).
+ * cmd_compare() is the command line on top of it (docs/cli.md, section mech compare).
  *
  * Status values (like the rest of libmech): MECH_OK the files match,
  * COMPARE_DIFFER (> 0) both files are valid but differ, MECH_EINPUT a

@@ -1,6 +1,6 @@
 #!/bin/sh
 # tests/cli_compare.sh: `mech compare`: exit statuses, the verdict, the
-# FILE:LINE:COLUMN of malformed files, --help (docs/compare.md).
+# FILE:LINE:COLUMN of malformed files, --help (docs/cli.md, section mech compare).
 # Run from the repository root:  MECH=build/mech sh tests/cli_compare.sh
 # Prints one line per failure, then "cli-compare: N passed, M failed"; exits 1
 # if anything failed.
