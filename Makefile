@@ -5,6 +5,7 @@
 #   make test       deps + build + the full test suite
 #   make test-san   the test suite built with -fsanitize=address,undefined
 #   make bench      optimised benchmarks, printed as tables
+#   make golden     regenerate tests/golden/*.csv (review the diff by hand)
 #   make install PREFIX=/usr/local
 #   make clean
 CC      ?= cc
@@ -32,7 +33,7 @@ LIB_OBJ  = $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o)
 TEST_SRC = $(wildcard tests/unit/*.c)
 TEST_OBJ = $(TEST_SRC:tests/unit/%.c=$(BUILD)/tests/%.o)
 
-.PHONY: all deps run test test-san bench install clean
+.PHONY: all deps run test test-san bench golden install clean
 
 all: $(BUILD)/mech
 
@@ -73,6 +74,7 @@ test: deps
 	$(BUILD)/unit-tests --jobs 2
 	MECH=$(BUILD)/mech sh tests/cli.sh
 	MECH=$(BUILD)/mech sh tests/cli_compare.sh
+	MECH=$(BUILD)/mech sh tests/golden.sh
 
 test-san:
 	@$(MAKE) --no-print-directory test BUILD=build/san OPT="-O1 -g -fno-omit-frame-pointer" \
@@ -89,6 +91,15 @@ $(BUILD)/bench-eval: bench/bench_eval.c $(BUILD)/libmech.a $(HEADERS)
 
 $(BUILD)/bench-solve: bench/bench_solve.c $(BUILD)/libmech.a $(HEADERS)
 	$(CC) $(CFLAGS) -Isrc -o $@ $< $(BUILD)/libmech.a $(LDLIBS)
+
+# Regenerate tests/golden/NAME.csv from mechanisms/NAME.yaml. Review the diff
+# (git diff --stat tests/golden; mech compare) before committing new goldens.
+golden: all
+	@for f in mechanisms/*.yaml; do \
+	    n=$$(basename $$f .yaml); \
+	    echo "$(BUILD)/mech solve $$f -o tests/golden/$$n.csv"; \
+	    $(BUILD)/mech solve $$f -o tests/golden/$$n.csv || exit 1; \
+	done
 
 install: all
 	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib $(DESTDIR)$(PREFIX)/include
