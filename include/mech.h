@@ -258,7 +258,16 @@ typedef struct mech_solve_options {
     double from, to;   /* driver positions, SI (rad or m) */
     int steps;
     FILE *log;         /* when not NULL: which blocks are solved, and why (--verbose) */
+    int forces;        /* 1: joint reactions and driver torque even if the file's
+                          outputs do not ask for them (outputs: forces: true) */
+    int friction;      /* MECH_FRICTION_*: how joint friction enters the forces */
 } mech_solve_options;
+
+enum {
+    MECH_FRICTION_ON = 0,  /* the joints' friction coefficients are applied (default) */
+    MECH_FRICTION_OFF,     /* frictionless reactions only */
+    MECH_FRICTION_BOTH     /* both, the frictionless columns suffixed ".nofriction" */
+};
 
 void mech_solve_options_default(mech_solve_options *o);
 
@@ -298,13 +307,16 @@ typedef struct mech_solve_stats {
     int nsolved;             /* unknowns actually solved (the needed blocks) */
     int nblocks;             /* blocks of the block triangular form */
     int nblocks_solved;
+    double worst_power_residual; /* forces: largest relative power-balance residual */
+    int max_friction_iterations; /* forces: worst step of the friction fixed point */
     double setup_seconds;    /* wall time to build the system, choose blocks, analyse */
     double seconds;          /* wall time of the sweep itself (all rows) */
 } mech_solve_stats;
 
 /* Solve the driver sweep of a checked model. On success *out holds one row
  * per driver position with the outputs the model asks for (points: x, y, vx,
- * vy, ax, ay; links: angle, omega, alpha; sliders: s, v, a; SI units). On
+ * vy, ax, ay; links: angle, omega, alpha; sliders: s, v, a; with forces,
+ * joint reactions, driver torque or force, power balance; SI units). On
  * failure returns MECH_ESOLVE (or MECH_EINPUT for an invalid system), d says
  * what happened and where (driver position, loop, unknowns), and *out holds
  * the rows solved before the failure. `stats` may be NULL. */

@@ -10,6 +10,7 @@
 const char cmd_solve_help[] =
     "usage: mech solve FILE [-o OUT.csv] [--from A --to B --steps N] [--tol T]\n"
     "                  [--outputs NAME,...] [--level positions|velocities|accelerations]\n"
+    "                  [--forces] [--friction on|off|both]\n"
     "                  [--diagnostics] [--stats] [--verbose] [--all]\n"
     "\n"
     "Solve positions, velocities and accelerations of the mechanism at every\n"
@@ -34,6 +35,12 @@ const char cmd_solve_help[] =
     "                      instead of the file's outputs\n"
     "  --level L           positions, velocities or accelerations (default): the\n"
     "                      highest derivative computed\n"
+    "  --forces            also joint reactions (Fx, Fy, magnitude; sliders: normal\n"
+    "                      force N and moment M), the driver torque or force, and\n"
+    "                      the power-balance residual (as 'outputs: {forces: true}')\n"
+    "  --friction MODE     on: apply the joints' friction coefficients (default);\n"
+    "                      off: frictionless; both: also the frictionless columns,\n"
+    "                      suffixed .nofriction\n"
     "  --diagnostics       add the columns iterations, residual [m], rcond\n"
     "  --stats             print iterations per step, worst residual, smallest\n"
     "                      rcond and time per step to standard error\n"
@@ -68,7 +75,7 @@ static int parse_number(const char *text, double *v)
 
 static const char *const value_options[] = {"-o", "--output", "--from", "--to", "--outputs",
                                            "--steps", "--tol", "--max-iter", "--min-rcond",
-                                           "--level"};
+                                           "--level", "--friction"};
 
 static int takes_value(const char *arg)
 {
@@ -106,6 +113,15 @@ static int parse_valued(solve_args *a, const char *arg, const char *val)
         if (!parse_number(val, &num) || !(num > 0 && num < 1))
             return usage_error("--min-rcond needs a number between 0 and 1, not '%s'", val);
         a->opt.min_rcond = num;
+    } else if (strcmp(arg, "--friction") == 0) {
+        if (strcmp(val, "on") == 0)
+            a->opt.friction = MECH_FRICTION_ON;
+        else if (strcmp(val, "off") == 0)
+            a->opt.friction = MECH_FRICTION_OFF;
+        else if (strcmp(val, "both") == 0)
+            a->opt.friction = MECH_FRICTION_BOTH;
+        else
+            return usage_error("--friction is on, off or both, not '%s'", val);
     } else if (strncmp(val, "position", 8) == 0) {  /* --level */
         a->opt.want = MECH_WANT_POSITION;
     } else if (strncmp(val, "velocit", 7) == 0) {
@@ -141,6 +157,8 @@ static int parse_args(int argc, char **argv, solve_args *a)
             a->opt.diagnostics = 1;
         else if (strcmp(arg, "--all") == 0)
             a->opt.all_blocks = 1;
+        else if (strcmp(arg, "--forces") == 0)
+            a->opt.forces = 1;
         else if (arg[0] == '-' && arg[1] != '\0')
             return usage_error("unknown option '%s'", arg);
         else if (a->file)
@@ -196,6 +214,9 @@ static void print_stats(const mech_model *m, const mech_solve_stats *st, FILE *o
                 angle ? "deg" : "mm");
     fprintf(out, "  factorizations     %d full, %d refactor\n", st->factorizations,
             st->refactorizations);
+    if (st->worst_power_residual > 0.0 || st->max_friction_iterations > 0)
+        fprintf(out, "  power balance      worst relative residual %.3g; friction iterations "
+                "at most %d\n", st->worst_power_residual, st->max_friction_iterations);
     fprintf(out, "  time               %.3g us per step (sweep %.3g s, set-up %.3g s)\n",
             per * 1e6, st->seconds, st->setup_seconds);
 }

@@ -207,7 +207,7 @@ void kin_state_free(kin_state *st)
 static double var_value(const double *v, int var) { return v && var >= 0 ? v[var] : 0.0; }
 
 /* Point r of link l: position, and rates when the link's rates are known. */
-static void on_link(const kin_state *st, int l, const double *r, double *p, double *v, double *a)
+void kin_on_link(const kin_state *st, int l, const double *r, double *p, double *v, double *a)
 {
     double c = cos(st->th[l]), s = sin(st->th[l]);
     double rx = c * r[0] - s * r[1], ry = s * r[0] + c * r[1];  /* R r */
@@ -272,7 +272,7 @@ static void place_link(const kin_tree *t, kin_state *st, int l, const double *po
     const mech_joint *jt = &m->joints[j];
     double rbuf[2], p[2], v[2], a[2];
     if (jt->kind == MECH_JOINT_REVOLUTE) {
-        on_link(st, pl, point_xy(m, pl, loops_attach(jt, pl), rbuf), p, v, a);
+        kin_on_link(st, pl, point_xy(m, pl, loops_attach(jt, pl), rbuf), p, v, a);
         place_at(st, l, point_xy(m, l, loops_attach(jt, l), rbuf), p, v, a);
         return;
     }
@@ -281,7 +281,7 @@ static void place_link(const kin_tree *t, kin_state *st, int l, const double *po
     slide_offset(st, jt, var_value(pos, sv), var_value(vel, sv), var_value(acc, sv), d[0], d[1],
                  d[2]);
     double sign = l == jt->link[0] ? 1.0 : -1.0;  /* mover = guide point + d */
-    on_link(st, pl, point_xy(m, pl, jt->point[l == jt->link[0] ? 1 : 0], rbuf), p, v, a);
+    kin_on_link(st, pl, point_xy(m, pl, jt->point[l == jt->link[0] ? 1 : 0], rbuf), p, v, a);
     for (int k = 0; k < 2; k++) {
         p[k] += sign * d[0][k];
         v[k] += sign * d[1][k];
@@ -314,6 +314,6 @@ void kin_point(const kin_tree *t, const kin_state *st, int name_id, double *p, d
         p[0] = p[1] = NAN;
         l = 0;
     }
-    on_link(st, l, point_xy(t->model, l, t->point_index[name_id], rbuf), p, v ? v : vb,
+    kin_on_link(st, l, point_xy(t->model, l, t->point_index[name_id], rbuf), p, v ? v : vb,
             a ? a : ab);
 }

@@ -52,4 +52,7 @@ void kin_update(const kin_tree *t, kin_state *st, const double *pos, const doubl
 void kin_point(const kin_tree *t, const kin_state *st, int name_id, double *p, double *v,
                double *a);
 
+/* Point r (link frame) of link l: position p, velocity v, acceleration a. */
+void kin_on_link(const kin_state *st, int l, const double *r, double *p, double *v, double *a);
+
 #endif

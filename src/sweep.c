@@ -14,6 +14,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "forces.h"
 #include "solve.h"
 
 static const double PI = 3.14159265358979323846;
@@ -23,6 +24,9 @@ enum { START_ATTEMPTS = 48 };
 
 typedef struct sweep {
     solver sv;
+    forces fc;
+    int want_forces;           /* joint reactions wanted */
+    int friction_mode;         /* MECH_FRICTION_* */
     mech_table *out;
     mech_solve_stats *st;
     mech_diag *d;
@@ -532,11 +536,54 @@ static int add_column(mech_table *t, const char *name, const char *suffix, const
     return 0;
 }
 
-static int make_columns(mech_table *t, const mech_model *m, int level, int diagnostics)
+/* Column base name of joint j: its name, or name(link,link) when several
+ * joints share the name (three links on one pin). */
+static const char *joint_label(const mech_model *m, int j, char *buf, size_t size)
+{
+    const mech_joint *jt = &m->joints[j];
+    int shared = 0;
+    for (int k = 0; k < m->njoints; k++)
+        shared |= k != j && strcmp(m->joints[k].name, jt->name) == 0;
+    if (!shared)
+        return jt->name;
+    snprintf(buf, size, "%s(%s,%s)", jt->name, m->links[jt->link[0]].name,
+             m->links[jt->link[1]].name);
+    return buf;
+}
+
+/* Reaction columns of every joint, the driver, and the power balance;
+ * `suffix` tells the frictionless set apart when both are written. */
+static int force_columns(mech_table *t, const mech_model *m, const char *suffix)
+{
+    char name[200], buf[160];
+    int rc = 0;
+    for (int j = 0; j < m->njoints; j++) {
+        const char *base = joint_label(m, j, buf, sizeof buf);
+        const char *parts[] = {".Fx", ".Fy", m->joints[j].kind == MECH_JOINT_SLIDER ? ".N" : ".F"};
+        for (int k = 0; k < 3; k++) {
+            snprintf(name, sizeof name, "%s%s", base, parts[k]);
+            rc |= add_column(t, name, suffix, "N");
+        }
+        if (m->joints[j].kind == MECH_JOINT_SLIDER && m->joints[j].locked) {
+            snprintf(name, sizeof name, "%s.M", base);
+            rc |= add_column(t, name, suffix, "N*m");
+        }
+    }
+    if (m->driver.kind == MECH_DRIVE_ANGLE)
+        rc |= add_column(t, "driver.torque", suffix, "N*m");
+    else
+        rc |= add_column(t, "driver.force", suffix, "N");
+    rc |= add_column(t, "power.residual", suffix, "-");
+    return rc;
+}
+
+static int make_columns(mech_table *t, const mech_model *m, int level, int diagnostics,
+                        int with_forces, int friction)
 {
     const mech_outputs *o = &m->outputs;
     int vel = level & MECH_WANT_VELOCITY, acc = level & MECH_WANT_ACCELERATION;
-    int max = 1 + 6 * o->npoints + 3 * o->nlinks + 3 * o->nsliders + 3;
+    int max = 1 + 6 * o->npoints + 3 * o->nlinks + 3 * o->nsliders + 3 +
+              (with_forces ? 2 * (4 * m->njoints + 2) + 2 : 0);
     t->columns = xcalloc((size_t)max, sizeof *t->columns);
     if (!t->columns)
         return -1;
@@ -565,6 +612,14 @@ static int make_columns(mech_table *t, const mech_model *m, int level, int diagn
         if (acc)
             rc |= add_column(t, s, ".a", "m/s^2");
     }
+    if (with_forces) {
+        rc |= force_columns(t, m, "");
+        if (friction >= 1)
+            rc |= add_column(t, "friction.power", "", "W") |
+                  add_column(t, "friction.iterations", "", "-");
+        if (friction == 2)
+            rc |= force_columns(t, m, ".nofriction");
+    }
     if (diagnostics)
         rc |= add_column(t, "iterations", "", "-") | add_column(t, "residual", "", "m") |
               add_column(t, "rcond", "", "-");
@@ -572,6 +627,23 @@ static int make_columns(mech_table *t, const mech_model *m, int level, int diagn
 }
 
 static double var_or_zero(const double *v, int var) { return var >= 0 ? v[var] : 0.0; }
+
+static double *fill_forces(sweep *w, double *out, int with_friction)
+{
+    const mech_model *m = w->m;
+    for (int j = 0; j < m->njoints; j++) {
+        double fx, fy, n, mo;
+        forces_joint(&w->fc, &w->sv, j, with_friction, &fx, &fy, &n, &mo);
+        *out++ = fx;
+        *out++ = fy;
+        *out++ = m->joints[j].kind == MECH_JOINT_SLIDER ? n : hypot(fx, fy);
+        if (m->joints[j].kind == MECH_JOINT_SLIDER && m->joints[j].locked)
+            *out++ = mo;
+    }
+    *out++ = forces_drive(&w->fc, with_friction);
+    *out++ = with_friction ? w->fc.residual : w->fc.residual0;
+    return out;
+}
 
 static void fill_row(sweep *w, int row)
 {
@@ -611,11 +683,46 @@ static void fill_row(sweep *w, int row)
         if (acc)
             *out++ = var_or_zero(sv->acc, var);
     }
+    if (w->want_forces) {
+        out = fill_forces(w, out, w->friction_mode != MECH_FRICTION_OFF);
+        if (w->fc.friction) {
+            *out++ = w->fc.friction_power;
+            *out++ = w->fc.iterations;
+        }
+        if (w->friction_mode == MECH_FRICTION_BOTH && w->fc.has_friction)
+            out = fill_forces(w, out, 0);
+    }
     if (sv->opt.diagnostics) {
         *out++ = w->row_iters;
         *out++ = sv->resid;
         *out++ = sv->rcond;
     }
+}
+
+/* ---- forces --------------------------------------------------------------- */
+
+static int solve_forces(sweep *w, double q)
+{
+    char qb[64];
+    int r = forces_solve(&w->fc, &w->sv);
+    if (r == -1)
+        return diag_error(w->d, w->m->file, w->m->driver.mark,
+                          "the force system is singular at %s = %s (reciprocal condition %.2g): "
+                          "redundant constraints make the joint reactions not unique",
+                          driver_word(w->m), q_text(w->m, q, qb, sizeof qb), w->fc.rcond),
+               MECH_ESOLVE;
+    if (r == -2)
+        return diag_error(w->d, w->m->file, w->m->driver.mark,
+                          "joint friction does not converge at %s = %s (fixed-point iteration, "
+                          "%d steps): the friction coefficients may make the mechanism "
+                          "self-locking there", driver_word(w->m), q_text(w->m, q, qb, sizeof qb),
+                          100), MECH_ESOLVE;
+    double worst = fmax(fabs(w->fc.residual), fabs(w->fc.residual0));
+    if (worst > w->st->worst_power_residual)
+        w->st->worst_power_residual = worst;
+    if (w->fc.iterations > w->st->max_friction_iterations)
+        w->st->max_friction_iterations = w->fc.iterations;
+    return MECH_OK;
 }
 
 /* ---- mech_solve ------------------------------------------------------- */
@@ -695,13 +802,27 @@ int mech_solve(const mech_model *m, const mech_solve_options *o, mech_table *out
     if (!m->has_driver)
         return diag_error(d, m->file, (mech_mark){0, 0}, "the mechanism has no driver");
     double t0 = now_seconds();
+    mech_solve_options opt = *o;
+    w.want_forces = o->forces || m->outputs.forces;
+    w.friction_mode = o->friction;
+    if (w.want_forces) {  /* reactions need every link's acceleration */
+        opt.all_blocks = 1;
+        opt.want = MECH_WANT_ALL;
+    }
+    o = &opt;
     int rc = solver_init(&w.sv, m, o, d), nvalues = 0;
+    if (rc == MECH_OK && w.want_forces)
+        rc = forces_init(&w.fc, &w.sv, w.friction_mode != MECH_FRICTION_OFF, d);
     w.st->setup_seconds = now_seconds() - t0;
     double *values = NULL;
     if (rc == MECH_OK) {
         rc = MECH_ENOMEM;
         values = sweep_values(m, o, &nvalues);
-        if (values && alloc_sweep(&w) == 0 && make_columns(out, m, w.sv.level, o->diagnostics) == 0 &&
+        if (values && alloc_sweep(&w) == 0 && make_columns(out, m, w.sv.level, o->diagnostics, w.want_forces,
+                                                   !w.fc.has_friction ? 0
+                                                   : w.friction_mode == MECH_FRICTION_OFF ? 0
+                                                   : w.friction_mode == MECH_FRICTION_BOTH ? 2
+                                                                                            : 1) == 0 &&
             (out->values = xcalloc((size_t)nvalues * (size_t)out->ncolumns + 1, sizeof(double))))
             rc = MECH_OK;
         else
@@ -732,6 +853,8 @@ int mech_solve(const mech_model *m, const mech_solve_options *o, mech_table *out
         if (rc != MECH_OK)
             break;
         solver_publish(&w.sv, q, w.qd, w.qdd);
+        if (w.want_forces && (rc = solve_forces(&w, q)) != MECH_OK)
+            break;
         fill_row(&w, row);
         w.st->iterations += w.row_iters;
         if (w.row_iters > w.st->max_iterations)
@@ -740,6 +863,7 @@ int mech_solve(const mech_model *m, const mech_solve_options *o, mech_table *out
     out->nrows = row;
     finish_stats(&w, row, t0);
     free(values);
+    forces_free(&w.fc);
     free_sweep(&w);
     return rc;
 }

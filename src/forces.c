@@ -1,0 +1,514 @@
+/* src/forces.c: joint reactions and the driver torque by Newton-Euler with
+ * D'Alembert inertia loads (docs/forces.md).
+ *
+ * Rows: for each moving link l, forces in x and y and the moment about its
+ * centre of mass G. Columns: Fx, Fy of each revolute joint; the normal force
+ * N (and, for a locked slider, the couple M) of each slider; the driver's
+ * torque or force. A joint's reaction acts on its receiving link (the later
+ * one in the file for a revolute, the sliding link for a slider) and its
+ * opposite on the other link.
+ *
+ * Friction: Coulomb moments mu r |F| in revolutes and forces mu |N| in
+ * sliders, opposing the relative motion, found by fixed-point iteration on
+ * the reaction magnitudes, starting from the frictionless solution. The
+ * sign of the relative speed is smoothed, v / sqrt(v^2 + eps^2), with eps a
+ * millionth of the driver speed, so that the friction load is continuous
+ * where the relative motion reverses.
+ *
+ * Power balance (independent of the force solution except for the driver):
+ *   P_driver + P_loads + P_gravity - P_friction = d/dt (kinetic energy). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "forces.h"
+
+enum { MAX_ENTRIES = 6, FRICTION_MAX_ITER = 100 };
+static const double FRICTION_TOL = 1e-12;
+
+/* ---- geometry of one step -------------------------------------------- */
+
+static int moving_row(int link) { return 3 * (link - 1); }  /* -3 .. for ground: unused */
+
+/* Receiving link (a) and the other (b) of joint j. */
+static void joint_links(const mech_joint *jt, int *a, int *b)
+{
+    if (jt->kind == MECH_JOINT_SLIDER) {
+        *a = jt->link[0];
+        *b = jt->link[1];
+    } else {
+        *a = jt->link[0] > jt->link[1] ? jt->link[0] : jt->link[1];
+        *b = jt->link[0] > jt->link[1] ? jt->link[1] : jt->link[0];
+    }
+}
+
+static void point_motion(const solver *sv, int l, int i, double *p, double *v, double *a)
+{
+    const mech_point *pt = &sv->m->links[l].points[i];
+    double r[2] = {pt->x, pt->y};
+    kin_on_link(&sv->ks, l, r, p, v, a);
+}
+
+/* Centre of mass of link l (the frame origin for a link without mass). */
+static void centre_motion(const solver *sv, int l, double *p, double *v, double *a)
+{
+    const mech_link *k = &sv->m->links[l];
+    double r[2] = {k->has_mass ? k->center[0] : 0.0, k->has_mass ? k->center[1] : 0.0};
+    kin_on_link(&sv->ks, l, r, p, v, a);
+}
+
+/* Contact point of joint j: the pin, or the sliding point. */
+static void contact(const solver *sv, const mech_joint *jt, double *p, double *v)
+{
+    double a[2];
+    point_motion(sv, jt->link[0], jt->point[0], p, v, a);
+}
+
+/* Guide direction u of a slider. */
+static void guide_dir(const solver *sv, const mech_joint *jt, double *u)
+{
+    double ang = sv->ks.th[jt->link[1]] + jt->angle;
+    u[0] = cos(ang);
+    u[1] = sin(ang);
+}
+
+static double cross(const double *r, const double *f) { return r[0] * f[1] - r[1] * f[0]; }
+
+/* ---- the columns ---------------------------------------------------- */
+
+typedef struct entry {
+    int row;
+    double val;
+} entry;
+
+static int push_force(entry *e, int n, const solver *sv, int l, const double *p, const double *f,
+                      double sign)
+{
+    if (l == 0)
+        return n;
+    double g[2], vg[2], ag[2];
+    centre_motion(sv, l, g, vg, ag);
+    double r[2] = {p[0] - g[0], p[1] - g[1]};
+    int row = moving_row(l);
+    e[n++] = (entry){row, sign * f[0]};
+    e[n++] = (entry){row + 1, sign * f[1]};
+    e[n++] = (entry){row + 2, sign * cross(r, f)};
+    return n;
+}
+
+static int push_moment(entry *e, int n, int l, double sign)
+{
+    if (l != 0)
+        e[n++] = (entry){moving_row(l) + 2, sign};
+    return n;
+}
+
+/* Entries of column c at the current position, sorted by row. */
+static int column_entries(const forces *fc, const solver *sv, int c, entry *e)
+{
+    const mech_model *m = fc->m;
+    int n = 0;
+    if (fc->joint[c] < 0 && m->driver.kind == MECH_DRIVE_ANGLE) {
+        n = push_moment(e, n, m->driver.index, 1.0);
+    } else {
+        const mech_joint *jt = &m->joints[fc->joint[c] >= 0 ? fc->joint[c] : m->driver.index];
+        int a, b;
+        joint_links(jt, &a, &b);
+        double p[2], v[2], u[2], dir[2];
+        contact(sv, jt, p, v);
+        switch (fc->kind[c]) {
+        case FC_FX: dir[0] = 1.0; dir[1] = 0.0; break;
+        case FC_FY: dir[0] = 0.0; dir[1] = 1.0; break;
+        case FC_NORMAL: guide_dir(sv, jt, u); dir[0] = -u[1]; dir[1] = u[0]; break;
+        case FC_DRIVE: guide_dir(sv, jt, dir); break;
+        case FC_MOMENT: dir[0] = dir[1] = 0.0; break;
+        }
+        if (fc->kind[c] == FC_MOMENT) {
+            n = push_moment(e, n, a, 1.0);
+            n = push_moment(e, n, b, -1.0);
+        } else {
+            n = push_force(e, n, sv, a, p, dir, 1.0);
+            n = push_force(e, n, sv, b, p, dir, -1.0);
+        }
+    }
+    for (int i = 1; i < n; i++)  /* insertion sort: at most 6 entries */
+        for (int k = i; k > 0 && e[k - 1].row > e[k].row; k--) {
+            entry t = e[k];
+            e[k] = e[k - 1];
+            e[k - 1] = t;
+        }
+    return n;
+}
+
+static int add_column(forces *fc, fc_kind kind, int joint)
+{
+    fc->kind[fc->ncols] = kind;
+    fc->joint[fc->ncols] = joint;
+    return fc->ncols++;
+}
+
+static void make_columns(forces *fc)
+{
+    const mech_model *m = fc->m;
+    for (int j = 0; j < m->njoints; j++) {
+        const mech_joint *jt = &m->joints[j];
+        fc->jcol[j] = fc->ncols;
+        if (jt->kind == MECH_JOINT_REVOLUTE) {
+            add_column(fc, FC_FX, j);
+            add_column(fc, FC_FY, j);
+        } else {
+            add_column(fc, FC_NORMAL, j);
+            if (jt->locked)
+                add_column(fc, FC_MOMENT, j);
+        }
+        if (jt->friction > 0.0)
+            fc->has_friction = 1;
+    }
+    add_column(fc, FC_DRIVE, -1);
+}
+
+static int build_pattern(forces *fc, const solver *sv)
+{
+    entry e[MAX_ENTRIES];
+    int cap = 0;
+    for (int c = 0; c < fc->ncols; c++)
+        cap += column_entries(fc, sv, c, e);
+    fc->Ai = xcalloc((size_t)cap + 1, sizeof *fc->Ai);
+    fc->Ax = xcalloc((size_t)cap + 1, sizeof *fc->Ax);
+    if (!fc->Ai || !fc->Ax)
+        return -1;
+    int at = 0;
+    for (int c = 0; c < fc->ncols; c++) {
+        fc->Ap[c] = at;
+        int n = column_entries(fc, sv, c, e);
+        for (int k = 0; k < n; k++)
+            fc->Ai[at++] = e[k].row;
+    }
+    fc->Ap[fc->ncols] = at;
+    fc->nnz = at;
+    return 0;
+}
+
+int forces_init(forces *fc, const solver *sv, int friction, mech_diag *d)
+{
+    const mech_model *m = sv->m;
+    memset(fc, 0, sizeof *fc);
+    fc->m = m;
+    fc->nrows = 3 * (m->nlinks - 1);
+    int maxcols = 2 * m->njoints + 1;
+    size_t nr = (size_t)fc->nrows + 1, nc = (size_t)maxcols + 1;
+    fc->kind = xcalloc(nc, sizeof *fc->kind);
+    fc->joint = xcalloc(nc, sizeof *fc->joint);
+    fc->jcol = xcalloc((size_t)m->njoints + 1, sizeof *fc->jcol);
+    fc->Ap = xcalloc(nc + 1, sizeof *fc->Ap);
+    fc->cscale = xcalloc(nc, sizeof *fc->cscale);
+    fc->b = xcalloc(nr + nc, sizeof *fc->b);
+    fc->y = xcalloc(nr + nc, sizeof *fc->y);
+    fc->y0 = xcalloc(nr + nc, sizeof *fc->y0);
+    fc->ynext = xcalloc(nr + nc, sizeof *fc->ynext);
+    fc->fric = xcalloc(nr, sizeof *fc->fric);
+    if (!fc->kind || !fc->joint || !fc->jcol || !fc->Ap || !fc->cscale || !fc->b || !fc->y ||
+        !fc->y0 || !fc->ynext || !fc->fric)
+        return diag_error(d, m->file, (mech_mark){0, 0}, "out of memory"), MECH_ENOMEM;
+    make_columns(fc);
+    fc->friction = friction && fc->has_friction;
+    if (fc->ncols != fc->nrows)
+        return diag_error(d, m->file, m->driver.mark,
+                          "the force analysis has %d unknown reactions for %d equilibrium "
+                          "equations: the mechanism is %s", fc->ncols, fc->nrows,
+                          fc->ncols > fc->nrows ? "over-constrained (reactions not unique)"
+                                                : "under-constrained"), MECH_EINPUT;
+    if (build_pattern(fc, sv) < 0)
+        return diag_error(d, m->file, (mech_mark){0, 0}, "out of memory"), MECH_ENOMEM;
+    double qd = fabs(m->driver.speed);
+    if (m->driver.kind == MECH_DRIVE_SLIDER)
+        qd /= sv->lref;
+    fc->speed_eps = 1e-6 * (qd > 0.0 ? qd : 1.0);
+    klu_defaults(&fc->common);
+    fc->common.scale = 0;
+    fc->common.tol = 0.1;
+    fc->sym = klu_analyze(fc->ncols, fc->Ap, fc->Ai, &fc->common);
+    if (!fc->sym)
+        return diag_error(d, m->file, m->driver.mark,
+                          "the force analysis is structurally singular: some reaction appears in "
+                          "no equilibrium equation that could determine it"), MECH_EINPUT;
+    return MECH_OK;
+}
+
+void forces_free(forces *fc)
+{
+    if (fc->num)
+        klu_free_numeric(&fc->num, &fc->common);
+    if (fc->sym)
+        klu_free_symbolic(&fc->sym, &fc->common);
+    void *blocks[] = {fc->kind, fc->joint, fc->jcol, fc->Ap, fc->Ai, fc->Ax, fc->b, fc->y,
+                      fc->y0, fc->ynext, fc->fric, fc->cscale};
+    for (size_t i = 0; i < sizeof blocks / sizeof blocks[0]; i++)
+        free(blocks[i]);
+    memset(fc, 0, sizeof *fc);
+}
+
+/* ---- the right-hand side --------------------------------------------- */
+
+/* An external force f at point p of link l: moves to the right-hand side. */
+static void load_force(double *rhs, const solver *sv, int l, const double *p, const double *f)
+{
+    if (l == 0)
+        return;
+    double g[2], vg[2], ag[2];
+    centre_motion(sv, l, g, vg, ag);
+    double r[2] = {p[0] - g[0], p[1] - g[1]};
+    int row = moving_row(l);
+    rhs[row] -= f[0];
+    rhs[row + 1] -= f[1];
+    rhs[row + 2] -= cross(r, f);
+}
+
+static void load_moment(double *rhs, int l, double t)
+{
+    if (l != 0)
+        rhs[moving_row(l) + 2] -= t;
+}
+
+/* Resultant of a load and its point of application (and that point's
+ * velocity, for the power balance). Uniform distributed loads act at the
+ * middle of their segment. */
+static void load_resultant(const solver *sv, const mech_load *ld, double *f, double *p, double *v)
+{
+    double a[2];
+    if (ld->kind == MECH_LOAD_FORCE) {
+        f[0] = ld->force[0];
+        f[1] = ld->force[1];
+        point_motion(sv, ld->link, ld->point[0], p, v, a);
+        return;
+    }
+    double p0[2], p1[2], v0[2], v1[2];
+    point_motion(sv, ld->link, ld->point[0], p0, v0, a);
+    point_motion(sv, ld->link, ld->point[1], p1, v1, a);
+    double w = ld->intensity * hypot(p1[0] - p0[0], p1[1] - p0[1]);
+    f[0] = w * cos(ld->direction);
+    f[1] = w * sin(ld->direction);
+    for (int k = 0; k < 2; k++) {
+        p[k] = 0.5 * (p0[k] + p1[k]);
+        v[k] = 0.5 * (v0[k] + v1[k]);
+    }
+}
+
+/* Inertia, gravity and external loads. */
+static void known_loads(const forces *fc, const solver *sv, double *rhs)
+{
+    const mech_model *m = fc->m;
+    for (int l = 1; l < m->nlinks; l++) {
+        const mech_link *k = &m->links[l];
+        int row = moving_row(l);
+        if (!k->has_mass) {
+            rhs[row] = rhs[row + 1] = rhs[row + 2] = 0.0;
+            continue;
+        }
+        double g[2], vg[2], ag[2];
+        centre_motion(sv, l, g, vg, ag);
+        rhs[row] = k->mass * (ag[0] - m->gravity[0]);
+        rhs[row + 1] = k->mass * (ag[1] - m->gravity[1]);
+        rhs[row + 2] = k->inertia * sv->ks.al[l];
+    }
+    for (int i = 0; i < m->nloads; i++) {
+        const mech_load *ld = &m->loads[i];
+        if (ld->kind == MECH_LOAD_TORQUE) {
+            load_moment(rhs, ld->link, ld->torque);
+            continue;
+        }
+        double f[2], p[2], v[2];
+        load_resultant(sv, ld, f, p, v);
+        load_force(rhs, sv, ld->link, p, f);
+    }
+}
+
+/* ---- friction ---------------------------------------------------------- */
+
+static double smooth_sign(double v, double eps) { return v / sqrt(v * v + eps * eps); }
+
+/* Relative speed of joint j: angular (revolute, receiving minus other link)
+ * or sliding (slider, along the guide). */
+static double relative_speed(const forces *fc, const solver *sv, int j)
+{
+    const mech_joint *jt = &fc->m->joints[j];
+    if (jt->kind == MECH_JOINT_SLIDER) {
+        int var = sv->tree.slide_var[j];
+        return var >= 0 ? sv->vel[var] : 0.0;
+    }
+    int a, b;
+    joint_links(jt, &a, &b);
+    return sv->ks.om[a] - sv->ks.om[b];
+}
+
+/* Friction loads for reactions y (into fc->fric) and the power they
+ * dissipate. */
+static double friction_loads(forces *fc, const solver *sv, const double *y)
+{
+    const mech_model *m = fc->m;
+    double power = 0.0;
+    memset(fc->fric, 0, (size_t)fc->nrows * sizeof *fc->fric);
+    for (int j = 0; j < m->njoints; j++) {
+        const mech_joint *jt = &m->joints[j];
+        if (!(jt->friction > 0.0))
+            continue;
+        int a, b, c = fc->jcol[j];
+        joint_links(jt, &a, &b);
+        double rel = relative_speed(fc, sv, j);
+        if (jt->kind == MECH_JOINT_REVOLUTE) {
+            double eps = fc->speed_eps;
+            double mf = jt->friction * jt->pin_radius * hypot(y[c], y[c + 1]) * smooth_sign(rel, eps);
+            load_moment(fc->fric, a, -mf);
+            load_moment(fc->fric, b, mf);
+            power += mf * rel;
+        } else {
+            double eps = fc->speed_eps * sv->lref, u[2], p[2], v[2];
+            double ff = jt->friction * fabs(y[c]) * smooth_sign(rel, eps);
+            guide_dir(sv, jt, u);
+            contact(sv, jt, p, v);
+            double fa[2] = {-ff * u[0], -ff * u[1]}, fb[2] = {ff * u[0], ff * u[1]};
+            load_force(fc->fric, sv, a, p, fa);
+            load_force(fc->fric, sv, b, p, fb);
+            power += ff * rel;
+        }
+    }
+    return power;
+}
+
+/* ---- solving ------------------------------------------------------------ */
+
+static int factor(forces *fc, const solver *sv)
+{
+    entry e[MAX_ENTRIES];
+    for (int c = 0; c < fc->ncols; c++) {
+        int n = column_entries(fc, sv, c, e), at = fc->Ap[c];
+        double big = 0.0;
+        for (int k = 0; k < n; k++)
+            big = fmax(big, fabs(e[k].val));
+        fc->cscale[c] = big > 0.0 ? 1.0 / big : 1.0;
+        for (int k = 0; k < n; k++)
+            fc->Ax[at + k] = e[k].val * fc->cscale[c];
+    }
+    if (!fc->num || !klu_refactor(fc->Ap, fc->Ai, fc->Ax, fc->sym, fc->num, &fc->common)) {
+        if (fc->num)
+            klu_free_numeric(&fc->num, &fc->common);
+        fc->num = klu_factor(fc->Ap, fc->Ai, fc->Ax, fc->sym, &fc->common);
+        if (!fc->num) {
+            fc->rcond = 0.0;
+            return -1;
+        }
+    }
+    if (!klu_condest(fc->Ap, fc->Ax, fc->sym, fc->num, &fc->common) || !(fc->common.condest > 0))
+        return -1;
+    fc->rcond = 1.0 / fc->common.condest;
+    return fc->rcond < 1e-13 ? -1 : 0;
+}
+
+static void solve_rhs(forces *fc, const double *rhs, double *y)
+{
+    memcpy(y, rhs, (size_t)fc->nrows * sizeof *y);
+    klu_solve(fc->sym, fc->num, fc->ncols, 1, y, &fc->common);
+    for (int c = 0; c < fc->ncols; c++)
+        y[c] *= fc->cscale[c];
+}
+
+/* P_driver + P_loads + P_gravity - P_friction - dT/dt, relative to the
+ * largest of those terms. */
+static double power_residual(const forces *fc, const solver *sv, double drive, double pfric)
+{
+    const mech_model *m = fc->m;
+    double pd = drive * m->driver.speed, kin = 0.0, ext = 0.0, scale = fabs(pd) + fabs(pfric);
+    for (int l = 1; l < m->nlinks; l++) {
+        const mech_link *k = &m->links[l];
+        if (!k->has_mass)
+            continue;
+        double g[2], vg[2], ag[2];
+        centre_motion(sv, l, g, vg, ag);
+        double dk = k->mass * (vg[0] * ag[0] + vg[1] * ag[1]) + k->inertia * sv->ks.om[l] * sv->ks.al[l];
+        double pg = k->mass * (m->gravity[0] * vg[0] + m->gravity[1] * vg[1]);
+        kin += dk;
+        ext += pg;
+        scale += fabs(k->mass * vg[0] * ag[0]) + fabs(k->mass * vg[1] * ag[1]) +
+                 fabs(k->inertia * sv->ks.om[l] * sv->ks.al[l]) + fabs(pg);
+    }
+    for (int i = 0; i < m->nloads; i++) {
+        const mech_load *ld = &m->loads[i];
+        double pw;
+        if (ld->kind == MECH_LOAD_TORQUE) {
+            pw = ld->torque * sv->ks.om[ld->link];
+        } else {
+            double f[2], p[2], v[2];
+            load_resultant(sv, ld, f, p, v);
+            pw = f[0] * v[0] + f[1] * v[1];
+        }
+        ext += pw;
+        scale += fabs(pw);
+    }
+    double r = pd + ext - pfric - kin;
+    return scale > 0.0 ? r / scale : 0.0;
+}
+
+int forces_solve(forces *fc, const solver *sv)
+{
+    int n = fc->nrows, drive = fc->ncols - 1;
+    known_loads(fc, sv, fc->b);
+    if (factor(fc, sv) < 0)
+        return -1;
+    solve_rhs(fc, fc->b, fc->y0);
+    fc->residual0 = power_residual(fc, sv, fc->y0[drive], 0.0);
+    memcpy(fc->y, fc->y0, (size_t)n * sizeof *fc->y);
+    fc->iterations = 0;
+    fc->friction_power = 0.0;
+    if (fc->friction) {
+        for (int it = 1;; it++) {
+            friction_loads(fc, sv, fc->y);
+            for (int r = 0; r < n; r++)
+                fc->fric[r] += fc->b[r];
+            solve_rhs(fc, fc->fric, fc->ynext);
+            double change = 0.0, big = 0.0;
+            for (int c = 0; c < n; c++) {
+                change = fmax(change, fabs(fc->ynext[c] - fc->y[c]));
+                big = fmax(big, fabs(fc->ynext[c]));
+            }
+            memcpy(fc->y, fc->ynext, (size_t)n * sizeof *fc->y);
+            fc->iterations = it;
+            if (change <= FRICTION_TOL * big) {
+                fc->friction_power = friction_loads(fc, sv, fc->y);
+                break;
+            }
+            if (it == FRICTION_MAX_ITER) {
+                fc->iterations = -1;
+                break;
+            }
+        }
+    }
+    fc->drive_power = fc->y[drive] * fc->m->driver.speed;
+    fc->residual = power_residual(fc, sv, fc->y[drive], fc->friction_power);
+    return fc->iterations < 0 ? -2 : 0;
+}
+
+void forces_joint(const forces *fc, const solver *sv, int j, int with_friction, double *fx,
+                  double *fy, double *n, double *mo)
+{
+    const double *y = with_friction ? fc->y : fc->y0;
+    const mech_joint *jt = &fc->m->joints[j];
+    int c = fc->jcol[j];
+    *n = *mo = 0.0;
+    if (jt->kind == MECH_JOINT_REVOLUTE) {
+        *fx = y[c];
+        *fy = y[c + 1];
+        return;
+    }
+    double u[2];
+    guide_dir(sv, jt, u);
+    *n = y[c];
+    *fx = -u[1] * y[c];
+    *fy = u[0] * y[c];
+    if (jt->locked)
+        *mo = y[c + 1];
+}
+
+double forces_drive(const forces *fc, int with_friction)
+{
+    return (with_friction ? fc->y : fc->y0)[fc->ncols - 1];
+}

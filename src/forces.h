@@ -1,0 +1,57 @@
+/* src/forces.h: kinetostatics (docs/forces.md). Newton-Euler equations of
+ * every moving link with D'Alembert inertia loads from the solved motion;
+ * unknowns are the joint reactions and the driver torque or force. The
+ * sparse pattern is fixed, so KLU analyses it once and refactors per step. */
+#ifndef MECH_FORCES_H
+#define MECH_FORCES_H
+
+#include "solve.h"
+
+/* What one column of the force system is. */
+typedef enum { FC_FX, FC_FY, FC_NORMAL, FC_MOMENT, FC_DRIVE } fc_kind;
+
+typedef struct forces {
+    const mech_model *m;
+    int friction;           /* 1: Coulomb friction of the joints is applied */
+    int has_friction;       /* some joint has a friction coefficient */
+    int nrows;              /* 3 per moving link */
+    int ncols;
+    fc_kind *kind;          /* [ncols] */
+    int *joint;             /* [ncols] joint of a reaction column (-1: the driver) */
+    int *jcol;              /* [njoints] first column of each joint */
+    int *Ap, *Ai;           /* [ncols+1], [nnz] */
+    double *Ax;             /* [nnz] */
+    int nnz;
+    double *b, *y, *y0;     /* [nrows] right-hand side; solution; frictionless solution */
+    double *ynext;          /* [nrows] friction iterate */
+    double *fric;           /* [nrows] friction loads moved to the right-hand side */
+    double *cscale;         /* [ncols] column equilibration */
+    klu_common common;
+    klu_symbolic *sym;
+    klu_numeric *num;
+    /* per step results */
+    int iterations;         /* friction fixed-point iterations */
+    double residual0;       /* power balance, frictionless, relative */
+    double residual;        /* power balance with friction (friction losses included) */
+    double friction_power;  /* W dissipated by joint friction */
+    double drive_power;     /* W supplied by the driver */
+    double rcond;
+    double speed_eps;       /* smoothing of sign(relative speed), rad/s */
+} forces;
+
+int forces_init(forces *fc, const solver *sv, int friction, mech_diag *d);
+void forces_free(forces *fc);
+
+/* Forces at the published position of sv (positions, velocities and
+ * accelerations of every link). Returns 0, or -1 when the force system is
+ * singular (redundant constraints): fc->rcond says how badly. */
+int forces_solve(forces *fc, const solver *sv);
+
+/* Reaction of joint j on the receiving link (docs/forces.md), ground frame:
+ * fx, fy and, for sliders, the normal force n and moment mo; from the
+ * friction solution (with_friction) or the frictionless one. */
+void forces_joint(const forces *fc, const solver *sv, int j, int with_friction, double *fx,
+                  double *fy, double *n, double *mo);
+double forces_drive(const forces *fc, int with_friction);
+
+#endif
