@@ -49,7 +49,7 @@ $(BUILD)/libmech.a: $(LIB_OBJ)
 $(BUILD)/mech: $(CMD_OBJ) $(BUILD)/libmech.a
 	$(CC) $(LDFLAGS) -o $@ $^ $(LDLIBS)
 
-$(BUILD)/tests/%.o: tests/unit/%.c $(HEADERS) | $(BUILD)/tests
+$(BUILD)/tests/%.o: tests/unit/%.c $(HEADERS) $(wildcard tests/unit/*.h) | $(BUILD)/tests
 	$(CC) $(CFLAGS) -Isrc -c $< -o $@
 
 $(BUILD)/unit-tests: $(TEST_OBJ) $(BUILD)/libmech.a

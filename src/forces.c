@@ -487,6 +487,37 @@ int forces_solve(forces *fc, const solver *sv)
     return fc->iterations < 0 ? -2 : 0;
 }
 
+/* The joints whose reactions are not determined at a singular position:
+ * large components of A^-1 b (inverse iteration) lie along the null space;
+ * when the factorisation itself failed, KLU's first singular column. */
+void forces_singular_joints(forces *fc, char *buf, size_t size)
+{
+    const mech_model *m = fc->m;
+    size_t at = 0;
+    buf[0] = '\0';
+    int ncols = fc->ncols, count = 0;
+    unsigned char *mark = xcalloc((size_t)m->njoints + 2, 1);
+    if (!mark)
+        return;
+    if (fc->num) {
+        for (int r = 0; r < fc->nrows; r++)
+            fc->ynext[r] = 1.0 + 0.1 * r;  /* a generic right-hand side */
+        solve_rhs(fc, fc->ynext, fc->ynext);
+        double big = vec_norm_inf(fc->ynext, ncols);
+        for (int c = 0; c < ncols; c++)
+            if (isfinite(big) && fabs(fc->ynext[c]) > 0.1 * big)
+                mark[fc->joint[c] >= 0 ? fc->joint[c] : m->njoints] = 1;
+    } else if (fc->common.singular_col >= 0 && fc->common.singular_col < ncols) {
+        int c = fc->common.singular_col;
+        mark[fc->joint[c] >= 0 ? fc->joint[c] : m->njoints] = 1;
+    }
+    for (int j = 0; j <= m->njoints && at < size; j++)
+        if (mark[j])
+            at += (size_t)snprintf(buf + at, size - at, "%s%s", count++ ? ", " : "",
+                                   j < m->njoints ? m->joints[j].name : "the driver");
+    free(mark);
+}
+
 void forces_joint(const forces *fc, const solver *sv, int j, int with_friction, double *fx,
                   double *fy, double *n, double *mo)
 {

@@ -53,5 +53,7 @@ int forces_solve(forces *fc, const solver *sv);
 void forces_joint(const forces *fc, const solver *sv, int j, int with_friction, double *fx,
                   double *fy, double *n, double *mo);
 double forces_drive(const forces *fc, int with_friction);
+/* After forces_solve returned -1: the names of the joints involved. */
+void forces_singular_joints(forces *fc, char *buf, size_t size);
 
 #endif

@@ -703,14 +703,17 @@ static void fill_row(sweep *w, int row)
 
 static int solve_forces(sweep *w, double q)
 {
-    char qb[64];
+    char qb[64], joints[400];
     int r = forces_solve(&w->fc, &w->sv);
-    if (r == -1)
+    if (r == -1) {
+        forces_singular_joints(&w->fc, joints, sizeof joints);
         return diag_error(w->d, w->m->file, w->m->driver.mark,
                           "the force system is singular at %s = %s (reciprocal condition %.2g): "
-                          "redundant constraints make the joint reactions not unique",
-                          driver_word(w->m), q_text(w->m, q, qb, sizeof qb), w->fc.rcond),
+                          "redundant constraints make the reactions of %s not unique",
+                          driver_word(w->m), q_text(w->m, q, qb, sizeof qb), w->fc.rcond,
+                          joints[0] ? joints : "some joints"),
                MECH_ESOLVE;
+    }
     if (r == -2)
         return diag_error(w->d, w->m->file, w->m->driver.mark,
                           "joint friction does not converge at %s = %s (fixed-point iteration, "
