@@ -9,6 +9,8 @@
 
 #include "mech.h"
 
+static const double PI = 3.14159265358979323846;
+
 static mech_model *load_text(const char *text)
 {
     mech_diag d;
@@ -151,6 +153,35 @@ Test(forces, slider_crank_virtual_work)
 
 /* ---- power balance of a loaded four-bar ------------------------------- */
 
+/* Substitute the frictionless reactions back into the coupler's Newton-Euler
+ * equations, computed here from the CSV alone: A's pin acts on the coupler
+ * (the later link), B's pin acts on the rocker, so -B on the coupler. */
+static void check_coupler_equilibrium(const mech_table *t)
+{
+    const double m = 0.3, I = 1e-4, g = -9.81, q = 100.0;  /* N/m, at -60 deg */
+    for (int r = 0; r < t->nrows; r++) {
+        double th = at(t, r, "coupler.angle"), w = at(t, r, "coupler.omega");
+        double al = at(t, r, "coupler.alpha"), c = cos(th), s = sin(th);
+        double Ax = at(t, r, "A.x"), Ay = at(t, r, "A.y"), Bx = at(t, r, "B.x"), By = at(t, r, "B.y");
+        double Px = at(t, r, "P.x"), Py = at(t, r, "P.y");
+        double rx = c * 0.030 - s * 0.005, ry = s * 0.030 + c * 0.005;  /* G - A */
+        double Gx = Ax + rx, Gy = Ay + ry;
+        double agx = at(t, r, "A.ax") - al * ry - w * w * rx;
+        double agy = at(t, r, "A.ay") + al * rx - w * w * ry;
+        double fAx = at(t, r, "A.Fx.nofriction"), fAy = at(t, r, "A.Fy.nofriction");
+        double fBx = -at(t, r, "B.Fx.nofriction"), fBy = -at(t, r, "B.Fy.nofriction");
+        double wl = q * 0.060, fdx = wl * cos(-PI / 3), fdy = wl * sin(-PI / 3);
+        double Mx = 0.5 * (Ax + Bx), My = 0.5 * (Ay + By);
+        double sx = fAx + fBx + 5 + fdx, sy = fAy + fBy - 20 + fdy + m * g;
+        double mom = (Ax - Gx) * fAy - (Ay - Gy) * fAx + (Bx - Gx) * fBy - (By - Gy) * fBx +
+                     (Px - Gx) * -20 - (Py - Gy) * 5 + (Mx - Gx) * fdy - (My - Gy) * fdx;
+        cr_assert(fabs(sx - m * agx) < 1e-10 * 100, "row %d: coupler x: %g vs %g", r, sx, m * agx);
+        cr_assert(fabs(sy - m * agy) < 1e-10 * 100, "row %d: coupler y: %g vs %g", r, sy, m * agy);
+        cr_assert(fabs(mom - I * al) < 1e-10 * 10, "row %d: coupler moment: %g vs %g", r, mom, I * al);
+    }
+}
+
+
 Test(forces, fourbar_power_balance)
 {
     mech_model *m = load_text(
@@ -184,6 +215,7 @@ Test(forces, fourbar_power_balance)
         cr_assert_leq(at(&t, r, "friction.iterations"), 30);
     }
     cr_assert_lt(worst, 1e-12, "power balance without friction: %g", worst);
+    check_coupler_equilibrium(&t);
     cr_assert_lt(worst_f, 1e-12, "power balance with friction: %g", worst_f);
     cr_assert_gt(loss, 0.0);
     /* friction changes the torque */
