@@ -1,5 +1,6 @@
 /* bench/bench_solve.c: time per driver step of mech_solve for each file at
- * three levels (positions; + velocities; + accelerations), with the Newton
+ * four levels (positions; + velocities; + accelerations; + forces, with the
+ * file's friction), with the Newton
  * iterations per step and the worst closure residual that time bought.
  * Median, min and max over repeated sweeps; set-up excluded. Not a test. */
 #include <stdio.h>
@@ -16,7 +17,8 @@ static int cmp(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-static void bench_level(const mech_model *m, const char *file, const char *label, int want)
+static void bench_level(const mech_model *m, const char *file, const char *label, int want,
+                        int forces)
 {
     double us[REPS];
     mech_solve_stats st = {0};
@@ -24,6 +26,7 @@ static void bench_level(const mech_model *m, const char *file, const char *label
         mech_solve_options o;
         mech_solve_options_default(&o);
         o.want = want;
+        o.forces = forces;
         mech_table t = {0};
         mech_diag d;
         mech_diag_init(&d);
@@ -61,9 +64,10 @@ int main(int argc, char **argv)
         }
         mech_diag_free(&d);
         const char *base = strrchr(argv[a], '/') ? strrchr(argv[a], '/') + 1 : argv[a];
-        bench_level(m, base, "pos", MECH_WANT_POSITION);
-        bench_level(m, base, "vel", MECH_WANT_POSITION | MECH_WANT_VELOCITY);
-        bench_level(m, base, "acc", MECH_WANT_ALL);
+        bench_level(m, base, "pos", MECH_WANT_POSITION, 0);
+        bench_level(m, base, "vel", MECH_WANT_POSITION | MECH_WANT_VELOCITY, 0);
+        bench_level(m, base, "acc", MECH_WANT_ALL, 0);
+        bench_level(m, base, "forces", MECH_WANT_ALL, 1);
         mech_model_free(&m);
     }
     return 0;

@@ -182,6 +182,15 @@ if run "mech solve dead centre" 1 "$MECH" solve tests/solve/dead-centre.yaml -o 
     [ -e "$tmp/dc.csv" ] && fail "a failed solve wrote an output file" || pass
 fi
 
+if run "mech solve --forces --friction both" 0 "$MECH" solve mechanisms/conveyor.yaml --friction both --stats -o "$tmp/cv.csv"; then
+    has_line "$tmp/cv.csv" '^q \[rad\],.*,O\.Fx \[N\],O\.Fy \[N\],O\.F \[N\],.*driver\.torque \[N\*m\],power\.residual \[-\],friction\.power \[W\],friction\.iterations \[-\],.*driver\.torque\.nofriction \[N\*m\],power\.residual\.nofriction \[-\]$' "--friction both header"
+    has_line "$tmp/err" 'power balance      worst relative residual' "--stats power balance"
+fi
+if run "mech solve --forces on a file without forces" 0 "$MECH" solve mechanisms/fourbar.yaml --forces --level positions -o "$tmp/fb4.csv"; then
+    has_line "$tmp/fb4.csv" 'A\.ax \[m/s^2\].*driver\.torque \[N\*m\]' "--forces implies accelerations"
+fi
+run "mech solve --friction bogus" 2 "$MECH" solve mechanisms/conveyor.yaml --friction bogus && pass
+
 for f in mechanisms/*.yaml; do
     run "mech solve $f" 0 "$MECH" solve "$f" -o "$tmp/all.csv" && pass
 done
