@@ -94,6 +94,28 @@ static void log_blocks(const solver *sv, const int *P, const int *Q, const int *
     }
 }
 
+/* Row-wise pattern of the Jacobian: columns of row r are rc[rp[r] .. rp[r+1]-1]. */
+static int transpose_pattern(const mech_system *s, int n, int **rp, int **rc)
+{
+    int nnz = s->Jp[n];
+    *rp = xcalloc((size_t)n + 1, sizeof **rp);
+    *rc = xcalloc((size_t)nnz + 1, sizeof **rc);
+    int *fill = xcalloc((size_t)n + 1, sizeof *fill);
+    if (!*rp || !*rc || !fill) {
+        free(fill);
+        return -1;
+    }
+    for (int p = 0; p < nnz; p++)
+        (*rp)[s->Ji[p] + 1]++;
+    for (int r = 0; r < n; r++)
+        (*rp)[r + 1] += (*rp)[r];
+    for (int c = 0; c < n; c++)
+        for (int p = s->Jp[c]; p < s->Jp[c + 1]; p++)
+            (*rc)[(*rp)[s->Ji[p]] + fill[s->Ji[p]]++] = c;
+    free(fill);
+    return 0;
+}
+
 /* Blocks to solve: those holding a needed unknown, then (the form is upper
  * block triangular, rows of block b only reach columns of blocks >= b)
  * every block reached from a block already chosen. */
@@ -104,35 +126,36 @@ static int choose_blocks(solver *sv, const unsigned char *need, unsigned char *r
     int n = sv->n, nmatch = 0;
     int *P = xcalloc((size_t)n, sizeof *P), *Q = xcalloc((size_t)n, sizeof *Q);
     int *R = xcalloc((size_t)n + 1, sizeof *R), *W = xcalloc(5 * (size_t)n, sizeof *W);
-    int *blk = xcalloc((size_t)n, sizeof *blk), *rowpos = xcalloc((size_t)n, sizeof *rowpos);
+    int *blk = xcalloc((size_t)n, sizeof *blk);
     unsigned char *solve_block = xcalloc((size_t)n + 1, 1);
-    int rc = -1;
-    if (!P || !Q || !R || !W || !blk || !rowpos || !solve_block)
+    int *rp = NULL, *rc = NULL, status = -1;
+    if (!P || !Q || !R || !W || !blk || !solve_block)
         goto done;
     double work;
     sv->nblocks = btf_order(n, s->Jp, s->Ji, 0.0, &work, P, Q, R, &nmatch, W);
     if (nmatch < n) {
-        rc = 1;  /* structurally singular: caller reports */
+        status = 1;  /* structurally singular: caller reports */
         goto done;
     }
     for (int b = 0; b < sv->nblocks; b++)
         for (int k = R[b]; k < R[b + 1]; k++) {
             blk[Q[k]] = b;       /* block of each unknown */
-            rowpos[P[k]] = b;    /* block of each equation */
         }
     for (int v = 0; v < n; v++)
         if (need[v])
             solve_block[blk[v]] = 1;
-    /* rows in block order: propagate from low blocks to the higher ones they reach */
+    /* rows in block order: propagate from low blocks to the higher ones they
+       reach, through the row-wise pattern (the transpose), in O(nnz) */
+    if (transpose_pattern(s, n, &rp, &rc) < 0)
+        goto done;
     for (int b = 0; b < sv->nblocks; b++) {
         if (!solve_block[b])
             continue;
-        for (int k = R[b]; k < R[b + 1]; k++)
+        for (int k = R[b]; k < R[b + 1]; k++) {
             row_on[P[k]] = 1;
-        for (int c = 0; c < n; c++)  /* columns touching this block's rows */
-            for (int p = s->Jp[c]; p < s->Jp[c + 1]; p++)
-                if (rowpos[s->Ji[p]] == b)
-                    solve_block[blk[c]] = 1;
+            for (int p = rp[P[k]]; p < rp[P[k] + 1]; p++)
+                solve_block[blk[rc[p]]] = 1;
+        }
     }
     sv->nblocks_solved = 0;
     for (int b = 0; b < sv->nblocks; b++)
@@ -143,16 +166,17 @@ static int choose_blocks(solver *sv, const unsigned char *need, unsigned char *r
         }
     if (sv->opt.log)
         log_blocks(sv, P, Q, R, solve_block, need);
-    rc = 0;
+    status = 0;
 done:
+    free(rp);
+    free(rc);
     free(P);
     free(Q);
     free(R);
     free(W);
     free(blk);
-    free(rowpos);
     free(solve_block);
-    return rc;
+    return status;
 }
 
 /* Pattern of the solved rows and columns, and the tape computing them. */

@@ -41,6 +41,7 @@ typedef struct sweep {
     double *xpred;             /* [ns] */
     /* row 0, kept to look for the assembly range after a failure */
     double q0, *x0, *xq0, *xqq0;
+    double *guess;             /* [n] the file's guess of each unknown, NAN if none */
     int row_iters;             /* Newton iterations spent on the current row */
     double fail_q;             /* where the last rejected attempt was */
     step_status fail_status;
@@ -360,38 +361,45 @@ static unsigned next_random(unsigned *state)
     return *state >> 8;
 }
 
+/* The file's guess for each unknown (NAN: none), gathered once: looking
+ * the guesses up per unknown would cost O(unknowns x guesses). */
+static int gather_guesses(sweep *w)
+{
+    solver *sv = &w->sv;
+    const mech_model *m = w->m;
+    w->guess = xcalloc((size_t)sv->n + 1, sizeof *w->guess);
+    if (!w->guess)
+        return -1;
+    for (int i = 0; i < sv->n; i++)
+        w->guess[i] = NAN;
+    for (int g = 0; g < m->nguesses; g++) {
+        const mech_guess *gs = &m->guesses[g];
+        int var = gs->is_slider ? sv->sys->joint_var[gs->index] : sv->sys->link_var[gs->index];
+        if (var >= 0 && var < sv->n)
+            w->guess[var] = gs->value;
+    }
+    return 0;
+}
+
 /* Starting values: the file's guesses; the others 0 on the first attempt,
  * scattered over a turn (angles) or +-2 lref (slides) later. */
 static void start_values(sweep *w, int attempt, unsigned *rng)
 {
     solver *sv = &w->sv;
-    const mech_model *m = w->m;
     for (int i = 0; i < sv->ns; i++) {
         int c = sv->col[i];
         double u = attempt ? (double)(next_random(rng) & 0xffff) / 65536.0 - 0.5 : 0.0;
         sv->x[i] = sv->sys->unk_kind[c] == UNK_ANGLE ? 2.0 * PI * u : 4.0 * sv->lref * u;
-        for (int g = 0; g < m->nguesses; g++) {
-            const mech_guess *gs = &m->guesses[g];
-            int var = gs->is_slider ? sv->sys->joint_var[gs->index] : sv->sys->link_var[gs->index];
-            if (var == c)
-                sv->x[i] = gs->value;
-        }
+        if (!isnan(w->guess[c]))
+            sv->x[i] = w->guess[c];
     }
 }
 
 static int has_unguessed(const sweep *w)
 {
-    const solver *sv = &w->sv;
-    for (int i = 0; i < sv->ns; i++) {
-        int c = sv->col[i], found = 0;
-        for (int g = 0; g < w->m->nguesses; g++) {
-            const mech_guess *gs = &w->m->guesses[g];
-            found |= (gs->is_slider ? sv->sys->joint_var[gs->index]
-                                    : sv->sys->link_var[gs->index]) == c;
-        }
-        if (!found)
+    for (int i = 0; i < w->sv.ns; i++)
+        if (isnan(w->guess[w->sv.col[i]]))
             return 1;
-    }
     return 0;
 }
 
@@ -747,12 +755,13 @@ static int alloc_sweep(sweep *w)
     for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
         if (!(*arrays[i] = xcalloc(ns, sizeof(double))))
             return -1;
-    return 0;
+    return gather_guesses(w);
 }
 
 static void free_sweep(sweep *w)
 {
-    double *arrays[] = {w->xc, w->xqc, w->xqqc, w->xq_prev, w->xpred, w->x0, w->xq0, w->xqq0};
+    double *arrays[] = {w->xc, w->xqc, w->xqqc, w->xq_prev, w->xpred, w->x0, w->xq0, w->xqq0,
+                        w->guess};
     for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
         free(arrays[i]);
     solver_free(&w->sv);
