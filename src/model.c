@@ -174,7 +174,9 @@ static void note_triangle(const mech_model *m, const link_pair *e[3], mech_diag 
 /* Rigid sub-structures that explain an over-constraint: two links joined by
  * joints that leave them no relative motion, or three links pinned to each
  * other in a triangle. Notes name at most three; O(J log J + J^1.5). */
-static void report_rigid(const mech_model *m, mech_diag *d)
+/* Notes on rigid sub-structures (links joined twice, pinned triangles);
+ * returns how many were found (d may be NULL: count only). */
+static int report_rigid(const mech_model *m, mech_diag *d)
 {
     int nj = m->njoints, np = 0, found = 0;
     link_pair *pairs = xcalloc((size_t)nj, sizeof *pairs);
@@ -263,6 +265,7 @@ done:
     free(out);
     free(mark);
     free(via);
+    return found;
 }
 
 static void count_joints(const mech_model *m, mech_summary *s, int *njoints_of)
@@ -318,13 +321,22 @@ int mech_check(const mech_model *m, mech_summary *s, mech_diag *d)
                        "must be fixed (add a link or a joint%s)", gruebler, abs_excess,
                        abs_excess == 1 ? "" : "s",
                        s->npin_in_slot ? ", or lock a slider's rotation" : "");
-        } else {
+        } else if (report_rigid(m, NULL) > 0) {
             diag_error(d, m->file, at,
                        "over-constrained: the mechanism has %s; its joints remove %d degree%s "
                        "of freedom too many (remove a joint%s)", gruebler, abs_excess,
                        abs_excess == 1 ? "" : "s",
                        s->nprismatic ? ", or free a slider's rotation" : "");
             report_rigid(m, d);
+        } else {
+            /* no rigid sub-structure: the extra constraints may be redundant
+               (a parallelogram's extra link); the solver finds out */
+            diag_warning(d, m->file, at,
+                         "over-constrained by the count: the mechanism has %s; %d constraint%s "
+                         "too many, so it moves only if %s redundant (as a parallelogram's "
+                         "extra link is): the solver checks this at every position",
+                         gruebler, abs_excess, abs_excess == 1 ? "" : "s",
+                         abs_excess == 1 ? "it is" : "they are");
         }
     }
     if (!m->has_driver)

@@ -65,7 +65,7 @@ static void print_text(const mech_system *s, FILE *out)
         fputc('\n', out);
     }
     fprintf(out, "\nposition equations f(x, q) = 0:\n");
-    for (int r = 0; r < n; r++) {
+    for (int r = 0; r < s->m; r++) {
         fprintf(out, "  f%d = ", r + 1);
         expr_print(&s->ex, s->f[r], &nm, 0, out);
         fprintf(out, "    [loop %d, %c]\n", r / 2 + 1, r % 2 ? 'y' : 'x');
@@ -78,13 +78,13 @@ static void print_text(const mech_system *s, FILE *out)
             fputc('\n', out);
         }
     fprintf(out, "\nvelocity: J x' = b\n");
-    for (int r = 0; r < n; r++) {
+    for (int r = 0; r < s->m; r++) {
         fprintf(out, "  b%d = ", r + 1);
         expr_print(&s->ex, s->vel[r], &nm, 0, out);
         fputc('\n', out);
     }
     fprintf(out, "\nacceleration: J x'' = c\n");
-    for (int r = 0; r < n; r++) {
+    for (int r = 0; r < s->m; r++) {
         fprintf(out, "  c%d = ", r + 1);
         expr_print(&s->ex, s->acc[r], &nm, 0, out);
         fputc('\n', out);
@@ -109,10 +109,10 @@ static void latex_rows(const mech_system *s, const char *lhs, const ex *rows, co
 {
     expr_names nm = names_of(s);
     fputs("\\begin{align*}\n", out);
-    for (int r = 0; r < s->n; r++) {
+    for (int r = 0; r < s->m; r++) {
         fprintf(out, "%s_{%d} &= ", lhs, r + 1);
         expr_print(&s->ex, rows[r], &nm, 1, out);
-        fprintf(out, "%s%s\n", rhs, r + 1 < s->n ? " \\\\" : "");
+        fprintf(out, "%s%s\n", rhs, r + 1 < s->m ? " \\\\" : "");
     }
     fputs("\\end{align*}\n", out);
 }

@@ -179,20 +179,77 @@ done:
     return status;
 }
 
+/* The KLU matrix of the least-squares mode: [I J; J^T 0] of size nr + ns,
+ * whose solution [r; dx] minimises |J dx - f| (Gauss-Newton). jpos[2k] and
+ * jpos[2k+1] are where J entry k goes (in J and in J^T). */
+static int augmented_pattern(solver *sv, const int *Jp, const int *Ji)
+{
+    int nr = sv->nr, ns = sv->ns, nnz = sv->nnzJ, N = nr + ns;
+    int *rp = xcalloc((size_t)nr + 1, sizeof *rp), *fill = xcalloc((size_t)nr + 1, sizeof *fill);
+    int *rk = xcalloc((size_t)nnz + 1, sizeof *rk);   /* J entries by row */
+    int *colof = xcalloc((size_t)nnz + 1, sizeof *colof);
+    sv->Ap = xcalloc((size_t)N + 1, sizeof *sv->Ap);
+    sv->Ai = xcalloc((size_t)(nr + 2 * nnz) + 1, sizeof *sv->Ai);
+    sv->Ax = xcalloc((size_t)(nr + 2 * nnz) + 1, sizeof *sv->Ax);
+    sv->jpos = xcalloc(2 * (size_t)nnz + 1, sizeof *sv->jpos);
+    int rc = -1;
+    if (!rp || !fill || !rk || !colof || !sv->Ap || !sv->Ai || !sv->Ax || !sv->jpos)
+        goto done;
+    for (int c = 0; c < ns; c++)
+        for (int k = Jp[c]; k < Jp[c + 1]; k++)
+            colof[k] = c;
+    for (int k = 0; k < nnz; k++)
+        rp[Ji[k] + 1]++;
+    for (int r = 0; r < nr; r++)
+        rp[r + 1] += rp[r];
+    for (int c = 0; c < ns; c++)
+        for (int k = Jp[c]; k < Jp[c + 1]; k++)
+            rk[rp[Ji[k]] + fill[Ji[k]]++] = k;
+    int at = 0;
+    for (int r = 0; r < nr; r++) {  /* columns of the residual block: I, then J^T */
+        sv->Ap[r] = at;
+        sv->Ai[at] = r;
+        sv->Ax[at++] = 1.0;
+        for (int p = rp[r]; p < rp[r + 1]; p++) {
+            int k = rk[p];
+            sv->jpos[2 * k + 1] = at;
+            sv->Ai[at++] = nr + colof[k];
+        }
+    }
+    for (int c = 0; c < ns; c++) {  /* columns of the unknowns: J */
+        sv->Ap[nr + c] = at;
+        for (int k = Jp[c]; k < Jp[c + 1]; k++) {
+            sv->jpos[2 * k] = at;
+            sv->Ai[at++] = Ji[k];
+        }
+    }
+    sv->Ap[N] = at;
+    sv->N = N;
+    sv->nnz = at;
+    rc = 0;
+done:
+    free(rp);
+    free(fill);
+    free(rk);
+    free(colof);
+    return rc;
+}
+
 /* Pattern of the solved rows and columns, and the tape computing them. */
 static int compile_subset(solver *sv, const unsigned char *row_on, const unsigned char *col_on)
 {
     const mech_system *s = sv->sys;
-    int n = sv->n, ns = 0, nr = 0;
-    int *rowmap = xcalloc((size_t)n + 1, sizeof *rowmap);
+    int n = sv->n, rows = s->m, ns = 0, nr = 0;
+    int *rowmap = xcalloc((size_t)rows + 1, sizeof *rowmap);
     sv->col = xcalloc((size_t)n + 1, sizeof *sv->col);
-    sv->row = xcalloc((size_t)n + 1, sizeof *sv->row);
-    sv->Ap = xcalloc((size_t)n + 1, sizeof *sv->Ap);
-    if (!rowmap || !sv->col || !sv->row || !sv->Ap) {
+    sv->row = xcalloc((size_t)rows + 1, sizeof *sv->row);
+    int *Jp = xcalloc((size_t)n + 1, sizeof *Jp);
+    if (!rowmap || !sv->col || !sv->row || !Jp) {
         free(rowmap);
+        free(Jp);
         return -1;
     }
-    for (int r = 0; r < n; r++) {
+    for (int r = 0; r < rows; r++) {
         rowmap[r] = row_on[r] ? nr : -1;
         if (row_on[r])
             sv->row[nr++] = r;
@@ -201,38 +258,56 @@ static int compile_subset(solver *sv, const unsigned char *row_on, const unsigne
         if (col_on[c])
             sv->col[ns++] = c;
     sv->ns = ns;
+    sv->nr = nr;
     int nnz = 0;
     for (int k = 0; k < ns; k++)
         for (int p = s->Jp[sv->col[k]]; p < s->Jp[sv->col[k] + 1]; p++)
             nnz += rowmap[s->Ji[p]] >= 0;
-    sv->nnz = nnz;
-    sv->Ai = xcalloc((size_t)nnz + 1, sizeof *sv->Ai);
-    sv->Ax = xcalloc((size_t)nnz + 1, sizeof *sv->Ax);
-    sv->proot = xcalloc((size_t)(ns + nnz) + 1, sizeof *sv->proot);
-    sv->vroot = xcalloc((size_t)ns + 1, sizeof *sv->vroot);
-    sv->aroot = xcalloc((size_t)ns + 1, sizeof *sv->aroot);
-    if (!sv->Ai || !sv->Ax || !sv->proot || !sv->vroot || !sv->aroot) {
+    sv->nnzJ = nnz;
+    int *Ji = xcalloc((size_t)nnz + 1, sizeof *Ji);
+    sv->Jv = xcalloc((size_t)nnz + 1, sizeof *sv->Jv);
+    sv->proot = xcalloc((size_t)(nr + nnz) + 1, sizeof *sv->proot);
+    sv->vroot = xcalloc((size_t)nr + 1, sizeof *sv->vroot);
+    sv->aroot = xcalloc((size_t)nr + 1, sizeof *sv->aroot);
+    if (!Ji || !sv->Jv || !sv->proot || !sv->vroot || !sv->aroot) {
         free(rowmap);
+        free(Jp);
+        free(Ji);
         return -1;
     }
-    for (int i = 0; i < ns; i++) {
+    for (int i = 0; i < nr; i++) {
         sv->proot[i] = s->f[sv->row[i]];
         sv->vroot[i] = s->vel[sv->row[i]];
         sv->aroot[i] = s->acc[sv->row[i]];
     }
     int at = 0;
     for (int k = 0; k < ns; k++) {
-        sv->Ap[k] = at;
+        Jp[k] = at;
         for (int p = s->Jp[sv->col[k]]; p < s->Jp[sv->col[k] + 1]; p++)
             if (rowmap[s->Ji[p]] >= 0) {
-                sv->Ai[at] = rowmap[s->Ji[p]];
-                sv->proot[ns + at++] = s->Jx[p];
+                Ji[at] = rowmap[s->Ji[p]];
+                sv->proot[nr + at++] = s->Jx[p];
             }
     }
-    sv->Ap[ns] = at;
+    Jp[ns] = at;
     free(rowmap);
+    int rc = 0;
+    if (sv->aug) {
+        rc = augmented_pattern(sv, Jp, Ji);
+        free(Jp);
+        free(Ji);
+    } else {  /* square: KLU factors J itself */
+        sv->Ap = Jp;
+        sv->Ai = Ji;
+        sv->Ax = xcalloc((size_t)nnz + 1, sizeof *sv->Ax);
+        sv->N = ns;
+        sv->nnz = nnz;
+        rc = sv->Ax ? 0 : -1;
+    }
+    if (rc < 0)
+        return -1;
     const ex *roots[NPHASES] = {sv->proot, sv->vroot, sv->aroot};
-    int nroots[NPHASES] = {ns + nnz, ns, ns};
+    int nroots[NPHASES] = {nr + nnz, nr, nr};
     int nph = sv->level & MECH_WANT_ACCELERATION ? 3 : sv->level & MECH_WANT_VELOCITY ? 2 : 1;
     /* dx/dq feeds the predictor even for positions only: keep the velocity phase */
     if (nph < 2)
@@ -242,21 +317,22 @@ static int compile_subset(solver *sv, const unsigned char *row_on, const unsigne
 
 static int alloc_state(solver *sv)
 {
-    size_t n1 = (size_t)sv->n + 1, ns = (size_t)sv->ns + 1;
+    size_t n1 = (size_t)sv->n + 1, ns = (size_t)sv->ns + 1, nr = (size_t)sv->nr + 1;
     sv->pos = xcalloc(n1, sizeof *sv->pos);
     sv->vel = xcalloc(n1, sizeof *sv->vel);
     sv->acc = xcalloc(n1, sizeof *sv->acc);
     sv->x = xcalloc(ns, sizeof *sv->x);
     sv->xq = xcalloc(ns, sizeof *sv->xq);
     sv->xqq = xcalloc(ns, sizeof *sv->xqq);
-    sv->f = xcalloc(ns, sizeof *sv->f);
+    sv->f = xcalloc(nr, sizeof *sv->f);
     sv->dx = xcalloc(ns, sizeof *sv->dx);
     sv->xt = xcalloc(ns, sizeof *sv->xt);
-    sv->ft = xcalloc(ns, sizeof *sv->ft);
+    sv->ft = xcalloc(nr, sizeof *sv->ft);
+    sv->rhs = xcalloc(nr + ns, sizeof *sv->rhs);
     sv->cscale = xcalloc(ns, sizeof *sv->cscale);
     sv->label = xcalloc(512, 1);
     if (!sv->pos || !sv->vel || !sv->acc || !sv->x || !sv->xq || !sv->xqq || !sv->f ||
-        !sv->dx || !sv->xt || !sv->ft || !sv->cscale || !sv->label)
+        !sv->dx || !sv->xt || !sv->ft || !sv->rhs || !sv->cscale || !sv->label)
         return -1;
     return kin_state_init(&sv->ks, sv->m) == MECH_OK ? 0 : -1;
 }
@@ -288,12 +364,27 @@ int solver_init(solver *sv, const mech_model *m, const mech_solve_options *o, me
     sv->ftol = sv->opt.tol * sv->lref;
     if (kin_tree_build(&sv->tree, sv->sys) != MECH_OK)
         return diag_error(d, m->file, (mech_mark){0, 0}, "out of memory"), MECH_ENOMEM;
-    unsigned char *need = xcalloc((size_t)sv->n + 1, 1), *row_on = xcalloc((size_t)sv->n + 1, 1),
+    int rows = sv->sys->m;
+    unsigned char *need = xcalloc((size_t)sv->n + 1, 1), *row_on = xcalloc((size_t)rows + 1, 1),
                   *col_on = xcalloc((size_t)sv->n + 1, 1);
     rc = MECH_ENOMEM;
+    sv->aug = rows > sv->n;
     if (need && row_on && col_on) {
         needed_unknowns(sv, need);
-        int b = choose_blocks(sv, need, row_on, col_on);
+        int b = 0;
+        if (sv->aug) {  /* redundant equations: no square block form; solve everything */
+            memset(row_on, 1, (size_t)rows);
+            memset(col_on, 1, (size_t)sv->n);
+            for (int l = 1; l < m->nlinks; l++)
+                sv->tree.active[l] = 1;
+            sv->nblocks = sv->nblocks_solved = 1;
+            if (sv->opt.log)
+                fprintf(sv->opt.log, "blocks: %d equations for %d unknowns (redundant "
+                        "constraints): all solved together, in the least-squares sense\n",
+                        rows, sv->n);
+        } else {
+            b = choose_blocks(sv, need, row_on, col_on);
+        }
         if (b > 0)
             rc = diag_error(d, m->file, m->driver.mark,
                             "the loop equations are structurally singular: some unknown "
@@ -318,7 +409,7 @@ int solver_init(solver *sv, const mech_model *m, const mech_solve_options *o, me
        candidate (KLU's default 1e-3 allows growth of 1e3 per column). */
     sv->common.tol = 0.1;
     if (sv->ns > 0) {
-        sv->sym = klu_analyze(sv->ns, sv->Ap, sv->Ai, &sv->common);
+        sv->sym = klu_analyze(sv->N, sv->Ap, sv->Ai, &sv->common);
         if (!sv->sym)
             return diag_error(d, m->file, (mech_mark){0, 0}, "KLU cannot analyse the Jacobian "
                               "(status %d)", sv->common.status), MECH_ENOMEM;
@@ -336,7 +427,8 @@ void solver_free(solver *sv)
     kin_state_free(&sv->ks);
     kin_tree_free(&sv->tree);
     mech_system_free(&sv->sys);
-    void *blocks[] = {sv->col, sv->row, sv->Ap, sv->Ai, sv->Ax, sv->cscale, sv->proot,
+    void *blocks[] = {sv->col, sv->row, sv->Ap, sv->Ai, sv->Ax, sv->Jv, sv->jpos, sv->rhs,
+                      sv->cscale, sv->proot,
                       sv->vroot, sv->aroot, sv->pos, sv->vel, sv->acc, sv->x, sv->xq,
                       sv->xqq, sv->f, sv->dx, sv->xt, sv->ft, sv->label};
     for (size_t i = 0; i < sizeof blocks / sizeof blocks[0]; i++)
@@ -375,25 +467,36 @@ static double evaluate(solver *sv, const double *x, double q, double *f)
         tape_set_var(t, sv->col[i], x[i]);
     tape_set_var(t, SYS_VAR_Q(sv->n), q);
     tape_run(t, PHASE_POSITION);
-    for (int i = 0; i < sv->ns; i++)
+    for (int i = 0; i < sv->nr; i++)
         f[i] = tape_value(t, sv->proot[i]);
-    for (int k = 0; k < sv->nnz; k++)
-        sv->Ax[k] = tape_value(t, sv->proot[sv->ns + k]);
+    for (int k = 0; k < sv->nnzJ; k++)
+        sv->Jv[k] = tape_value(t, sv->proot[sv->nr + k]);
     sv->factored = 0;
-    return vec_norm_inf(f, sv->ns);
+    return vec_norm_inf(f, sv->nr);
 }
 
-/* Scale every column to unit largest entry (J C), remembering C. */
+/* Scale every column of J to unit largest entry (J C), remembering C, and
+ * place the values in the KLU matrix (J itself, or [I JC; (JC)^T 0]). */
 static void equilibrate(solver *sv)
 {
-    for (int k = 0; k < sv->ns; k++) {
+    const int *Jp = sv->aug ? sv->Ap + sv->nr : sv->Ap;  /* column starts of J's entries */
+    int k = 0;
+    for (int c = 0; c < sv->ns; c++) {
+        int len = sv->aug ? Jp[c + 1] - Jp[c] : sv->Ap[c + 1] - sv->Ap[c];
         double big = 0.0;
-        for (int p = sv->Ap[k]; p < sv->Ap[k + 1]; p++)
-            big = fmax(big, fabs(sv->Ax[p]));
-        double c = big > 0.0 && isfinite(big) ? 1.0 / big : 1.0;
-        sv->cscale[k] = c;
-        for (int p = sv->Ap[k]; p < sv->Ap[k + 1]; p++)
-            sv->Ax[p] *= c;
+        for (int p = 0; p < len; p++)
+            big = fmax(big, fabs(sv->Jv[k + p]));
+        double cs = big > 0.0 && isfinite(big) ? 1.0 / big : 1.0;
+        sv->cscale[c] = cs;
+        for (int p = 0; p < len; p++, k++) {
+            double v = sv->Jv[k] * cs;
+            if (sv->aug) {
+                sv->Ax[sv->jpos[2 * k]] = v;
+                sv->Ax[sv->jpos[2 * k + 1]] = v;
+            } else {
+                sv->Ax[k] = v;
+            }
+        }
     }
 }
 
@@ -444,12 +547,19 @@ static double condition(solver *sv)
     return sv->rcond;
 }
 
-/* Solve J y = b in place (b := dx), undoing the column scaling. */
-static void solve_in_place(solver *sv, double *b)
+/* dx from J dx = b (b has nr entries, dx ns): with the factors of J, or in
+ * the least-squares sense through [I J; J^T 0] [r; y] = [b; 0]; the column
+ * scaling is undone. */
+static void linear_solve(solver *sv, const double *b, double *dx)
 {
-    klu_solve(sv->sym, sv->num, sv->ns, 1, b, &sv->common);
+    double *w = sv->rhs;
+    memcpy(w, b, (size_t)sv->nr * sizeof *w);
+    for (int i = sv->nr; i < sv->N; i++)
+        w[i] = 0.0;
+    klu_solve(sv->sym, sv->num, sv->N, 1, w, &sv->common);
+    const double *y = sv->aug ? w + sv->nr : w;
     for (int i = 0; i < sv->ns; i++)
-        b[i] *= sv->cscale[i];
+        dx[i] = y[i] * sv->cscale[i];
 }
 
 step_status solver_newton(solver *sv, double q)
@@ -469,8 +579,7 @@ step_status solver_newton(solver *sv, double q)
             return STEP_NO_ASSEMBLY;
         if (factor(sv) < 0)
             return STEP_SINGULAR;
-        memcpy(sv->dx, sv->f, (size_t)ns * sizeof *sv->dx);
-        solve_in_place(sv, sv->dx);
+        linear_solve(sv, sv->f, sv->dx);
         double step = solver_step_size(sv, sv->dx);
         /* converged: residual small, and the step too, or no longer shrinking
            (the rounding floor of an ill-conditioned position) */
@@ -494,7 +603,7 @@ step_status solver_newton(solver *sv, double q)
             lambda *= 0.5;
         }
         memcpy(sv->x, sv->xt, (size_t)ns * sizeof *sv->x);
-        memcpy(sv->f, sv->ft, (size_t)ns * sizeof *sv->f);
+        memcpy(sv->f, sv->ft, (size_t)sv->nr * sizeof *sv->f);
         r = rt;
         prev_step = lambda == 1.0 ? step : INFINITY;
         sv->iters = it + 1;
@@ -509,18 +618,18 @@ int solver_rates(solver *sv)
     /* geometric rates (qdot = 1, qddot = 0); solver_publish scales them */
     tape_set_var(t, SYS_VAR_QDOT(sv->n), 1.0);
     tape_run(t, PHASE_VELOCITY);
-    for (int i = 0; i < sv->ns; i++)
-        sv->xq[i] = tape_value(t, sv->vroot[i]);
-    solve_in_place(sv, sv->xq);
+    for (int i = 0; i < sv->nr; i++)
+        sv->ft[i] = tape_value(t, sv->vroot[i]);
+    linear_solve(sv, sv->ft, sv->xq);
     if (!(sv->level & MECH_WANT_ACCELERATION))
         return 0;
     for (int i = 0; i < sv->ns; i++)
         tape_set_var(t, SYS_VAR_XDOT(sv->n, sv->col[i]), sv->xq[i]);
     tape_set_var(t, SYS_VAR_QDDOT(sv->n), 0.0);
     tape_run(t, PHASE_ACCELERATION);
-    for (int i = 0; i < sv->ns; i++)
-        sv->xqq[i] = tape_value(t, sv->aroot[i]);
-    solve_in_place(sv, sv->xqq);
+    for (int i = 0; i < sv->nr; i++)
+        sv->ft[i] = tape_value(t, sv->aroot[i]);
+    linear_solve(sv, sv->ft, sv->xqq);
     return 0;
 }
 

@@ -29,12 +29,19 @@ typedef struct solver {
     /* the solved subset: blocks of the block triangular form that outputs need */
     int n;                     /* all unknowns */
     int ns;                    /* unknowns solved */
+    int nr;                    /* equations solved: ns, or more with redundant ones */
+    int aug;                   /* 1: least squares ([I J; J^T 0]), redundant constraints */
     int *col;                  /* [ns] unknown of each solved column */
-    int *row;                  /* [ns] equation of each solved row */
+    int *row;                  /* [nr] equation of each solved row */
     int nblocks, nblocks_solved;
-    int *Ap, *Ai;              /* [ns+1], [nnz] pattern of the solved Jacobian */
+    int N;                     /* order of the KLU matrix: ns, or nr + ns */
+    int *Ap, *Ai;              /* [N+1], [nnz] pattern of the KLU matrix */
     double *Ax;                /* [nnz] values, columns equilibrated */
     int nnz;
+    double *Jv;                /* [nnzJ] the Jacobian's values, in J's CSC order */
+    int nnzJ;
+    int *jpos;                 /* [2 nnzJ] least squares: where each J value goes in Ax */
+    double *rhs;               /* [N] solve work */
     double *cscale;            /* [ns] column scaling of the last factorisation */
     tape tp;                   /* evaluator of the solved rows only */
     ex *proot, *vroot, *aroot; /* roots of the three phases */
@@ -50,7 +57,8 @@ typedef struct solver {
     double *pos, *vel, *acc;   /* [n+1] variable values (n = driver), SI */
     double *x;                 /* [ns] current solved unknowns */
     double *xq, *xqq;          /* [ns] dx/dq and d2x/dq2 at x */
-    double *f, *dx, *xt, *ft;  /* [ns] work */
+    double *f, *ft;            /* [nr] residuals */
+    double *dx, *xt;           /* [ns] work */
     double resid;              /* |f|inf at x */
     int iters;                 /* Newton iterations of the last solve */
     int stats_factor, stats_refactor;

@@ -113,7 +113,7 @@ static int worst_loop(const solver *sv)
 {
     int worst = 0;
     double big = -1.0;
-    for (int i = 0; i < sv->ns; i++)
+    for (int i = 0; i < sv->nr; i++)
         if (fabs(sv->f[i]) > big) {
             big = fabs(sv->f[i]);
             worst = sv->row[i] / 2;
@@ -127,7 +127,7 @@ static int worst_loop(const solver *sv)
 static int dense_null(const solver *sv, double *right, double *left)
 {
     int n = sv->ns;
-    if (n == 0 || n > 300)
+    if (n == 0 || n > 300 || sv->aug)  /* the least-squares matrix is not J */
         return -1;
     double *a = xcalloc((size_t)n * (size_t)n, sizeof *a);
     int *pr = xcalloc((size_t)n, sizeof *pr), *pc = xcalloc((size_t)n, sizeof *pc);
@@ -236,6 +236,57 @@ static void report_singular(sweep *w, double q)
                what);
 }
 
+/* With redundant constraints (more loop equations than unknowns), say which
+ * equations are implied by the others at the first position: modified
+ * Gram-Schmidt over the rows of J, in order; a row left with less than 1e-8
+ * of its length is redundant. Small systems only (dense). */
+static void report_redundant(sweep *w, double q)
+{
+    solver *sv = &w->sv;
+    int nr = sv->nr, ns = sv->ns;
+    if (!sv->aug || nr > 400)
+        return;
+    double *a = xcalloc((size_t)nr * (size_t)ns + 1, sizeof *a);
+    if (!a)
+        return;
+    for (int c = 0, k = 0; c < ns; c++)
+        for (int p = sv->Ap[nr + c]; p < sv->Ap[nr + c + 1]; p++, k++)
+            a[(size_t)sv->Ai[p] * ns + c] = sv->Jv[k];
+    char list[600] = "", lb[256], qb[64];
+    size_t at = 0;
+    int count = 0;
+    for (int i = 0; i < nr; i++) {
+        double *ri = a + (size_t)i * ns, len0 = 0.0, len = 0.0;
+        for (int c = 0; c < ns; c++)
+            len0 += ri[c] * ri[c];
+        for (int j = 0; j < i; j++) {
+            double *rj = a + (size_t)j * ns, dot = 0.0, nj = 0.0;
+            for (int c = 0; c < ns; c++)
+                dot += ri[c] * rj[c], nj += rj[c] * rj[c];
+            if (nj > 0.0)
+                for (int c = 0; c < ns; c++)
+                    ri[c] -= dot / nj * rj[c];
+        }
+        for (int c = 0; c < ns; c++)
+            len += ri[c] * ri[c];
+        if (len <= 1e-16 * len0) {
+            for (int c = 0; c < ns; c++)
+                ri[c] = 0.0;
+            if (at < sizeof list)
+                at += (size_t)snprintf(list + at, sizeof list - at, "%s%s equation of %s",
+                                       count++ ? ", " : "", sv->row[i] % 2 ? "y" : "x",
+                                       loop_label(sv, sv->row[i] / 2, lb, sizeof lb));
+        }
+    }
+    free(a);
+    diag_warning(w->d, w->m->file, w->m->driver.mark,
+                 "redundant constraints: at %s = %s the %d loop equations have rank %d; "
+                 "implied by the others: the %s; the mechanism moves because "
+                 "they are consistent, and it is solved in the least-squares sense (joint "
+                 "reactions are not unique)", driver_word(w->m),
+                 q_text(w->m, q, qb, sizeof qb), nr, nr - count, count ? list : "(none found)");
+}
+
 /* ---- continuation ----------------------------------------------------- */
 
 static void predict(sweep *w, double qn)
@@ -341,7 +392,7 @@ static step_status advance(sweep *w, double q, double hmin)
             continue;
         }
         if (w->fail_status == STEP_OK) {
-            w->fail_resid = vec_norm_inf(w->sv.f, w->sv.ns);
+            w->fail_resid = vec_norm_inf(w->sv.f, w->sv.nr);
             w->fail_loop = worst_loop(&w->sv);
         }
         w->fail_q = qn;
@@ -431,6 +482,7 @@ static int start(sweep *w, double q)
         w->qc = q;
         accept(w, q);
         w->have_prev = 0;
+        report_redundant(w, q);
         return MECH_OK;
     }
     if (branch >= 0) {

@@ -255,15 +255,15 @@ static int build_residual(mech_system *s, mech_diag *d)
 
 static int build_jacobian(mech_system *s, int *vars)
 {
-    int n = s->n, cap = 4 * n + 16, nnz = 0;
+    int n = s->n, rows = s->m, cap = 4 * rows + 16, nnz = 0;
     expr_ctx *c = &s->ex;
     int *ti = xcalloc((size_t)cap, sizeof *ti), *tj = xcalloc((size_t)cap, sizeof *tj);
     ex *tx = xcalloc((size_t)cap, sizeof *tx);
-    s->fq = xcalloc((size_t)n, sizeof *s->fq);
+    s->fq = xcalloc((size_t)rows + 1, sizeof *s->fq);
     s->Jp = xcalloc((size_t)n + 1, sizeof *s->Jp);
     if (!ti || !tj || !tx || !s->fq || !s->Jp)
         goto oom;
-    for (int r = 0; r < n; r++) {
+    for (int r = 0; r < rows; r++) {
         int nv = expr_vars(c, s->f[r], vars, SYS_NVARS(n));
         s->fq[r] = c->zero;
         for (int k = 0; k < nv; k++) {
@@ -291,9 +291,9 @@ static int build_jacobian(mech_system *s, int *vars)
         }
     }
     /* triplets (row-major, rows ascending) -> compressed columns */
-    s->Ji = xcalloc((size_t)nnz, sizeof *s->Ji);
-    s->Jx = xcalloc((size_t)nnz, sizeof *s->Jx);
-    int *fill = xcalloc((size_t)n, sizeof *fill);
+    s->Ji = xcalloc((size_t)nnz + 1, sizeof *s->Ji);
+    s->Jx = xcalloc((size_t)nnz + 1, sizeof *s->Jx);
+    int *fill = xcalloc((size_t)n + 1, sizeof *fill);
     if (!s->Ji || !s->Jx || !fill) {
         free(fill);
         goto oom;
@@ -323,33 +323,33 @@ oom:
 /* vel = -f_q qdot; acc = -(d/dt of (J xdot + f_q qdot) without the xddot term). */
 static int build_rates(mech_system *s, int *vars)
 {
-    int n = s->n;
+    int n = s->n, rows = s->m;
     expr_ctx *c = &s->ex;
     ex qdot = expr_var(c, SYS_VAR_QDOT(n)), qddot = expr_var(c, SYS_VAR_QDDOT(n));
-    s->vel = xcalloc((size_t)n, sizeof *s->vel);
-    s->acc = xcalloc((size_t)n, sizeof *s->acc);
+    s->vel = xcalloc((size_t)rows + 1, sizeof *s->vel);
+    s->acc = xcalloc((size_t)rows + 1, sizeof *s->acc);
     ex *row = xcalloc((size_t)n + 2, sizeof *row);     /* terms of one row */
-    int *rowlen = xcalloc((size_t)n, sizeof *rowlen);
+    int *rowlen = xcalloc((size_t)rows + 1, sizeof *rowlen);
     if (!s->vel || !s->acc || !row || !rowlen) {
         free(row);
         free(rowlen);
         return -1;
     }
     /* v_r = sum_j J_rj xdot_j + f_q,r qdot, gathered row by row from the CSC */
-    ex *v = xcalloc((size_t)n, sizeof *v);
+    ex *v = xcalloc((size_t)rows + 1, sizeof *v);
     if (!v) {
         free(row);
         free(rowlen);
         return -1;
     }
-    for (int r = 0; r < n; r++)
+    for (int r = 0; r < rows; r++)
         v[r] = c->zero;
     for (int j = 0; j < n; j++)
         for (int k = s->Jp[j]; k < s->Jp[j + 1]; k++) {
             int r = s->Ji[k];
             v[r] = expr_add(c, v[r], expr_mul(c, s->Jx[k], expr_var(c, SYS_VAR_XDOT(n, j))));
         }
-    for (int r = 0; r < n; r++) {
+    for (int r = 0; r < rows; r++) {
         s->vel[r] = expr_neg(c, expr_mul(c, s->fq[r], qdot));
         ex vr = expr_add(c, v[r], expr_mul(c, s->fq[r], qdot));
         int nv = expr_vars(c, vr, vars, SYS_NVARS(n)), nt = 0;
@@ -375,20 +375,20 @@ static int build_rates(mech_system *s, int *vars)
 
 static int compile(mech_system *s)
 {
-    int n = s->n;
+    int n = s->n, rows = s->m;
     const ex *roots[NPHASES];
     int nroots[NPHASES];
-    ex *pos = xcalloc((size_t)(n + s->nnz), sizeof *pos);
+    ex *pos = xcalloc((size_t)(rows + s->nnz) + 1, sizeof *pos);
     if (!pos)
         return -1;
-    memcpy(pos, s->f, (size_t)n * sizeof *pos);
-    memcpy(pos + n, s->Jx, (size_t)s->nnz * sizeof *pos);
+    memcpy(pos, s->f, (size_t)rows * sizeof *pos);
+    memcpy(pos + rows, s->Jx, (size_t)s->nnz * sizeof *pos);
     roots[PHASE_POSITION] = pos;
-    nroots[PHASE_POSITION] = n + s->nnz;
+    nroots[PHASE_POSITION] = rows + s->nnz;
     roots[PHASE_VELOCITY] = s->vel;
-    nroots[PHASE_VELOCITY] = n;
+    nroots[PHASE_VELOCITY] = rows;
     roots[PHASE_ACCELERATION] = s->acc;
-    nroots[PHASE_ACCELERATION] = n;
+    nroots[PHASE_ACCELERATION] = rows;
     int rc = tape_compile(&s->tp, &s->ex, SYS_NVARS(n), NPHASES, roots, nroots);
     free(pos);
     return rc;
@@ -445,11 +445,13 @@ int mech_system_new(const mech_model *m, mech_system **out, mech_diag *d)
         goto fail;
     if ((rc = loops_build(m, &s->loops, d)) != MECH_OK)
         goto fail;
-    if (2 * s->loops.nloops != s->n) {
+    s->m = 2 * s->loops.nloops;
+    /* more equations than unknowns: redundant constraints, which the solver
+       treats in the least-squares sense and checks for consistency */
+    if (s->m < s->n) {
         rc = diag_error(d, m->file, m->driver.mark,
-                        "%d unknowns but %d loop equations (%d loops): the mechanism is %s",
-                        s->n, 2 * s->loops.nloops, s->loops.nloops,
-                        s->n > 2 * s->loops.nloops ? "under-constrained" : "over-constrained");
+                        "%d unknowns but %d loop equations (%d loops): the mechanism is "
+                        "under-constrained", s->n, s->m, s->loops.nloops);
         goto fail;
     }
     rc = MECH_ENOMEM;
@@ -481,7 +483,7 @@ void sys_eval_position(mech_system *s, const double *x, double q, double *f, dou
         tape_set_var(t, i, x[i]);
     tape_set_var(t, SYS_VAR_Q(s->n), q);
     tape_run(t, PHASE_POSITION);
-    for (int r = 0; r < s->n; r++)
+    for (int r = 0; r < s->m; r++)
         f[r] = tape_value(t, s->f[r]);
     if (Jx)
         for (int k = 0; k < s->nnz; k++)
@@ -493,7 +495,7 @@ void sys_eval_velocity_rhs(mech_system *s, double qdot, double *rhs)
     tape *t = &s->tp;
     tape_set_var(t, SYS_VAR_QDOT(s->n), qdot);
     tape_run(t, PHASE_VELOCITY);
-    for (int r = 0; r < s->n; r++)
+    for (int r = 0; r < s->m; r++)
         rhs[r] = tape_value(t, s->vel[r]);
 }
 
@@ -505,6 +507,6 @@ void sys_eval_accel_rhs(mech_system *s, const double *xdot, double qdot, double 
     tape_set_var(t, SYS_VAR_QDOT(s->n), qdot);
     tape_set_var(t, SYS_VAR_QDDOT(s->n), qddot);
     tape_run(t, PHASE_ACCELERATION);
-    for (int r = 0; r < s->n; r++)
+    for (int r = 0; r < s->m; r++)
         rhs[r] = tape_value(t, s->acc[r]);
 }

@@ -38,7 +38,9 @@ typedef enum { UNK_ANGLE, UNK_SLIDE } unknown_kind;
 
 struct mech_system {
     const mech_model *model;   /* borrowed; must outlive the system */
-    int n;                     /* unknowns (= equations) */
+    int n;                     /* unknowns */
+    int m;                     /* equations, 2 per loop: n, or more with redundant
+                                  constraints (solved in the least-squares sense) */
     unknown_kind *unk_kind;    /* [n] */
     int *unk_index;            /* [n] link index (ANGLE) or joint index (SLIDE) */
     int *link_var;             /* [nlinks] unknown of the link's angle, or -1 */
@@ -49,14 +51,14 @@ struct mech_system {
     char **latex;              /* [SYS_NVARS(n)] LaTeX names */
     loop_set loops;
     expr_ctx ex;
-    ex *f;                     /* [n] residual rows; row 2k, 2k+1 = loop k, x and y */
-    int *Jp;                   /* [n+1] column pointers of the Jacobian df/dx (CSC) */
+    ex *f;                     /* [m] residual rows; row 2k, 2k+1 = loop k, x and y */
+    int *Jp;                   /* [n+1] column pointers of the m x n Jacobian df/dx (CSC) */
     int *Ji;                   /* [nnz] row indices, ascending within a column */
     ex *Jx;                    /* [nnz] nonzero expressions */
     int nnz;
-    ex *fq;                    /* [n] df/dq */
-    ex *vel;                   /* [n] velocity right-hand side  -df/dq qdot */
-    ex *acc;                   /* [n] acceleration right-hand side */
+    ex *fq;                    /* [m] df/dq */
+    ex *vel;                   /* [m] velocity right-hand side  -df/dq qdot */
+    ex *acc;                   /* [m] acceleration right-hand side */
     tape tp;                   /* compiled evaluator */
 };
 
