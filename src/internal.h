@@ -92,6 +92,8 @@ typedef struct expr_env {
     const unit_defaults *units;
     const expr_param *params;
     int nparams;
+    const name_map *param_index; /* name -> index into params, or NULL (linear search):
+                                    a file may define many parameters */
 } expr_env;
 int quantity_eval(const char *text, quantity want, const expr_env *env,
                   double *value, char *err, size_t errsize, size_t *err_pos);
@@ -111,6 +113,9 @@ struct ynode {
     ynode **items;     /* SEQ: [n] items; MAP: [2n] key, value pairs */
     size_t n;          /* SEQ: items; MAP: pairs */
     size_t nraw;       /* items stored (2n for a MAP) */
+    const ynode *dup_of; /* SCALAR key of a MAP: the first key of that mapping with the
+                            same text when this one repeats it, else NULL (found once,
+                            in linear time, so large mappings are not quadratic) */
 };
 
 typedef struct yaml_limits {

@@ -32,10 +32,17 @@
 
 enum {
     MAX_NAME = 64,            /* bytes in a name */
-    MAX_LINKS = 1000000,
+    MAX_LINKS = 1000000,      /* links with the ground: 999 999 moving */
     MAX_POINTS_PER_LINK = 10000,
-    MAX_STEPS = 1000000,      /* driver positions in one sweep */
-    MAX_LIST = 4000000        /* items in any other list */
+    MAX_GROUND_POINTS = 1000000, /* the ground holds every fixed pivot: a chain of
+                                    100 000 four-bars has 100 001 */
+    MAX_STEPS = 1000000,      /* driver intervals in one sweep (docs/limits.md) */
+    MAX_PARAMS = 100000,
+    MAX_LOADS = 1000000,
+    MAX_LOOPS = 1000,         /* listed loops: for the papers' mechanisms; larger ones */
+    MAX_LOOP_POINTS = 1000,   /* leave 'loops' out (found automatically, linear time) */
+    MAX_LIST = 4000000,       /* items in any other list */
+    MAX_SUGGEST = 1000        /* names searched for a "did you mean" */
 };
 
 typedef struct loader {
@@ -54,6 +61,11 @@ typedef struct loader {
     int links_bad;        /* 'links' missing or unreadable: names of links are not known */
     int points_bad;       /* some link's points unreadable: names of points are not known */
     name_map bad_params;  /* parameters whose definition failed (keys borrowed from the tree) */
+    name_map param_map;   /* parameter name -> index into params (keys borrowed) */
+    int *carrier_start;   /* [npoint_names + 1] after the links: the links carrying point id */
+    int *carrier_link;    /* are carrier_link[carrier_start[id] .. carrier_start[id + 1] - 1], */
+    int *carrier_point;   /* ascending, with the point's index in each (carrier_point) */
+    int carrier_ids;      /* point ids indexed (0: no index, search the links) */
 } loader;
 
 static int find_point(const loader *ld, const char *name) { return name_map_get(&ld->point_map, name); }
@@ -61,6 +73,35 @@ static int find_link(const loader *ld, const char *name) { return name_map_get(&
 static int find_joint(const loader *ld, const char *name) { return name_map_get(&ld->joint_map, name); }
 
 #define COUNT(a) (sizeof(a) / sizeof((a)[0]))
+
+/* The links carrying point `id`: carrier_link[*first .. *end - 1]; empty
+ * without the index. Joints and loads name points of links; looking them up
+ * here keeps a file with 10^6 ground points and many joints linear. */
+static void carriers_of(const loader *ld, int id, int *first, int *end)
+{
+    *first = *end = 0;
+    if (id >= 0 && id < ld->carrier_ids) {
+        *first = ld->carrier_start[id];
+        *end = ld->carrier_start[id + 1];
+    }
+}
+
+/* Index of point `id` in link `li`, or -1 (binary search among the carriers). */
+static int point_in_link(const loader *ld, int li, int id)
+{
+    if (ld->carrier_ids == 0)
+        return model_point_in_link(&ld->m->links[li], id);
+    int lo, end;
+    carriers_of(ld, id, &lo, &end);
+    for (int hi = end; lo < hi;) {
+        int mid = lo + (hi - lo) / 2;
+        if (ld->carrier_link[mid] < li)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo < end && ld->carrier_link[lo] == li ? ld->carrier_point[lo] : -1;
+}
 
 static int err(loader *ld, const ynode *n, const char *fmt, ...) MECH_PRINTF(3, 4);
 static int err(loader *ld, const ynode *n, const char *fmt, ...)
@@ -107,18 +148,13 @@ static int check_map(loader *ld, const ynode *map, const char *const *allowed, s
                 err(ld, k, "a key in %s must be a plain name", where);
             continue;
         }
-        for (size_t j = 0; j < i; j++) {
-            const ynode *o = map->items[2 * j];
-            if (o->kind == YNODE_SCALAR && strcmp(o->text, k->text) == 0) {
-                if (noun)
-                    err(ld, k, "duplicate %s '%s'%s%s (first given at line %d)", noun, k->text,
-                        where ? " in " : "", where ? where : "", o->mark.line);
-                else
-                    err(ld, k, "duplicate key '%s' in %s (first given at line %d)", k->text,
-                        where, o->mark.line);
-                break;
-            }
-        }
+        const ynode *o = k->dup_of;  /* found by yamltree.c */
+        if (o && noun)
+            err(ld, k, "duplicate %s '%s'%s%s (first given at line %d)", noun, k->text,
+                where ? " in " : "", where ? where : "", o->mark.line);
+        else if (o)
+            err(ld, k, "duplicate key '%s' in %s (first given at line %d)", k->text, where,
+                o->mark.line);
         if (!allowed || is_allowed(k->text, allowed, nallowed))
             continue;
         const char *near = nearest_name(k->text, allowed, nallowed);
@@ -262,7 +298,16 @@ static int get_count(loader *ld, const ynode *n, const char *what, long lo, long
     errno = 0;
     long v = strtol(n->text, &end, 10);
     if (end == n->text || *end != '\0' || errno) {
-        err(ld, n, "%s must be a whole number, not '%s'", what, n->text);
+        /* a whole number too big for a long, or written 1e12: out of range, not
+         * "not a whole number" */
+        double x = strtod(n->text, &end);
+        int whole = end != n->text && *end == '\0' && (isinf(x) || x == floor(x)) && !isnan(x);
+        if (whole && (x < (double)lo || x > (double)hi))
+            err(ld, n, "%s must be between %ld and %ld, not %s", what, lo, hi, n->text);
+        else if (whole)
+            err(ld, n, "%s must be written with digits only, not '%s'", what, n->text);
+        else
+            err(ld, n, "%s must be a whole number, not '%s'", what, n->text);
         return 0;
     }
     if (v < lo || v > hi) {
@@ -303,12 +348,22 @@ static int get_vec2(loader *ld, const ynode *n, quantity q, const char *what, do
     return get_quantity(ld, n->items[1], q, what, &out[1]) && ok;
 }
 
+/* Past the cap on errors, a message is only counted: do not spend time on it. */
+static int errors_full(const loader *ld)
+{
+    return ld->d->nerrors >= (ld->d->max_errors ? ld->d->max_errors : 100);
+}
+
 /* Report a name that is not among the candidates: say the nearest one, or
  * list them all when there are few (`kinds` is the plural of `kind`). */
 static void err_unknown(loader *ld, const ynode *n, const char *kind, const char *kinds,
                         const char *name, const char *const *cands, size_t ncands)
 {
-    const char *near = nearest_name(name, cands, ncands);
+    /* Suggestions cost an edit distance per candidate: not among 10^5 links,
+     * nor for messages past the cap, which are only counted */
+    if (errors_full(ld))
+        return (void)err(ld, n, "unknown %s '%s'", kind, name);
+    const char *near = ncands <= MAX_SUGGEST ? nearest_name(name, cands, ncands) : NULL;
     if (near)
         return (void)err(ld, n, "unknown %s '%s' (did you mean '%s'?)", kind, name, near);
     if (ncands == 0)
@@ -331,6 +386,8 @@ static int find_link_or_report(loader *ld, const ynode *n, const char *what)
     int li = find_link(ld, name);
     if (li >= 0 || ld->links_bad)
         return li;
+    if (errors_full(ld))
+        return err(ld, n, "unknown link"), -1;
     const char **names = xcalloc((size_t)ld->m->nlinks, sizeof *names);
     for (int i = 0; names && i < ld->m->nlinks; i++)
         names[i] = ld->m->links[i].name;
@@ -408,6 +465,8 @@ static void load_parameters(loader *ld, const ynode *map)
 {
     if (!check_map(ld, map, NULL, 0, "'parameters'", "parameter"))
         return;
+    if (map->n > MAX_PARAMS)
+        return (void)err(ld, map, "too many parameters (%zu; at most %d)", map->n, MAX_PARAMS);
     mech_model *m = ld->m;
     m->params = xcalloc(map->n, sizeof *m->params);
     ld->params = xcalloc(map->n, sizeof *ld->params);
@@ -426,7 +485,7 @@ static void load_parameters(loader *ld, const ynode *map)
                        "name", name, taken, name);
             continue;
         }
-        if (ymap_get(map, name) != v)
+        if (k->dup_of)
             continue; /* duplicate key, already reported */
         if (!want_kind(ld, v, YNODE_SCALAR, "a parameter value"))
             continue;
@@ -444,12 +503,19 @@ static void load_parameters(loader *ld, const ynode *map)
         }
         mech_param *mp = &m->params[m->nparams];
         mp->name = xstrdup(name);
+        if (!mp->name || name_map_put(&ld->param_map, mp->name, m->nparams) < 0) {
+            free(mp->name);
+            mp->name = NULL;
+            err(ld, k, "out of memory");
+            continue;
+        }
         mp->value = p.value;
         mp->mark = k->mark;
         p.name = mp->name;
         ld->params[m->nparams++] = p;
         ld->env.nparams = m->nparams;
         ld->env.params = ld->params;
+        ld->env.param_index = &ld->param_map;
     }
 }
 
@@ -477,9 +543,21 @@ static int intern_point(loader *ld, const char *name)
     return m->npoint_names++;
 }
 
+/* The index of point `name` among the points of `l` read so far, or -1;
+ * `index` (name -> index, or NULL) keeps a link of 10^6 points linear. */
+static int point_of_link(const mech_link *l, const name_map *index, const char *name)
+{
+    if (index)
+        return name_map_get(index, name);
+    for (int i = 0; i < l->npoints; i++)
+        if (l->points[i].name && strcmp(l->points[i].name, name) == 0)
+            return i;
+    return -1;
+}
+
 /* A point: [x, y] or {length, angle, from}. `l` holds the points read so far. */
-static int load_point_coords(loader *ld, const mech_link *l, const ynode *v, const char *what,
-                             double *x, double *y)
+static int load_point_coords(loader *ld, const mech_link *l, const name_map *index,
+                             const ynode *v, const char *what, double *x, double *y)
 {
     if (v->kind == YNODE_SEQ) {
         double xy[2];
@@ -506,14 +584,12 @@ static int load_point_coords(loader *ld, const mech_link *l, const ynode *v, con
     ok = get_quantity(ld, ang, Q_ANGLE, what, &a) && ok;
     if (from) {
         const char *fname = get_name(ld, from, "'from'");
-        int found = 0;
-        for (int i = 0; fname && i < l->npoints; i++)
-            if (strcmp(l->points[i].name, fname) == 0) {
-                x0 = l->points[i].x;
-                y0 = l->points[i].y;
-                found = 1;
-            }
-        if (fname && !found) {
+        int i = fname ? point_of_link(l, index, fname) : -1;
+        if (i >= 0) {
+            x0 = l->points[i].x;
+            y0 = l->points[i].y;
+        }
+        if (fname && i < 0) {
             err(ld, from, "'from: %s' must name a point listed earlier in link '%s'", fname,
                 l->name);
             ok = 0;
@@ -541,8 +617,9 @@ static int load_points(loader *ld, mech_link *l, const ynode *map)
     }
     size_t errors = ld->d->nerrors;
     check_map(ld, map, NULL, 0, where, "point");
-    if (map->n > MAX_POINTS_PER_LINK) {
-        err(ld, map, "link '%s' has %zu points; at most %d", l->name, map->n, MAX_POINTS_PER_LINK);
+    int max = l->is_ground ? MAX_GROUND_POINTS : MAX_POINTS_PER_LINK;
+    if (map->n > (size_t)max) {
+        err(ld, map, "link '%s' has %zu points; at most %d", l->name, map->n, max);
         return 0;
     }
     l->points = xcalloc(map->n, sizeof *l->points);
@@ -550,23 +627,29 @@ static int load_points(loader *ld, mech_link *l, const ynode *map)
         err(ld, map, "out of memory");
         return 0;
     }
+    name_map index = {0};  /* point name -> index, for 'from' */
     for (size_t i = 0; i < map->n; i++) {
         const ynode *k = map->items[2 * i], *v = map->items[2 * i + 1];
         const char *name = get_name(ld, k, "point name");
         if (!name)
             ld->points_bad = 1;
-        if (!name || ymap_get(map, name) != v)
+        if (!name || k->dup_of)
             continue;  /* invalid or duplicate (reported) */
         char what[128];
         snprintf(what, sizeof what, "point '%s' of link '%s'", name, l->name);
         mech_point *p = &l->points[l->npoints];
-        if (!load_point_coords(ld, l, v, what, &p->x, &p->y))
+        if (!load_point_coords(ld, l, &index, v, what, &p->x, &p->y))
             p->x = p->y = 0;
         p->name = xstrdup(name);
         p->id = intern_point(ld, name);
         p->mark = k->mark;
+        if (!p->name || p->id < 0 || name_map_put(&index, p->name, l->npoints) < 0) {
+            err(ld, k, "out of memory");
+            break;
+        }
         l->npoints++;
     }
+    name_map_free(&index);
     return ld->d->nerrors == errors;
 }
 
@@ -612,7 +695,7 @@ static void load_mass(loader *ld, mech_link *l, const ynode *map)
             err(ld, center, "%s: '%s' is not a point of link '%s'", what, center->text, l->name);
             return;
         }
-    } else if (!load_point_coords(ld, l, center, what, &l->center[0], &l->center[1])) {
+    } else if (!load_point_coords(ld, l, NULL, center, what, &l->center[0], &l->center[1])) {
         return;
     }
     snprintf(what, sizeof what, "inertia of link '%s'", l->name);
@@ -684,13 +767,13 @@ static void load_links(loader *ld, const ynode *map)
         return;
     }
     if (map->n >= MAX_LINKS) {
-        err(ld, map, "too many links (%zu; at most %d)", map->n, MAX_LINKS);
+        err(ld, map, "too many links (%zu; at most %d moving links)", map->n, MAX_LINKS - 1);
         return;
     }
     for (size_t i = 0; i < map->n; i++) {
         const ynode *k = map->items[2 * i], *v = map->items[2 * i + 1];
         const char *name = get_name(ld, k, "link name");
-        if (!name || ymap_get(map, name) != v)
+        if (!name || k->dup_of)
             continue;
         if (strcmp(name, "ground") == 0) {
             err(ld, k, "'ground' is the fixed link: give its points under the top-level 'ground' key");
@@ -781,7 +864,7 @@ static void load_revolute(loader *ld, const ynode *map)
             int li = find_link_or_report(ld, ln->items[i], "link");
             if (li < 0)
                 return;
-            if (model_point_in_link(&m->links[li], id) < 0) {
+            if (point_in_link(ld, li, id) < 0) {
                 err(ld, ln->items[i], "link '%s' has no point '%s'", m->links[li].name, pn->text);
                 return;
             }
@@ -792,15 +875,16 @@ static void load_revolute(loader *ld, const ynode *map)
             return;
         }
     } else {
-        for (int li = 0; li < m->nlinks; li++)
-            if (model_point_in_link(&m->links[li], id) >= 0) {
-                if (nc == 2) {
-                    err(ld, pn, "point '%s' is on more than two links; say which two this joint "
-                                "joins with 'links: [a, b]'", pn->text);
-                    return;
-                }
-                carriers[nc++] = li;
+        int first, end;
+        carriers_of(ld, id, &first, &end);
+        for (int c = first; c < end; c++) {
+            if (nc == 2) {
+                err(ld, pn, "point '%s' is on more than two links; say which two this joint "
+                            "joins with 'links: [a, b]'", pn->text);
+                return;
             }
+            carriers[nc++] = ld->carrier_link[c];
+        }
         if (nc < 2) {
             err(ld, pn, "point '%s' is on only one link; a revolute joint needs it on two",
                 pn->text);
@@ -815,7 +899,7 @@ static void load_revolute(loader *ld, const ynode *map)
     j->mark = map->mark;
     for (int i = 0; i < 2; i++) {
         j->link[i] = carriers[i];
-        j->point[i] = model_point_in_link(&m->links[carriers[i]], id);
+        j->point[i] = point_in_link(ld, carriers[i], id);
     }
     set_joint_name(ld, j, ymap_get(map, "name"), pn->text);
     get_friction(ld, map, j);
@@ -845,27 +929,28 @@ static int load_slider_joint(loader *ld, const ynode *map)
         mover = find_link_or_report(ld, ln, "sliding link");
         if (mover < 0)
             return 0;
-        if (model_point_in_link(&m->links[mover], id) < 0)
+        if (point_in_link(ld, mover, id) < 0)
             return err(ld, ln, "link '%s' has no point '%s'", m->links[mover].name, pn->text), 0;
     } else {
-        int nc = 0;
-        for (int li = 0; li < m->nlinks; li++)
-            if (li != guide && model_point_in_link(&m->links[li], id) >= 0)
-                mover = li, nc++;
+        int nc = 0, first, end;
+        carriers_of(ld, id, &first, &end);
+        for (int c = first; c < end; c++)
+            if (ld->carrier_link[c] != guide)
+                mover = ld->carrier_link[c], nc++;
         if (nc != 1)
             return err(ld, pn, "point '%s' is on %d links; say which one slides with "
                                "'link: name'", pn->text, nc), 0;
     }
     if (mover == guide)
         return err(ld, on, "a slider's link and its guide ('on') must differ"), 0;
-    if (model_point_in_link(&m->links[guide], id) >= 0)
+    if (point_in_link(ld, guide, id) >= 0)
         return err(ld, pn, "the guide link '%s' also has a point '%s'; the sliding point "
                            "must be a point of the moving link only", m->links[guide].name,
                    pn->text), 0;
     int tid = find_point_or_report(ld, through, "'through' point");
     if (tid < 0)
         return 0;
-    int tp = model_point_in_link(&m->links[guide], tid);
+    int tp = point_in_link(ld, guide, tid);
     if (tp < 0)
         return err(ld, through, "'through: %s' must be a point of the guide link '%s'",
                    through->text, m->links[guide].name), 0;
@@ -876,7 +961,7 @@ static int load_slider_joint(loader *ld, const ynode *map)
     j->is_explicit = 1;
     j->mark = map->mark;
     j->link[0] = mover;
-    j->point[0] = model_point_in_link(&m->links[mover], id);
+    j->point[0] = point_in_link(ld, mover, id);
     j->link[1] = guide;
     j->point[1] = tp;
     j->locked = 1;
@@ -905,9 +990,43 @@ static void load_slider(loader *ld, const ynode *map)
         return;
     const ynode *pn = ymap_get(map, "slider");
     int id = pn && pn->kind == YNODE_SCALAR ? find_point(ld, pn->text) : -1;
-    for (int li = 0; id >= 0 && li < ld->m->nlinks; li++)
-        if (model_point_in_link(&ld->m->links[li], id) >= 0)
-            ld->link_failed[li] = 1;
+    int first, end;
+    carriers_of(ld, id, &first, &end);
+    for (int c = first; c < end; c++)
+        ld->link_failed[ld->carrier_link[c]] = 1;
+}
+
+/* Index the links that carry each point name (see carriers_of); points are
+ * all known once the links are read. */
+static void index_carriers(loader *ld)
+{
+    mech_model *m = ld->m;
+    size_t n = (size_t)m->npoint_names, total = 0;
+    for (int li = 0; li < m->nlinks; li++)
+        total += (size_t)m->links[li].npoints;
+    ld->carrier_start = xcalloc(n + 2, sizeof *ld->carrier_start);
+    ld->carrier_link = xcalloc(total, sizeof *ld->carrier_link);
+    ld->carrier_point = xcalloc(total, sizeof *ld->carrier_point);
+    if (!ld->carrier_start || !ld->carrier_link || !ld->carrier_point)
+        return (void)err(ld, NULL, "out of memory");
+    int *fill = ld->carrier_start + 1;  /* counts, then the next free slot of each id */
+    for (int li = 0; li < m->nlinks; li++)
+        for (int p = 0; p < m->links[li].npoints; p++)
+            if (m->links[li].points[p].id >= 0)
+                fill[m->links[li].points[p].id + 1]++;
+    for (size_t i = 0; i < n; i++)
+        fill[i + 1] += fill[i];
+    for (int li = 0; li < m->nlinks; li++)  /* in link order: each id's carriers ascend */
+        for (int p = 0; p < m->links[li].npoints; p++) {
+            int id = m->links[li].points[p].id;
+            if (id < 0)
+                continue;
+            ld->carrier_link[fill[id]] = li;
+            ld->carrier_point[fill[id]++] = p;
+        }
+    /* fill[id] is now the end of id's carriers, i.e. carrier_start[id + 1] */
+    ld->carrier_start[0] = 0;
+    ld->carrier_ids = (int)n;
 }
 
 static void load_joints(loader *ld, const ynode *seq)
@@ -915,7 +1034,7 @@ static void load_joints(loader *ld, const ynode *seq)
     if (!want_kind(ld, seq, YNODE_SEQ, "'joints'"))
         return;
     if (seq->n > MAX_LIST)
-        return (void)err(ld, seq, "too many joints");
+        return (void)err(ld, seq, "too many joints (%zu; at most %d)", seq->n, MAX_LIST);
     for (size_t i = 0; i < seq->n; i++) {
         const ynode *j = seq->items[i];
         if (!want_kind(ld, j, YNODE_MAP, "a joint"))
@@ -1036,35 +1155,45 @@ done:
     free(parent);
 }
 
-/* Links need two points, unless a slider carries them (a piston block). */
+/* Links need two points, unless a slider carries them (a piston block); a
+ * link is held by at most one locked slider. One pass over the joints, with
+ * per-link marks, so that many links or sliders stay linear. */
 static void check_link_points(loader *ld)
 {
     mech_model *m = ld->m;
+    int *locked_by = xcalloc((size_t)m->nlinks, sizeof *locked_by); /* 1 + joint, or 0 */
+    unsigned char *slides = xcalloc((size_t)m->nlinks, sizeof *slides);
+    if (!locked_by || !slides) {
+        err(ld, NULL, "out of memory");
+        goto done;
+    }
+    for (int ji = 0; ji < m->njoints; ji++)
+        if (m->joints[ji].kind == MECH_JOINT_SLIDER)
+            slides[m->joints[ji].link[0]] = 1;
     for (int li = 1; li < m->nlinks; li++) {
         const mech_link *l = &m->links[li];
-        if (l->npoints >= 2 || !l->name || ld->link_failed[li])
+        if (l->npoints >= 2 || !l->name || ld->link_failed[li] || slides[li])
             continue;
-        int slides = 0;
-        for (int ji = 0; ji < m->njoints; ji++)
-            if (m->joints[ji].kind == MECH_JOINT_SLIDER && m->joints[ji].link[0] == li)
-                slides = 1;
-        if (!slides)
-            diag_error(ld->d, ld->file, l->mark,
-                       "link '%s' has %d point%s; a link needs at least two (only a slider "
-                       "block may have one)", l->name, l->npoints, l->npoints == 1 ? "" : "s");
+        diag_error(ld->d, ld->file, l->mark,
+                   "link '%s' has %d point%s; a link needs at least two (only a slider "
+                   "block may have one)", l->name, l->npoints, l->npoints == 1 ? "" : "s");
     }
     for (int ji = 0; ji < m->njoints; ji++) {
         const mech_joint *j = &m->joints[ji];
         if (j->kind != MECH_JOINT_SLIDER || !j->locked)
             continue;
-        for (int k = 0; k < ji; k++) {
-            const mech_joint *o = &m->joints[k];
-            if (o->kind == MECH_JOINT_SLIDER && o->locked && o->link[0] == j->link[0])
-                diag_error(ld->d, ld->file, j->mark,
-                           "link '%s' is held by two locked sliders ('%s' and '%s'); make one "
-                           "'rotation: free'", m->links[j->link[0]].name, o->name, j->name);
-        }
+        int first = locked_by[j->link[0]] - 1;
+        if (first < 0)
+            locked_by[j->link[0]] = ji + 1;
+        else
+            diag_error(ld->d, ld->file, j->mark,
+                       "link '%s' is held by two locked sliders ('%s' and '%s'); make one "
+                       "'rotation: free'", m->links[j->link[0]].name, m->joints[first].name,
+                       j->name);
     }
+done:
+    free(locked_by);
+    free(slides);
 }
 
 /* ---- driver, guesses, branches, loops ------------------------------ */
@@ -1078,6 +1207,8 @@ static int slider_by_name(loader *ld, const ynode *n, const char *what)
     int ji = find_joint(ld, name);
     if (ji >= 0 && m->joints[ji].kind == MECH_JOINT_SLIDER)
         return ji;
+    if (errors_full(ld))
+        return err(ld, n, "unknown slider"), -1;
     const char **names = xcalloc((size_t)m->njoints, sizeof *names);
     size_t k = 0;
     for (int i = 0; names && i < m->njoints; i++)
@@ -1118,6 +1249,8 @@ static void load_range(loader *ld, const ynode *n, quantity q, mech_driver *dr)
     ok = get_count(ld, steps, "'steps'", 1, MAX_STEPS, &s) && ok;
     if (!ok)
         return;
+    if (!isfinite(b - a))  /* from -1e308 to 1e308: the positions would be inf and NaN */
+        return (void)err(ld, n, "%s range is too wide (from %g to %g)", what, a, b);
     dr->values = xcalloc((size_t)s + 1, sizeof *dr->values);
     if (!dr->values)
         return (void)err(ld, n, "out of memory");
@@ -1206,7 +1339,7 @@ static void load_initial(loader *ld, const ynode *map)
     for (size_t i = 0; i < map->n; i++) {
         const ynode *k = map->items[2 * i], *v = map->items[2 * i + 1];
         const char *name = get_name(ld, k, "initial guess name");
-        if (!name || ymap_get(map, name) != v)
+        if (!name || k->dup_of)
             continue;
         mech_guess *g = &m->guesses[m->nguesses];
         g->mark = k->mark;
@@ -1225,6 +1358,8 @@ static void load_initial(loader *ld, const ynode *map)
             g->index = ji;
             if (get_quantity(ld, v, Q_LENGTH, "initial displacement", &g->value))
                 m->nguesses++;
+        } else if (errors_full(ld)) {
+            err(ld, k, "unknown link or slider");
         } else {
             size_t nn = (size_t)m->nlinks + (size_t)m->njoints, c = 0;
             const char **names = xcalloc(nn, sizeof *names);
@@ -1242,8 +1377,11 @@ static void load_initial(loader *ld, const ynode *map)
 static void load_branches(loader *ld, const ynode *seq)
 {
     mech_model *m = ld->m;
-    if (!want_kind(ld, seq, YNODE_SEQ, "'branch'") || seq->n > MAX_LIST)
+    if (!want_kind(ld, seq, YNODE_SEQ, "'branch'"))
         return;
+    if (seq->n > MAX_LIST)
+        return (void)err(ld, seq, "too many branch conditions (%zu; at most %d)", seq->n,
+                         MAX_LIST);
     m->branches = xcalloc(seq->n, sizeof *m->branches);
     if (!m->branches)
         return (void)err(ld, seq, "out of memory");
@@ -1317,10 +1455,14 @@ static void load_loop(loader *ld, const ynode *n, mech_loop *lp)
             return (void)err(ld, n, "out of memory");
     } else if (n->kind != YNODE_SEQ) {
         return (void)err(ld, n, "a loop must be a list of point names [A, B, C, A] or a string \"A B C A\"");
-    } else if (n->n > MAX_LIST) {
-        return (void)err(ld, n, "loop too long");
     }
     int len = n->kind == YNODE_SCALAR ? count : (int)n->n;
+    if (len > MAX_LOOP_POINTS) {
+        for (int i = 0; i < count; i++)
+            free(names[i]);
+        free(names);
+        return (void)err(ld, n, "loop too long (%d points; at most %d)", len, MAX_LOOP_POINTS);
+    }
     lp->points = xcalloc((size_t)len, sizeof *lp->points);
     lp->marks = xcalloc((size_t)len, sizeof *lp->marks);
     lp->mark = n->mark;
@@ -1353,8 +1495,11 @@ static void load_loop(loader *ld, const ynode *n, mech_loop *lp)
 static void load_loops(loader *ld, const ynode *seq)
 {
     mech_model *m = ld->m;
-    if (!want_kind(ld, seq, YNODE_SEQ, "'loops'") || seq->n > MAX_LIST)
+    if (!want_kind(ld, seq, YNODE_SEQ, "'loops'"))
         return;
+    if (seq->n > MAX_LOOPS)
+        return (void)err(ld, seq, "too many loops listed (%zu; at most %d); leave 'loops' out "
+                                  "and they are found automatically", seq->n, MAX_LOOPS);
     m->loops = xcalloc(seq->n, sizeof *m->loops);
     if (!m->loops)
         return (void)err(ld, seq, "out of memory");
@@ -1371,7 +1516,7 @@ static int load_target_link(loader *ld, const ynode *map, int point_id, const yn
     const ynode *ln = ymap_get(map, "link");
     if (ln) {
         int li = find_link_or_report(ld, ln, "loaded link");
-        if (li >= 0 && point_id >= 0 && model_point_in_link(&m->links[li], point_id) < 0) {
+        if (li >= 0 && point_id >= 0 && point_in_link(ld, li, point_id) < 0) {
             err(ld, pnode, "link '%s' has no point '%s'", m->links[li].name, pnode->text);
             return -1;
         }
@@ -1379,10 +1524,10 @@ static int load_target_link(loader *ld, const ynode *map, int point_id, const yn
     }
     if (point_id < 0)
         return err(ld, map, "this load needs 'link: NAME'"), -1;
-    int found = -1, nc = 0;
-    for (int li = 0; li < m->nlinks; li++)
-        if (model_point_in_link(&m->links[li], point_id) >= 0)
-            found = li, nc++;
+    int found = -1, nc = 0, first, end;
+    carriers_of(ld, point_id, &first, &end);
+    for (int c = first; c < end; c++)
+        found = ld->carrier_link[c], nc++;
     if (nc != 1)
         return err(ld, pnode, "point '%s' is on %d links; say which one is loaded with 'link: NAME'",
                    pnode->text, nc), -1;
@@ -1410,7 +1555,7 @@ static void load_one_load(loader *ld, const ynode *map, mech_load *l)
         l->link = load_target_link(ld, map, id, at);
         ok = get_vec2(ld, f, Q_FORCE, "force", l->force) && id >= 0 && l->link >= 0;
         if (ok)
-            l->point[0] = model_point_in_link(&ld->m->links[l->link], id);
+            l->point[0] = point_in_link(ld, l->link, id);
     } else if (t) {
         l->kind = MECH_LOAD_TORQUE;
         l->link = load_target_link(ld, map, -1, NULL);
@@ -1428,8 +1573,8 @@ static void load_one_load(loader *ld, const ynode *map, mech_load *l)
         if (dir)
             ok = get_quantity(ld, dir, Q_ANGLE, "load direction", &l->direction) && ok;
         if (ok && a >= 0 && b >= 0 && l->link >= 0) {
-            l->point[0] = model_point_in_link(&ld->m->links[l->link], a);
-            l->point[1] = model_point_in_link(&ld->m->links[l->link], b);
+            l->point[0] = point_in_link(ld, l->link, a);
+            l->point[1] = point_in_link(ld, l->link, b);
             if (l->point[1] < 0)
                 ok = 0, err(ld, to, "link '%s' has no point '%s'", ld->m->links[l->link].name, to->text);
         } else {
@@ -1445,8 +1590,10 @@ static void load_one_load(loader *ld, const ynode *map, mech_load *l)
 static void load_loads(loader *ld, const ynode *seq)
 {
     mech_model *m = ld->m;
-    if (!want_kind(ld, seq, YNODE_SEQ, "'loads'") || seq->n > MAX_LIST)
+    if (!want_kind(ld, seq, YNODE_SEQ, "'loads'"))
         return;
+    if (seq->n > MAX_LOADS)
+        return (void)err(ld, seq, "too many loads (%zu; at most %d)", seq->n, MAX_LOADS);
     m->loads = xcalloc(seq->n, sizeof *m->loads);
     if (!m->loads)
         return (void)err(ld, seq, "out of memory");
@@ -1463,8 +1610,10 @@ static int resolve_slider(loader *ld, const ynode *n) { return slider_by_name(ld
 static void load_name_list(loader *ld, const ynode *seq, const char *what, resolve_fn fn,
                            int **out, int *count)
 {
-    if (!want_kind(ld, seq, YNODE_SEQ, what) || seq->n > MAX_LIST)
+    if (!want_kind(ld, seq, YNODE_SEQ, what))
         return;
+    if (seq->n > MAX_LIST)
+        return (void)err(ld, seq, "too many %s (%zu; at most %d)", what, seq->n, MAX_LIST);
     *out = xcalloc(seq->n, sizeof **out);
     if (!*out)
         return (void)err(ld, seq, "out of memory");
@@ -1551,6 +1700,7 @@ static void load_document(loader *ld, const ynode *root)
         load_links(ld, links);
     else
         ld->links_bad = 1;
+    index_carriers(ld);
     if ((v = ymap_get(root, "joints")))
         load_joints(ld, v);
     add_implicit_revolutes(ld);
@@ -1599,6 +1749,10 @@ int mech_load_string(const char *text, size_t len, const char *name, mech_model 
     free(ld.params);
     free(ld.link_failed);
     name_map_free(&ld.bad_params);
+    name_map_free(&ld.param_map);
+    free(ld.carrier_start);
+    free(ld.carrier_link);
+    free(ld.carrier_point);
     name_map_free(&ld.point_map);
     name_map_free(&ld.link_map);
     name_map_free(&ld.joint_map);

@@ -365,6 +365,18 @@ static int build_from_file(const mech_model *m, loop_set *ls, mech_diag *d)
                           m->nloops, m->nloops == 1 ? "" : "s", needed, m->njoints, m->nlinks,
                           m->nloops < needed ? "; add the missing loops or remove 'loops' to find them automatically"
                                              : "; remove the extra loops");
+    /* Each step of a listed loop searches the links and joints, and the rank
+     * test is dense: bound both (docs/limits.md). Automatic loops are linear. */
+    double steps = 0, points = 0;
+    for (int k = 0; k < m->nloops; k++)
+        steps += m->loops[k].npoints;
+    for (int l = 0; l < m->nlinks; l++)
+        points += m->links[l].npoints;
+    if ((double)m->nloops * m->njoints > 1e7 || steps * (points + m->njoints) > 1e9)
+        return diag_error(d, m->file, m->loops[0].mark,
+                          "listed loops are for small mechanisms: %d loops over %d joints "
+                          "and %.0f points is too much work to check; remove 'loops' to find "
+                          "them automatically", m->nloops, m->njoints, points);
     term_buf b = {0};
     double *rows = xcalloc((size_t)m->nloops * (size_t)m->njoints, sizeof *rows);
     ls->start = xcalloc((size_t)m->nloops + 1, sizeof *ls->start);

@@ -331,8 +331,9 @@ static int alloc_state(solver *sv)
     sv->rhs = xcalloc(nr + ns, sizeof *sv->rhs);
     sv->cscale = xcalloc(ns, sizeof *sv->cscale);
     sv->label = xcalloc(512, 1);
+    sv->seen = xcalloc((size_t)(sv->nr + sv->ns) + 1, 1);
     if (!sv->pos || !sv->vel || !sv->acc || !sv->x || !sv->xq || !sv->xqq || !sv->f ||
-        !sv->dx || !sv->xt || !sv->ft || !sv->rhs || !sv->cscale || !sv->label)
+        !sv->dx || !sv->xt || !sv->ft || !sv->rhs || !sv->cscale || !sv->label || !sv->seen)
         return -1;
     return kin_state_init(&sv->ks, sv->m) == MECH_OK ? 0 : -1;
 }
@@ -430,7 +431,7 @@ void solver_free(solver *sv)
     void *blocks[] = {sv->col, sv->row, sv->Ap, sv->Ai, sv->Ax, sv->Jv, sv->jpos, sv->rhs,
                       sv->cscale, sv->proot,
                       sv->vroot, sv->aroot, sv->pos, sv->vel, sv->acc, sv->x, sv->xq,
-                      sv->xqq, sv->f, sv->dx, sv->xt, sv->ft, sv->label};
+                      sv->xqq, sv->f, sv->dx, sv->xt, sv->ft, sv->label, sv->seen};
     for (size_t i = 0; i < sizeof blocks / sizeof blocks[0]; i++)
         free(blocks[i]);
     memset(sv, 0, sizeof *sv);
@@ -608,6 +609,46 @@ step_status solver_newton(solver *sv, double q)
         prev_step = lambda == 1.0 ? step : INFINITY;
         sv->iters = it + 1;
     }
+}
+
+/* Parity of a permutation (0 even, 1 odd), by its cycles. */
+static int parity(const int *perm, int n, unsigned char *seen)
+{
+    int odd = 0;
+    memset(seen, 0, (size_t)n);
+    for (int i = 0; i < n; i++) {
+        if (seen[i])
+            continue;
+        int len = 0;
+        for (int k = i; !seen[k]; k = perm[k], len++)
+            seen[k] = 1;
+        odd ^= (len - 1) & 1;
+    }
+    return odd;
+}
+
+int solver_det_sign(solver *sv)
+{
+    if (!sv->num || sv->N == 0)
+        return 1;
+    /* L U = A(Pnum, Q) with unit-diagonal L; the column scaling is positive */
+    const double *ud = sv->num->Udiag;
+    int neg = parity(sv->num->Pnum, sv->N, sv->seen) ^ parity(sv->sym->Q, sv->N, sv->seen);
+    for (int k = 0; k < sv->N; k++) {
+        if (ud[k] == 0.0)
+            return 0;
+        neg ^= ud[k] < 0.0;
+    }
+    return neg ? -1 : 1;
+}
+
+void solver_velocity_rhs(solver *sv, double *out)
+{
+    tape *t = &sv->tp;
+    tape_set_var(t, SYS_VAR_QDOT(sv->n), 1.0);
+    tape_run(t, PHASE_VELOCITY);
+    for (int i = 0; i < sv->nr; i++)
+        out[i] = tape_value(t, sv->vroot[i]);
 }
 
 int solver_rates(solver *sv)

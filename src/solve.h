@@ -66,6 +66,7 @@ typedef struct solver {
     kin_tree tree;
     kin_state ks;
     char *label;               /* scratch for messages */
+    unsigned char *seen;       /* [N] scratch for permutation parities */
 } solver;
 
 int solver_init(solver *sv, const mech_model *m, const mech_solve_options *o, mech_diag *d);
@@ -79,6 +80,13 @@ int solver_rates(solver *sv);
 /* Scatter x, and the rates for driver speed qd and acceleration qdd, into
  * pos, vel, acc and update the link frames. */
 void solver_publish(solver *sv, double q, double qd, double qdd);
+
+/* Sign of det of the factored matrix (+1, -1, 0 singular): a change between
+ * two positions means the sweep crossed a singular one. */
+int solver_det_sign(solver *sv);
+/* -df/dq (the velocity right-hand side for q' = 1) at the last position
+ * evaluated, for the nr solved rows. */
+void solver_velocity_rhs(solver *sv, double *out);
 
 /* |v|inf, and the size of a change of the solved unknowns (angles in rad,
  * slides in units of lref). */

@@ -43,6 +43,8 @@ typedef struct sweep {
     double q0, *x0, *xq0, *xqq0;
     double *guess;             /* [n] the file's guess of each unknown, NAN if none */
     int row_iters;             /* Newton iterations spent on the current row */
+    int det_sign;              /* sign of det J at the base (0: unknown) */
+    int crossings;             /* sign changes reported */
     double fail_q;             /* where the last rejected attempt was */
     step_status fail_status;
     double fail_resid;         /* residual and worst loop of the first rejected attempt */
@@ -204,20 +206,48 @@ static void list_large(const solver *sv, const double *v, int loops, char *buf, 
             last_loop = k;
             at += (size_t)snprintf(buf + at, size - at, "%s%s", count++ ? ", " : "",
                                    loop_label(sv, k, lb, sizeof lb));
-        } else {
-            at += (size_t)snprintf(buf + at, size - at, "%s%s", count++ ? ", " : "",
-                                   sv->sys->names[sv->col[i]]);
+        } else {  /* the unknown, and where it is: "th_crank (at 0 deg)" */
+            int c = sv->col[i];
+            int angle = sv->sys->unk_kind[c] == UNK_ANGLE;
+            double val = angle ? remainder(sv->x[i], 2.0 * PI) * 180.0 / PI : sv->x[i] * 1e3;
+            if (fabs(val) < 5e-4)  /* known to about sqrt(eps) at a singular position */
+                val = 0.0;
+            at += (size_t)snprintf(buf + at, size - at, "%s%s (at %.3f %s)", count++ ? ", " : "",
+                                   sv->sys->names[c], val, angle ? "deg" : "mm");
         }
     }
+}
+
+/* At a singular position, is the driver's column -f_q in the range of J
+ * (w . f_q = 0 for the left null vector w)? Then the solution curve goes on
+ * through the position and another crosses it: a change point. Otherwise
+ * the driver cannot move on: a dead point or limit position. */
+static int is_change_point(solver *sv, const double *left)
+{
+    double *fq = xcalloc((size_t)sv->nr + 1, sizeof *fq);
+    if (!fq)
+        return 0;
+    solver_velocity_rhs(sv, fq);
+    double dot = 0.0, nw = 0.0, nf = 0.0;
+    for (int i = 0; i < sv->nr; i++) {
+        dot += left[i] * fq[i];
+        nw += left[i] * left[i];
+        nf += fq[i] * fq[i];
+    }
+    free(fq);
+    return nw > 0.0 && nf > 0.0 && fabs(dot) <= 1e-3 * sqrt(nw * nf);
 }
 
 static void report_singular(sweep *w, double q)
 {
     solver *sv = &w->sv;
     char qb[64], what[700] = "";
+    const char *kind = "a dead point, toggle or limit position";
     double *right = xcalloc((size_t)sv->ns + 1, sizeof *right);
-    double *left = xcalloc((size_t)sv->ns + 1, sizeof *left);
+    double *left = xcalloc((size_t)sv->nr + 1, sizeof *left);
     if (right && left && dense_null(sv, right, left) == 0) {
+        if (is_change_point(sv, left))
+            kind = "a change point, where two assembly branches cross";
         snprintf(what, sizeof what, ": the unknowns ");
         list_large(sv, right, 0, what, sizeof what);
         size_t at = strlen(what);
@@ -230,10 +260,9 @@ static void report_singular(sweep *w, double q)
     free(right);
     free(left);
     diag_error(w->d, w->m->file, w->m->driver.mark,
-               "singular position at %s = %s (reciprocal condition %.2g, limit %.2g): a dead "
-               "point, toggle or branch point%s; velocities there are not unique",
-               driver_word(w->m), q_text(w->m, q, qb, sizeof qb), sv->rcond, sv->opt.min_rcond,
-               what);
+               "singular position at %s = %s (reciprocal condition %.2g, limit %.2g): %s%s; "
+               "velocities there are not unique", driver_word(w->m),
+               q_text(w->m, q, qb, sizeof qb), sv->rcond, sv->opt.min_rcond, kind, what);
 }
 
 /* With redundant constraints (more loop equations than unknowns), say which
@@ -321,10 +350,29 @@ static int branches_hold(sweep *w, int *which)
     return 1;
 }
 
+/* det J changed sign between the base and qn: a singular position was
+ * crossed (a change point); the sweep may have passed to another assembly. */
+static void note_crossing(sweep *w, double qn)
+{
+    int sign = solver_det_sign(&w->sv);
+    if (sign != 0 && w->det_sign != 0 && sign != w->det_sign && w->crossings++ < 10) {
+        char qa[64], qb[64];
+        diag_warning(w->d, w->m->file, w->m->driver.mark,
+                     "between %s = %s and %s the Jacobian's determinant changes sign: the "
+                     "sweep passed a change point, where assembly branches cross, and may "
+                     "continue on the other assembly; declare `branch:` to keep one",
+                     driver_word(w->m), q_text(w->m, fmin(w->qc, qn), qa, sizeof qa),
+                     q_text(w->m, fmax(w->qc, qn), qb, sizeof qb));
+    }
+    if (sign != 0)
+        w->det_sign = sign;
+}
+
 /* Keep the converged x at qn as the new base of the continuation. */
 static void accept(sweep *w, double qn)
 {
     solver *sv = &w->sv;
+    note_crossing(w, qn);
     size_t bytes = (size_t)sv->ns * sizeof(double);
     memcpy(w->xq_prev, w->xqc, bytes);
     w->q_prev = w->qc;

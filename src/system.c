@@ -15,12 +15,54 @@ enum { PHASE_POSITION, PHASE_VELOCITY, PHASE_ACCELERATION, NPHASES };
 
 /* ---- unknowns and names --------------------------------------------- */
 
-static const mech_joint *locking_slider(const mech_model *m, int l)
+/* For each link, the first locked slider that holds it, or -1: one pass over
+ * the joints, not one per link (10^5 links and joints). NULL: no memory. */
+static int *locking_sliders(const mech_model *m)
 {
-    for (int j = 0; j < m->njoints; j++)
-        if (m->joints[j].kind == MECH_JOINT_SLIDER && m->joints[j].locked && m->joints[j].link[0] == l)
-            return &m->joints[j];
-    return NULL;
+    int *lock = xcalloc((size_t)m->nlinks, sizeof *lock);
+    if (!lock)
+        return NULL;
+    for (int l = 0; l < m->nlinks; l++)
+        lock[l] = -1;
+    for (int j = m->njoints - 1; j >= 0; j--)  /* backwards: the first one wins */
+        if (m->joints[j].kind == MECH_JOINT_SLIDER && m->joints[j].locked)
+            lock[m->joints[j].link[0]] = j;
+    return lock;
+}
+
+/* The link whose angle each link copies through chains of locked sliders
+ * (itself when none holds it), or -1 when the chain ends in a cycle. Each
+ * link is visited once (a long chain is linear, not quadratic). */
+static int *angle_sources(const mech_model *m)
+{
+    enum { UNKNOWN = -2, ON_PATH = -3 };
+    int *lock = locking_sliders(m);
+    int *src = xcalloc((size_t)m->nlinks, sizeof *src);
+    int *path = xcalloc((size_t)m->nlinks, sizeof *path);
+    if (!lock || !src || !path) {
+        free(src);
+        src = NULL;
+        goto done;
+    }
+    for (int l = 0; l < m->nlinks; l++)
+        src[l] = UNKNOWN;
+    for (int l = 0; l < m->nlinks; l++) {
+        int np = 0, k = l;
+        while (src[k] == UNKNOWN && lock[k] >= 0) {
+            src[k] = ON_PATH;
+            path[np++] = k;
+            k = m->joints[lock[k]].link[1];
+        }
+        int root = src[k] == ON_PATH ? -1 : src[k] == UNKNOWN ? k : src[k];
+        if (src[k] == UNKNOWN)
+            src[k] = k;
+        while (np > 0)
+            src[path[--np]] = root;
+    }
+done:
+    free(lock);
+    free(path);
+    return src;
 }
 
 static int driver_link(const mech_model *m)
@@ -41,11 +83,14 @@ static int assign_unknowns(mech_system *s)
     s->unk_index = xcalloc((size_t)(m->nlinks + m->njoints), sizeof *s->unk_index);
     s->link_var = xcalloc((size_t)m->nlinks, sizeof *s->link_var);
     s->joint_var = xcalloc((size_t)m->njoints + 1, sizeof *s->joint_var);
-    if (!s->unk_kind || !s->unk_index || !s->link_var || !s->joint_var)
+    int *lock = locking_sliders(m);
+    if (!s->unk_kind || !s->unk_index || !s->link_var || !s->joint_var || !lock) {
+        free(lock);
         return -1;
+    }
     for (int l = 0; l < m->nlinks; l++) {
         s->link_var[l] = -1;
-        if (l == 0 || l == driver_link(m) || locking_slider(m, l))
+        if (l == 0 || l == driver_link(m) || lock[l] >= 0)
             continue;
         s->unk_kind[n] = UNK_ANGLE;
         s->unk_index[n] = l;
@@ -60,6 +105,7 @@ static int assign_unknowns(mech_system *s)
         s->joint_var[j] = n++;
     }
     s->n = n;
+    free(lock);
     return 0;
 }
 
@@ -153,22 +199,25 @@ static int link_angles(mech_system *s, mech_diag *d)
     expr_ctx *c = &s->ex;
     s->link_angle = xcalloc((size_t)m->nlinks, sizeof *s->link_angle);
     s->slide = xcalloc((size_t)m->njoints + 1, sizeof *s->slide);
-    if (!s->link_angle || !s->slide)
+    int *src = angle_sources(m);
+    if (!s->link_angle || !s->slide || !src) {
+        free(src);
         return diag_error(d, m->file, (mech_mark){0, 0}, "out of memory");
+    }
     for (int l = 0; l < m->nlinks; l++) {
-        /* follow locked sliders to the link whose angle this one copies */
-        int k = l, hops = 0;
-        const mech_joint *lock;
-        while ((lock = locking_slider(m, k)) != NULL && hops++ <= m->nlinks)
-            k = lock->link[1];
-        if (hops > m->nlinks)
+        /* the link whose angle this one copies through locked sliders */
+        int k = src[l];
+        if (k < 0) {
+            free(src);
             return diag_error(d, m->file, m->links[l].mark,
                               "link '%s' is in a cycle of locked sliders: none of them can turn",
                               m->links[l].name);
+        }
         s->link_angle[l] = k == 0 ? c->zero
                            : k == driver_link(m) ? expr_var(c, SYS_VAR_Q(s->n))
                                                   : expr_var(c, s->link_var[k]);
     }
+    free(src);
     for (int j = 0; j < m->njoints; j++)
         s->slide[j] = m->joints[j].kind != MECH_JOINT_SLIDER ? -1
                       : j == driver_slider(m) ? expr_var(c, SYS_VAR_Q(s->n))

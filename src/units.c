@@ -89,11 +89,26 @@ int unit_is_name(const char *s, size_t len) { return unit_lookup(s, len) != NULL
 
 int dim_equal(dim a, dim b) { return memcmp(a.e, b.e, sizeof a.e) == 0; }
 
+/* Powers of a unit beyond +-99 would wrap around in a signed char (m^257
+ * read as m): they become DIM_BAD, which sticks, and the evaluator reports it. */
+enum { DIM_MAX = 99, DIM_BAD = 127 };
+
+static signed char dim_clamp(int e) { return e > DIM_MAX || e < -DIM_MAX ? DIM_BAD : (signed char)e; }
+
+static int dim_is_bad(dim a)
+{
+    for (int i = 0; i < NDIMS; i++)
+        if (a.e[i] == DIM_BAD)
+            return 1;
+    return 0;
+}
+
 static dim dim_add(dim a, dim b, int sign)
 {
     dim r;
     for (int i = 0; i < NDIMS; i++)
-        r.e[i] = (signed char)(a.e[i] + sign * b.e[i]);
+        r.e[i] = a.e[i] == DIM_BAD || b.e[i] == DIM_BAD ? DIM_BAD
+                                                        : dim_clamp(a.e[i] + sign * b.e[i]);
     return r;
 }
 
@@ -101,7 +116,7 @@ static dim dim_scale(dim a, int k)
 {
     dim r;
     for (int i = 0; i < NDIMS; i++)
-        r.e[i] = (signed char)(a.e[i] * k);
+        r.e[i] = a.e[i] == DIM_BAD ? DIM_BAD : dim_clamp(a.e[i] * k);
     return r;
 }
 
@@ -306,7 +321,17 @@ static qval parse_number(qparser *p)
     double scale;
     dim d;
     const char *uend;
-    if (!unit_parse(u, &scale, &d, &uend)) {
+    int known_unit = unit_parse(u, &scale, &d, &uend);
+    if (!known_unit && unit_lookup(u, n)) {  /* "m^100": the unit is fine, its power is not */
+        qfail(p, u, "bad power of unit '%.*s' (write an integer from -99 to 99 after '^')",
+              (int)n, u);
+        return make_bare(v);
+    }
+    if (known_unit && dim_is_bad(d)) {
+        qfail(p, u, "unit power out of range (at most %d)", DIM_MAX);
+        return make_bare(v);
+    }
+    if (!known_unit) {
         char word[64];
         snprintf(word, sizeof word, "%.*s", (int)(n < 40 ? n : 40), u);
         const char *names[NUNITS];
@@ -409,6 +434,24 @@ static qval call_function(qparser *p, const char *name, size_t n, const char *at
     return a;
 }
 
+/* Index of the parameter named by the n bytes at `name`, or -1. Names are
+ * at most 64 bytes (load.c), so a longer word is no parameter. */
+static int find_param(const expr_env *env, const char *name, size_t n)
+{
+    if (env->param_index) {
+        char word[65];
+        if (n >= sizeof word)
+            return -1;
+        memcpy(word, name, n);
+        word[n] = '\0';
+        return name_map_get(env->param_index, word);
+    }
+    for (int i = 0; i < env->nparams; i++)
+        if (strlen(env->params[i].name) == n && memcmp(env->params[i].name, name, n) == 0)
+            return i;
+    return -1;
+}
+
 static qval parse_atom(qparser *p)
 {
     p->s = skip_space(p->s);
@@ -433,10 +476,10 @@ static qval parse_atom(qparser *p)
         }
         if (n == 2 && memcmp(at, "pi", 2) == 0)  /* pi rad: angle: pi/2 is 90 deg whatever the default */
             return (qval){PI, quantity_table[Q_ANGLE].d, 0};
-        for (int i = 0; i < p->env->nparams; i++) {
-            const expr_param *q = &p->env->params[i];
-            if (strlen(q->name) == n && memcmp(q->name, at, n) == 0)
-                return (qval){q->value, q->d, q->bare};
+        int found = find_param(p->env, at, n);
+        if (found >= 0) {
+            const expr_param *q = &p->env->params[found];
+            return (qval){q->value, q->d, q->bare};
         }
         if (unit_lookup(at, n))
             qfail(p, at, "unit '%.*s' without a number (write 1 %.*s)", (int)n, at, (int)n, at);
@@ -492,7 +535,10 @@ static qval parse_power(qparser *p)
     }
     if (r == 1) {
         a.v = pow(a.v, e);
+        int was_bad = dim_is_bad(a.d);
         a.d = dim_scale(a.d, e);
+        if (dim_is_bad(a.d) && !was_bad)
+            qfail(p, at, "unit power out of range (at most %d)", DIM_MAX);
     }
     return a;
 }
@@ -517,6 +563,10 @@ static qval parse_term(qparser *p)
         }
         a.d = dim_add(a.d, b.d, *at == '*' ? 1 : -1);
         a.bare = a.bare && b.bare;
+        if (dim_is_bad(a.d) && !dim_is_bad(b.d)) {  /* report once, where it happens */
+            qfail(p, at, "unit power out of range (at most %d)", DIM_MAX);
+            return a;
+        }
     }
 }
 

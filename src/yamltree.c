@@ -153,7 +153,35 @@ static int on_open(builder *b, const yaml_event_t *ev, ynode_kind kind)
     return 0;
 }
 
-static void on_close(builder *b) { b->depth--; }
+/* Mark each repeated scalar key of a closed mapping with its first use. A
+ * hash of the keys keeps a mapping of 10^5 links linear. */
+static int mark_duplicate_keys(ynode *map)
+{
+    if (map->kind != YNODE_MAP || map->n < 2)
+        return 0;
+    name_map seen = {0};
+    int rc = 0;
+    for (size_t i = 0; i < map->n && rc == 0; i++) {
+        ynode *k = map->items[2 * i];
+        if (k->kind != YNODE_SCALAR)
+            continue;
+        int first = name_map_get(&seen, k->text);
+        if (first >= 0)
+            k->dup_of = map->items[2 * (size_t)first];
+        else
+            rc = name_map_put(&seen, k->text, (int)i);
+    }
+    name_map_free(&seen);
+    return rc;
+}
+
+static int on_close(builder *b, const yaml_event_t *ev)
+{
+    ynode *n = b->stack[--b->depth];
+    if (mark_duplicate_keys(n) < 0)
+        return diag_error(b->d, b->file, mark_of(ev->start_mark), "out of memory");
+    return 0;
+}
 
 /* What libyaml's context ("while parsing a block mapping") is about, in words
  * for the note that points at its start. */
@@ -247,8 +275,7 @@ static int handle(builder *b, const yaml_event_t *ev, int *ndocs)
         return on_open(b, ev, YNODE_MAP);
     case YAML_SEQUENCE_END_EVENT:
     case YAML_MAPPING_END_EVENT:
-        on_close(b);
-        return 0;
+        return on_close(b, ev);
     default:
         return 0;
     }

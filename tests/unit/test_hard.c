@@ -505,7 +505,7 @@ Test(hard, change_point_stays_on_declared_branch)
  * toggle or branch point: the unknowns th_coupler, th_rocker are not
  * determined by loop 1 (B-C-O-A-B); velocities there are not unique", the
  * same words as a dead centre; nothing says the branches cross here. */
-Test(hard, change_point_reported_as_crossing, .disabled = true)
+Test(hard, change_point_reported_as_crossing)
 {
     mech_model *m = load("tests/hard/change-point.yaml", NULL);
     mech_solve_options o;
@@ -532,7 +532,7 @@ Test(hard, change_point_reported_as_crossing, .disabled = true)
  * turn A-B-C changes sign between the rows at 179.501 and 180.499 deg
  * (-2.3e-05 then +2.3e-05 m^2) and the row at 360 deg is the crossed
  * assembly (coupler angle -0.9273 rad, +0.9273 at 0 deg). */
-Test(hard, change_point_undeclared_not_silent, .disabled = true)
+Test(hard, change_point_undeclared_not_silent)
 {
     mech_model *m = load("tests/hard/change-point-undeclared.yaml", NULL);
     mech_solve_options o;
@@ -789,7 +789,7 @@ static int angle_after(const char *msg, const char *word, double *deg)
  * 1e-06): a dead point, toggle or branch point: the unknowns th_crank, th_rod
  * are not determined by loop 1 (A-B-O-A); velocities there are not unique"
  * (and the same at 70 mm, reciprocal condition 2.2e-09). */
-Test(hard, dead_centre_reports_crank_angle, .disabled = true)
+Test(hard, dead_centre_reports_crank_angle)
 {
     static const double to[2] = {0.130, 0.070}, want[2] = {0, 180};
     for (int k = 0; k < 2; k++) {
