@@ -45,6 +45,7 @@ typedef struct sweep {
     int row_iters;             /* Newton iterations spent on the current row */
     int det_sign;              /* sign of det J at the base (0: unknown) */
     int crossings;             /* sign changes reported */
+    int searching;             /* looking for assembly limits: no crossing reports */
     double fail_q;             /* where the last rejected attempt was */
     step_status fail_status;
     double fail_resid;         /* residual and worst loop of the first rejected attempt */
@@ -355,7 +356,8 @@ static int branches_hold(sweep *w, int *which)
 static void note_crossing(sweep *w, double qn)
 {
     int sign = solver_det_sign(&w->sv);
-    if (sign != 0 && w->det_sign != 0 && sign != w->det_sign && w->crossings++ < 10) {
+    if (sign != 0 && w->det_sign != 0 && sign != w->det_sign && !w->searching &&
+        w->crossings++ < 10) {
         char qa[64], qb[64];
         diag_warning(w->d, w->m->file, w->m->driver.mark,
                      "between %s = %s and %s the Jacobian's determinant changes sign: the "
@@ -560,18 +562,14 @@ static int start(sweep *w, double q)
 
 /* March from row 0 away from the sweep direction to find where assembly
  * stops on that side; returns that limit (or the end of the search). */
-static double lower_limit(sweep *w, double span, double hrow, int *found)
+/* From the base, march in direction dir by steps h until assembly fails or
+ * `span` is covered; returns the last position reached (a limit when
+ * *found). */
+static double march(sweep *w, double dir, double h, double span, int *found)
 {
-    solver *sv = &w->sv;
-    size_t bytes = (size_t)sv->ns * sizeof(double);
-    memcpy(w->xc, w->x0, bytes);
-    memcpy(w->xqc, w->xq0, bytes);
-    memcpy(w->xqqc, w->xqq0, bytes);
-    w->qc = w->q0;
-    w->have_prev = 0;
-    double dir = hrow > 0 ? -1.0 : 1.0, h = fabs(hrow);
+    double q0 = w->qc;
     *found = 0;
-    for (double q = w->q0; fabs(q - w->q0) < span;) {
+    for (double q = q0; fabs(q - q0) < span;) {
         q += dir * h;
         if (advance(w, q, 1e-9 * fmax(h, 1e-12)) != STEP_OK) {
             *found = w->fail_status == STEP_NO_ASSEMBLY || w->fail_status == STEP_SINGULAR;
@@ -579,6 +577,53 @@ static double lower_limit(sweep *w, double span, double hrow, int *found)
         }
     }
     return w->qc;
+}
+
+/* Make (q, x, x_q, x_qq) the base of the continuation. */
+static void set_base(sweep *w, double q, const double *x, const double *xq, const double *xqq)
+{
+    size_t bytes = (size_t)w->sv.ns * sizeof(double);
+    memcpy(w->xc, x, bytes);
+    memcpy(w->xqc, xq, bytes);
+    memcpy(w->xqqc, xqq, bytes);
+    w->qc = q;
+    w->have_prev = 0;
+}
+
+static double lower_limit(sweep *w, double span, double hrow, int *found)
+{
+    set_base(w, w->q0, w->x0, w->xq0, w->xqq0);
+    return march(w, hrow > 0 ? -1.0 : 1.0, fabs(hrow), span, found);
+}
+
+/* Look for another interval where a crank assembles, in the gap (hi, lo +
+ * 2 pi) left by the one found: Newton from scattered starts every row
+ * spacing; at the first success, march both ways to its limits. Small
+ * systems only (it is a search). Returns 1 with the interval in lo2, hi2. */
+static int other_interval(sweep *w, double lo, double hi, double h, double *lo2, double *hi2)
+{
+    solver *sv = &w->sv;
+    if (sv->ns > 50 || !(h > 0.0))
+        return 0;
+    unsigned rng = 12345u;
+    for (double q = hi + h; q < lo + 2.0 * PI - 0.5 * h; q += h)
+        for (int a = 1; a <= 8; a++) {
+            start_values(w, a, &rng);
+            if (try_position(w, q, 0) != STEP_OK)
+                continue;
+            /* save this point: both marches start from it */
+            size_t bytes = (size_t)sv->ns * sizeof(double);
+            memcpy(w->x0, sv->x, bytes);
+            memcpy(w->xq0, sv->xq, bytes);
+            memcpy(w->xqq0, sv->xqq, bytes);
+            int f1, f2;
+            set_base(w, q, w->x0, w->xq0, w->xqq0);
+            *hi2 = march(w, 1.0, h, 2.0 * PI, &f1);
+            set_base(w, q, w->x0, w->xq0, w->xqq0);
+            *lo2 = march(w, -1.0, h, 2.0 * PI, &f2);
+            return f1 && f2;
+        }
+    return 0;
 }
 
 static void report_failure(sweep *w, double q_row, double hrow)
@@ -595,17 +640,22 @@ static void report_failure(sweep *w, double q_row, double hrow)
         return;
     }
     if (s == STEP_NO_ASSEMBLY) {
+        w->searching = 1;
         double span = is_angle_driver(m) ? 2.0 * PI : fabs(q_row - w->q0) * 4.0 + sv->lref;
         int found;
         double lower = lower_limit(w, span, hrow, &found);
-        double lo = fmin(lower, upper), hi = fmax(lower, upper);
+        double lo = fmin(lower, upper), hi = fmax(lower, upper), lo2, hi2;
+        char more[200] = "", qd[64], qe[64];
+        if (found && is_angle_driver(m) && other_interval(w, lo, hi, fabs(hrow), &lo2, &hi2))
+            snprintf(more, sizeof more, " and from %s to %s", q_text(m, lo2, qd, sizeof qd),
+                     q_text(m, hi2, qe, sizeof qe));
         diag_error(w->d, m->file, m->driver.mark,
                    "cannot assemble at %s = %s: %s does not close (residual %.3g m); the "
-                   "mechanism assembles for %s from %s%s to %s (limit positions%s)",
+                   "mechanism assembles for %s from %s%s to %s%s (limit positions%s)",
                    driver_word(m), q_text(m, q_row, qa, sizeof qa),
                    loop_label(sv, loop, lb, sizeof lb), resid, driver_word(m),
                    found || lo == lower ? "" : "at most ", q_text(m, lo, qb, sizeof qb),
-                   q_text(m, hi, qc, sizeof qc),
+                   q_text(m, hi, qc, sizeof qc), more,
                    found ? "" : "; the other side was not searched past one range");
         return;
     }

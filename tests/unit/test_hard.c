@@ -647,7 +647,7 @@ Test(hard, two_intervals_reports_the_current_one)
  * assembles for driver angle from 51.3178 deg to 125.1 deg (limit
  * positions)": the search for the lower limit stops at the first limit
  * (51.3178 deg) and the gap beyond it is never crossed. */
-Test(hard, two_intervals_both_reported, .disabled = true)
+Test(hard, two_intervals_both_reported)
 {
     mech_model *m = load("tests/hard/non-grashof-two-intervals.yaml", NULL);
     mech_diag d;
