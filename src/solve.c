@@ -24,13 +24,26 @@ static const double MAX_STEP = 1.0;
 
 /* ---- set-up ------------------------------------------------------------ */
 
-/* The largest distance between two points of one link (or of the ground),
- * the length scale of tolerances and slide columns. */
+/* The length scale of tolerances and slide columns: the largest distance
+ * between two points of one link (or of the ground). A link with many
+ * points (a ground with 10^4 pivots) uses its bounding box's diagonal
+ * instead, at most sqrt(2) larger, to stay linear in the size. */
 static double largest_length(const mech_model *m)
 {
     double L = 0.0;
     for (int l = 0; l < m->nlinks; l++) {
         const mech_link *k = &m->links[l];
+        if (k->npoints > 64) {
+            double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
+            for (int i = 0; i < k->npoints; i++) {
+                x0 = fmin(x0, k->points[i].x);
+                x1 = fmax(x1, k->points[i].x);
+                y0 = fmin(y0, k->points[i].y);
+                y1 = fmax(y1, k->points[i].y);
+            }
+            L = fmax(L, hypot(x1 - x0, y1 - y0));
+            continue;
+        }
         for (int i = 0; i < k->npoints; i++) {
             if (l == 0)
                 L = fmax(L, hypot(k->points[i].x, k->points[i].y));
