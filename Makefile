@@ -23,8 +23,8 @@ YAML_LIBS   := $(shell pkg-config --libs yaml-0.1 2>/dev/null || echo -lyaml)
 CRIT_LIBS   := $(shell pkg-config --libs criterion 2>/dev/null || echo -lcriterion)
 
 CFLAGS  = $(CFLAGS_BASE) $(OPT) $(SAN) -Iinclude $(YAML_CFLAGS) $(KLU_CFLAGS)
-LDLIBS  = $(YAML_LIBS) $(KLU_LIBS) -lm
-LDFLAGS = $(SAN)
+LDLIBS  = $(YAML_LIBS) $(KLU_LIBS) -lm -pthread
+LDFLAGS = $(SAN) -pthread
 
 CMD_SRC  = src/main.c $(wildcard src/cmd_*.c)
 CMD_OBJ  = $(CMD_SRC:src/%.c=$(BUILD)/obj/%.o)

@@ -14,4 +14,7 @@ int cmd_load_checked(const char *path, mech_model **m);
 extern const char cmd_solve_help[];
 int cmd_solve(int argc, char **argv);
 
+extern const char cmd_batch_help[];
+int cmd_batch(int argc, char **argv);
+
 #endif

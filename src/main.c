@@ -47,6 +47,8 @@ static const command commands[] = {
     {"solve", cmd_solve, "solve positions, velocities and accelerations over the driver range",
      cmd_solve_help},
     {"compare", cmd_compare, "compare a result CSV with a golden CSV", compare_help},
+    {"batch", cmd_batch, "solve many files on worker threads, with golden comparisons",
+     cmd_batch_help},
 };
 #define NCOMMANDS (sizeof commands / sizeof commands[0])
 

@@ -195,5 +195,29 @@ for f in mechanisms/*.yaml; do
     run "mech solve $f" 0 "$MECH" solve "$f" -o "$tmp/all.csv" && pass
 done
 
+# ---- mech batch -----------------------------------------------------------
+
+if run "mech batch --help" 0 "$MECH" batch --help; then
+    has_line "$tmp/out" '^usage: mech batch' "mech batch --help"
+fi
+mkdir "$tmp/bo"
+if run "mech batch all goldens" 0 "$MECH" batch -j 2 -q --out-dir "$tmp/bo" --golden tests/golden mechanisms/*.yaml; then
+    n=$(grep -c ' ok .* match$' "$tmp/out")
+    m=$(ls mechanisms/*.yaml | wc -l)
+    [ "$n" -eq "$m" ] && pass || fail "mech batch: $n of $m files ok and matching"
+    cmp -s "$tmp/bo/fourbar.csv" tests/golden/fourbar.csv && pass || fail "mech batch: fourbar.csv differs from a single solve's golden"
+fi
+if run "mech batch with failures" 1 "$MECH" batch -j 3 mechanisms/fourbar.yaml tests/solve/non-grashof.yaml tests/bad/01-bad-indentation.yaml mechanisms/slider-crank.yaml; then
+    has_line "$tmp/out" '^non-grashof  *FAILED' "batch: failing file reported"
+    has_line "$tmp/out" '^slider-crank  *ok' "batch: files after a failure still solved"
+    has_line "$tmp/err" 'cannot assemble at driver angle = 143 deg' "batch: messages kept per file"
+fi
+if run "mech batch --shard" 0 "$MECH" batch -q --shard 1/2 mechanisms/fourbar.yaml mechanisms/slider-crank.yaml mechanisms/stirling.yaml; then
+    lines=$(grep -c ' ok ' "$tmp/out")
+    [ "$lines" -eq 1 ] && grep -q '^slider-crank ' "$tmp/out" && pass || fail "--shard 1/2 of 3 files: expected only slider-crank, got $(cat "$tmp/out")"
+fi
+run "mech batch --shard 2/2" 2 "$MECH" batch --shard 2/2 mechanisms/fourbar.yaml && pass
+run "mech batch no files" 2 "$MECH" batch -j 2 && pass
+
 echo "cli: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]

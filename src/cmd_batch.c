@@ -1,0 +1,329 @@
+/* src/cmd_batch.c: `mech batch`, many mechanism files solved on worker
+ * threads (docs/batch.md).
+ *
+ * Each file is independent: its own model, solver and diagnostics, written
+ * to a memory stream and printed in file order at the end, so a failing file
+ * never disturbs the others and the output does not depend on the number of
+ * workers. Work is handed out by an atomic counter; --shard K/M keeps only
+ * the files whose index i satisfies i % M == K, for running one batch over
+ * several machines (GNU Parallel, Slurm job arrays). */
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "commands.h"
+#include "compare.h"
+
+const char cmd_batch_help[] =
+    "usage: mech batch FILE... [-j N] [--out-dir DIR] [--golden DIR] [--shard K/M]\n"
+    "                  [--rtol R] [--atol A] [--forces] [-q]\n"
+    "\n"
+    "Solve many mechanism files on N worker threads, each exactly as 'mech solve\n"
+    "FILE' would, and print a summary table: file, status, steps, worst residual,\n"
+    "time per step, and the golden comparison. A failing file does not stop or\n"
+    "change the others. Messages are printed per file, in the order given.\n"
+    "\n"
+    "options:\n"
+    "  -j, --jobs N      worker threads (default: the number of processors)\n"
+    "  --out-dir DIR     write DIR/NAME.csv for each FILE (NAME = its base name\n"
+    "                    without .yaml); without it nothing is written\n"
+    "  --golden DIR      compare each result with DIR/NAME.csv (mech compare)\n"
+    "  --rtol R, --atol A  tolerances of the golden comparison (1e-9, 1e-12)\n"
+    "  --shard K/M       solve only the files with index % M == K (0 <= K < M),\n"
+    "                    to split one batch over M machines\n"
+    "  --forces          also the force analysis, for every file\n"
+    "  -q, --quiet       no progress bar and no per-file messages, only the table\n"
+    "  -h, --help        show this help\n"
+    "\n"
+    "exit status: 0 every file solved (and matched its golden), 1 some file could\n"
+    "not be solved or differs from its golden, 2 bad usage or an invalid file,\n"
+    "3 a file cannot be read or written\n";
+
+typedef struct job {
+    const char *path;
+    char name[256];
+    int code;            /* exit status of this file */
+    int steps;
+    double worst_residual, us_per_step;
+    const char *golden;  /* "-", "match", "DIFFER", "missing", "error" */
+    char *messages;      /* diagnostics, printed at the end */
+    size_t msize;
+} job;
+
+typedef struct batch {
+    job *jobs;
+    int njobs;
+    atomic_int next, done;
+    const char *out_dir, *golden_dir;
+    compare_options cmp;
+    int forces, progress;
+} batch;
+
+static void base_name(const char *path, char *out, size_t size)
+{
+    const char *b = strrchr(path, '/');
+    b = b ? b + 1 : path;
+    snprintf(out, size, "%s", b);
+    size_t n = strlen(out);
+    if (n > 5 && strcmp(out + n - 5, ".yaml") == 0)
+        out[n - 5] = '\0';
+    else if (n > 4 && strcmp(out + n - 4, ".yml") == 0)
+        out[n - 4] = '\0';
+}
+
+static int exit_of(int rc)
+{
+    return rc == MECH_OK ? MECH_EXIT_OK
+           : rc == MECH_ESOLVE ? MECH_EXIT_SOLVE
+           : rc == MECH_EIO ? MECH_EXIT_IO : MECH_EXIT_INPUT;
+}
+
+static void compare_golden(const batch *b, job *jb, const char *csv, FILE *msg)
+{
+    char golden[4096];
+    snprintf(golden, sizeof golden, "%s/%s.csv", b->golden_dir, jb->name);
+    if (access(golden, R_OK) != 0) {
+        jb->golden = "missing";
+        fprintf(msg, "%s: no golden file %s\n", jb->path, golden);
+        if (jb->code == MECH_EXIT_OK)
+            jb->code = MECH_EXIT_SOLVE;
+        return;
+    }
+    int st = compare_csv_files(csv, golden, &b->cmp, NULL, NULL);
+    jb->golden = st == MECH_OK ? "match" : st == COMPARE_DIFFER ? "DIFFER" : "error";
+    if (st != MECH_OK) {  /* again, to say what differs */
+        compare_options o = b->cmp;
+        o.table = 1;
+        fprintf(msg, "%s: differs from %s:\n", jb->path, golden);
+        compare_csv_files(csv, golden, &o, msg, msg);
+    }
+    if (st != MECH_OK && jb->code == MECH_EXIT_OK)
+        jb->code = compare_exit_status(st);
+}
+
+/* One file, start to end; everything it says goes to jb->messages. */
+static void run_job(const batch *b, job *jb)
+{
+    FILE *msg = open_memstream(&jb->messages, &jb->msize);
+    FILE *out = msg ? msg : stderr;
+    mech_diag d;
+    mech_diag_init(&d);
+    mech_model *m = NULL;
+    mech_summary sum;
+    mech_table t = {0};
+    mech_solve_stats st = {0};
+    jb->golden = "-";
+    int rc = mech_load_file(jb->path, &m, &d);
+    if (rc == MECH_OK)
+        rc = mech_check(m, &sum, &d);
+    if (rc == MECH_OK) {
+        mech_solve_options o;
+        mech_solve_options_default(&o);
+        o.forces = b->forces;
+        rc = mech_solve(m, &o, &t, &st, &d);
+    }
+    mech_diag_print(&d, out);
+    mech_diag_free(&d);
+    jb->code = exit_of(rc);
+    jb->steps = st.steps;
+    jb->worst_residual = st.worst_residual;
+    jb->us_per_step = st.steps ? st.seconds / st.steps * 1e6 : 0.0;
+    char csv[4096] = "";
+    if (rc == MECH_OK && (b->out_dir || b->golden_dir)) {
+        if (b->out_dir)
+            snprintf(csv, sizeof csv, "%s/%s.csv", b->out_dir, jb->name);
+        else  /* golden only: a private temporary file */
+            snprintf(csv, sizeof csv, "%s/mech-batch-%ld-%d.csv",
+                     getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp", (long)getpid(),
+                     (int)(jb - b->jobs));
+        mech_diag_init(&d);
+        if (mech_table_write_csv(&t, csv, &d) != MECH_OK)
+            jb->code = MECH_EXIT_IO;
+        mech_diag_print(&d, out);
+        mech_diag_free(&d);
+        if (jb->code == MECH_EXIT_OK && b->golden_dir)
+            compare_golden(b, jb, csv, out);
+        if (!b->out_dir)
+            remove(csv);
+    }
+    mech_table_free(&t);
+    mech_model_free(&m);
+    if (msg)
+        fclose(msg);
+}
+
+static void progress(const batch *b, int done)
+{
+    if (!b->progress)
+        return;
+    int width = 40, fill = b->njobs ? done * width / b->njobs : width;
+    fprintf(stderr, "\r[%.*s%*s] %d/%d", fill, "########################################",
+            width - fill, "", done, b->njobs);
+    if (done == b->njobs)
+        fputc('\n', stderr);
+}
+
+static void *worker(void *arg)
+{
+    batch *b = arg;
+    for (;;) {
+        int i = atomic_fetch_add(&b->next, 1);
+        if (i >= b->njobs)
+            return NULL;
+        run_job(b, &b->jobs[i]);
+        int done = atomic_fetch_add(&b->done, 1) + 1;
+        progress(b, done);
+    }
+}
+
+static int default_jobs(void)
+{
+    long n = sysconf(_SC_NPROCESSORS_ONLN);
+    return n > 0 && n < 1024 ? (int)n : 1;
+}
+
+static int usage_error(const char *fmt, const char *arg)
+{
+    fputs("mech batch: ", stderr);
+    fprintf(stderr, fmt, arg);
+    fputs(" (see 'mech batch --help')\n", stderr);
+    return MECH_EXIT_INPUT;
+}
+
+static int parse_shard(const char *s, int *k, int *mod)
+{
+    char *end;
+    long a = strtol(s, &end, 10);
+    if (end == s || *end != '/')
+        return -1;
+    const char *p = end + 1;
+    long bnum = strtol(p, &end, 10);
+    if (end == p || *end != '\0' || bnum < 1 || a < 0 || a >= bnum || bnum > 1000000)
+        return -1;
+    *k = (int)a;
+    *mod = (int)bnum;
+    return 0;
+}
+
+static void print_table(const batch *b, FILE *out)
+{
+    fprintf(out, "%-28s %-6s %7s %12s %12s %s\n", "file", "status", "steps", "worst res m",
+            "us/step", "golden");
+    static const char *const words[] = {"ok", "FAILED", "INPUT", "IO"};
+    for (int i = 0; i < b->njobs; i++) {
+        const job *jb = &b->jobs[i];
+        fprintf(out, "%-28s %-6s %7d %12.3g %12.3g %s\n", jb->name,
+                jb->code >= 0 && jb->code <= 3 ? words[jb->code] : "?", jb->steps,
+                jb->worst_residual, jb->us_per_step, jb->golden ? jb->golden : "-");
+    }
+}
+
+int cmd_batch(int argc, char **argv)
+{
+    batch b;
+    memset(&b, 0, sizeof b);
+    compare_options_default(&b.cmp);
+    b.cmp.table = 0;
+    int nthreads = default_jobs(), quiet = 0, shard_k = 0, shard_m = 1;
+    const char **files = calloc((size_t)argc + 1, sizeof *files);
+    int nfiles = 0;
+    if (!files)
+        return MECH_EXIT_INPUT;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
+        int takes = !strcmp(a, "-j") || !strcmp(a, "--jobs") || !strcmp(a, "--out-dir") ||
+                    !strcmp(a, "--golden") || !strcmp(a, "--shard") || !strcmp(a, "--rtol") ||
+                    !strcmp(a, "--atol");
+        if (cmd_wants_help(a)) {
+            fputs(cmd_batch_help, stdout);
+            free(files);
+            return MECH_EXIT_OK;
+        }
+        if (takes && !v) {
+            free(files);
+            return usage_error("option '%s' needs a value", a);
+        }
+        char *end;
+        if (!strcmp(a, "-j") || !strcmp(a, "--jobs")) {
+            long n = strtol(v, &end, 10);
+            if (*end || n < 1 || n > 1024) {
+                free(files);
+                return usage_error("-j needs a number of workers from 1 to 1024, not '%s'", v);
+            }
+            nthreads = (int)n;
+        } else if (!strcmp(a, "--out-dir")) {
+            b.out_dir = v;
+        } else if (!strcmp(a, "--golden")) {
+            b.golden_dir = v;
+        } else if (!strcmp(a, "--rtol") || !strcmp(a, "--atol")) {
+            double x = strtod(v, &end);
+            if (*end || !(x >= 0)) {
+                free(files);
+                return usage_error("a tolerance must be a number >= 0, not '%s'", v);
+            }
+            *(a[2] == 'r' ? &b.cmp.rtol : &b.cmp.atol) = x;
+        } else if (!strcmp(a, "--shard")) {
+            if (parse_shard(v, &shard_k, &shard_m) < 0) {
+                free(files);
+                return usage_error("--shard needs K/M with 0 <= K < M, not '%s'", v);
+            }
+        } else if (!strcmp(a, "--forces")) {
+            b.forces = 1;
+        } else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
+            quiet = 1;
+        } else if (a[0] == '-' && a[1]) {
+            free(files);
+            return usage_error("unknown option '%s'", a);
+        } else {
+            files[nfiles++] = a;
+        }
+        if (takes)
+            i++;
+    }
+    if (nfiles == 0) {
+        free(files);
+        return usage_error("%s", "no files given (usage: mech batch FILE... [-j N])");
+    }
+    b.jobs = calloc((size_t)nfiles, sizeof *b.jobs);
+    if (!b.jobs) {
+        free(files);
+        return MECH_EXIT_INPUT;
+    }
+    for (int i = 0; i < nfiles; i++)
+        if (i % shard_m == shard_k) {
+            job *jb = &b.jobs[b.njobs++];
+            jb->path = files[i];
+            base_name(files[i], jb->name, sizeof jb->name);
+        }
+    b.progress = !quiet && isatty(STDERR_FILENO);
+    if (nthreads > b.njobs)
+        nthreads = b.njobs > 0 ? b.njobs : 1;
+    pthread_t *tid = calloc((size_t)nthreads, sizeof *tid);
+    int started = 0;
+    for (int t = 0; tid && t < nthreads; t++)
+        started += pthread_create(&tid[t], NULL, worker, &b) == 0;
+    if (started == 0)
+        worker(&b);  /* no threads: do the work here */
+    for (int t = 0; t < started; t++)
+        pthread_join(tid[t], NULL);
+    int code = MECH_EXIT_OK;
+    for (int i = 0; i < b.njobs; i++) {
+        job *jb = &b.jobs[i];
+        if (!quiet && jb->messages && jb->msize)
+            fputs(jb->messages, stderr);
+        free(jb->messages);
+        /* worst outcome: a failed solve or differing golden (1) outranks
+           invalid input (2) and unreadable files (3), then success */
+        if (jb->code == MECH_EXIT_SOLVE || (code == MECH_EXIT_OK && jb->code != MECH_EXIT_OK))
+            code = jb->code;
+    }
+    print_table(&b, stdout);
+    free(tid);
+    free(b.jobs);
+    free(files);
+    return code;
+}
