@@ -22,9 +22,10 @@
  *  8 mechanisms/stirling.yaml         1000 revolutions without drift
  *  9 (generated)                      a chain of 10 000 four-bar loops
  *
- * Tests of behaviour the solver does not have yet are disabled, each with a
+ * A test of behaviour the solver does not have yet is disabled, with a
  * comment FAILS TODAY saying what happens instead (the numbers are in
- * tests/hard/README.md). Run from the repository root (the files are found by
+ * tests/hard/README.md); one is, chain_10000_from_rough_guesses (case 9).
+ * Run from the repository root (the files are found by
  * relative path). Under a sanitizer (MECH_SANITIZE set in the environment, or
  * built with -fsanitize=address) the long runs of cases 8 and 9 are shorter.
  * Set MECH_HARD_VERBOSE=1 to print the measured errors, condition estimates
@@ -500,11 +501,11 @@ Test(hard, change_point_stays_on_declared_branch)
 /* The report says what happened: a change point, where the assembly
  * branches cross (and the sweep could continue on either), as the error that
  * stops the sweep or as a warning while it goes on on the declared branch.
- * FAILS TODAY: the sweep stops at 180 deg with "singular position at driver
- * angle = 180 deg (reciprocal condition 1e-06, limit 1e-06): a dead point,
- * toggle or branch point: the unknowns th_coupler, th_rocker are not
- * determined by loop 1 (B-C-O-A-B); velocities there are not unique", the
- * same words as a dead centre; nothing says the branches cross here. */
+ * The sweep stops at 180 deg with "singular position at driver angle =
+ * 180 deg (reciprocal condition 1e-06, limit 1e-06): a change point, where
+ * two assembly branches cross: the unknowns th_coupler (at 0.000 deg),
+ * th_rocker (at 180.000 deg) are not determined by loop 1 (B-C-O-A-B);
+ * velocities there are not unique". */
 Test(hard, change_point_reported_as_crossing)
 {
     mech_model *m = load("tests/hard/change-point.yaml", NULL);
@@ -528,10 +529,12 @@ Test(hard, change_point_reported_as_crossing)
 /* Without a declared branch and with no row on the crossing: the passage
  * from one assembly to the other is reported (error or warning, naming
  * about 180 deg), not done silently.
- * FAILS TODAY: mech_solve returns MECH_OK with no diagnostic at all; the
- * turn A-B-C changes sign between the rows at 179.501 and 180.499 deg
- * (-2.3e-05 then +2.3e-05 m^2) and the row at 360 deg is the crossed
- * assembly (coupler angle -0.9273 rad, +0.9273 at 0 deg). */
+ * mech_solve returns MECH_OK with the warning "between driver angle =
+ * 179.501 deg and 180.499 deg the Jacobian's determinant changes sign: the
+ * sweep passed a change point, where assembly branches cross, and may
+ * continue on the other assembly; declare `branch:` to keep one" (the row at
+ * 360 deg is the crossed assembly, coupler angle -0.9273 rad, +0.9273 at
+ * 0 deg). */
 Test(hard, change_point_undeclared_not_silent)
 {
     mech_model *m = load("tests/hard/change-point-undeclared.yaml", NULL);
@@ -642,11 +645,11 @@ Test(hard, two_intervals_reports_the_current_one)
 /* Issue 7 asks for "the crank-angle interval(s) where it assembles": the
  * other interval, [234.9004, 308.6822] deg (= [-125.0996, -51.3178]), is
  * named too.
- * FAILS TODAY: the message is "cannot assemble at driver angle = 126 deg:
- * loop 1 (B-C-O-A-B) does not close (residual 0.000298 m); the mechanism
- * assembles for driver angle from 51.3178 deg to 125.1 deg (limit
- * positions)": the search for the lower limit stops at the first limit
- * (51.3178 deg) and the gap beyond it is never crossed. */
+ * The message is "cannot assemble at driver angle = 126 deg: loop 1
+ * (B-C-O-A-B) does not close (residual 0.000298 m); the mechanism assembles
+ * for driver angle from 51.3178 deg to 125.1 deg and from 234.9 deg to
+ * 308.682 deg (limit positions)": the gap left by the first interval is
+ * searched from scattered starts. */
 Test(hard, two_intervals_both_reported)
 {
     mech_model *m = load("tests/hard/non-grashof-two-intervals.yaml", NULL);
@@ -784,11 +787,12 @@ static int angle_after(const char *msg, const char *word, double *deg)
 /* Issue 7: "detected as a singular position with its angle": the message
  * gives the crank angle at the dead centre, 0 deg at 130 mm and 180 deg at
  * 70 mm (the first "... deg" after the crank's name).
- * FAILS TODAY: the messages give only the displacement: "singular position
- * at driver displacement = 130 mm (reciprocal condition 6.7e-09, limit
- * 1e-06): a dead point, toggle or branch point: the unknowns th_crank, th_rod
- * are not determined by loop 1 (A-B-O-A); velocities there are not unique"
- * (and the same at 70 mm, reciprocal condition 2.2e-09). */
+ * The message is "singular position at driver displacement = 130 mm
+ * (reciprocal condition 6.7e-09, limit 1e-06): a dead point, toggle or limit
+ * position: the unknowns th_crank (at 0.000 deg), th_rod (at 0.000 deg) are
+ * not determined by loop 1 (A-B-O-A); velocities there are not unique", and
+ * at 70 mm (reciprocal condition 2.2e-09) "th_crank (at 180.000 deg), th_rod
+ * (at 0.000 deg)". */
 Test(hard, dead_centre_reports_crank_angle)
 {
     static const double to[2] = {0.130, 0.070}, want[2] = {0, 180};
