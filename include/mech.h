@@ -194,6 +194,18 @@ int mech_load_string(const char *text, size_t len, const char *name,
                      mech_model **out, mech_diag *d);
 void mech_model_free(mech_model **m);
 
+/* A replacement for one of the file's `parameters:`: its definition text
+ * ("135 mm", "l1 + 2 mm"), evaluated where the file's would have been. */
+typedef struct mech_override {
+    const char *name;
+    const char *text;
+} mech_override;
+
+/* mech_load_file with some parameters replaced (mech sweep). Naming a
+ * parameter the file does not define is an error. */
+int mech_load_file_with(const char *path, const mech_override *ov, int nov, mech_model **out,
+                        mech_diag *d);
+
 int mech_find_link(const mech_model *m, const char *name);   /* index or -1 */
 int mech_find_joint(const mech_model *m, const char *name);  /* index or -1 */
 int mech_find_point(const mech_model *m, const char *name);  /* name id or -1 */

@@ -17,4 +17,7 @@ int cmd_solve(int argc, char **argv);
 extern const char cmd_batch_help[];
 int cmd_batch(int argc, char **argv);
 
+extern const char cmd_sweep_help[];
+int cmd_sweep(int argc, char **argv);
+
 #endif

@@ -66,6 +66,9 @@ typedef struct loader {
     int *carrier_link;    /* are carrier_link[carrier_start[id] .. carrier_start[id + 1] - 1], */
     int *carrier_point;   /* ascending, with the point's index in each (carrier_point) */
     int carrier_ids;      /* point ids indexed (0: no index, search the links) */
+    const mech_override *ov; /* [nov] parameter definitions replaced (mech sweep) */
+    int nov;
+    unsigned char *ov_used;  /* [nov] the file defines it */
 } loader;
 
 static int find_point(const loader *ld, const char *name) { return name_map_get(&ld->point_map, name); }
@@ -492,7 +495,18 @@ static void load_parameters(loader *ld, const ynode *map)
         expr_param p = {0};
         char msg[256];
         size_t pos = 0;
-        if (quantity_eval_param(v->text, &ld->env, &p, msg, sizeof msg, &pos) < 0) {
+        const char *text = v->text;
+        for (int o = 0; o < ld->nov; o++)
+            if (strcmp(ld->ov[o].name, name) == 0) {
+                text = ld->ov[o].text;
+                ld->ov_used[o] = 1;
+            }
+        if (text != v->text && quantity_eval_param(text, &ld->env, &p, msg, sizeof msg, &pos) < 0) {
+            diag_error(ld->d, ld->file, v->mark, "parameter '%s' replaced by '%s': %s", name,
+                       text, msg);
+            continue;
+        }
+        if (text == v->text && quantity_eval_param(v->text, &ld->env, &p, msg, sizeof msg, &pos) < 0) {
             int echo = uses_bad_param(ld, v->text);
             if (name_map_put(&ld->bad_params, k->text, 1) < 0 || echo)
                 continue;
@@ -1721,8 +1735,27 @@ static void load_document(loader *ld, const ynode *root)
         default_outputs(m);
 }
 
+static int load_string_with(const char *text, size_t len, const char *name,
+                            const mech_override *ov, int nov, mech_model **out, mech_diag *d);
+
 int mech_load_string(const char *text, size_t len, const char *name, mech_model **out,
                      mech_diag *d)
+{
+    return load_string_with(text, len, name, NULL, 0, out, d);
+}
+
+/* Overrides naming no parameter of the file. */
+static void unused_overrides(loader *ld)
+{
+    for (int o = 0; o < ld->nov; o++)
+        if (!ld->ov_used[o])
+            diag_error(ld->d, ld->file, (mech_mark){0, 0},
+                       "no parameter '%s' in the file's 'parameters:' to replace",
+                       ld->ov[o].name);
+}
+
+static int load_string_with(const char *text, size_t len, const char *name,
+                            const mech_override *ov, int nov, mech_model **out, mech_diag *d)
 {
     *out = NULL;
     size_t errors_before = d->nerrors;
@@ -1732,6 +1765,14 @@ int mech_load_string(const char *text, size_t len, const char *name, mech_model 
     loader ld = {0};
     ld.file = name;
     ld.d = d;
+    ld.ov = ov;
+    ld.nov = nov;
+    unsigned char used[64] = {0};
+    ld.ov_used = used;
+    if (nov > 64) {
+        ytree_free(root);
+        return diag_error(d, name, (mech_mark){0, 0}, "at most 64 parameter replacements");
+    }
     ld.m = xcalloc(1, sizeof *ld.m);
     unit_defaults_init(&ld.units);
     ld.env.units = &ld.units;
@@ -1745,6 +1786,7 @@ int mech_load_string(const char *text, size_t len, const char *name, mech_model 
                        "'links:', 'driver:', ...), not %s", ynode_kind_name(root->kind));
     else
         load_document(&ld, root);
+    unused_overrides(&ld);
     ytree_free(root);
     free(ld.params);
     free(ld.link_failed);
@@ -1820,6 +1862,20 @@ int mech_load_file(const char *path, mech_model **out, mech_diag *d)
     if (!buf)
         return rc;
     rc = mech_load_string(buf, len, path, out, d);
+    free(buf);
+    return rc;
+}
+
+int mech_load_file_with(const char *path, const mech_override *ov, int nov, mech_model **out,
+                        mech_diag *d)
+{
+    *out = NULL;
+    size_t len = 0;
+    int rc;
+    char *buf = read_file(path, yaml_default_limits.max_bytes, &len, d, &rc);
+    if (!buf)
+        return rc;
+    rc = load_string_with(buf, len, path, ov, nov, out, d);
     free(buf);
     return rc;
 }

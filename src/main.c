@@ -49,6 +49,8 @@ static const command commands[] = {
     {"compare", cmd_compare, "compare a result CSV with a golden CSV", compare_help},
     {"batch", cmd_batch, "solve many files on worker threads, with golden comparisons",
      cmd_batch_help},
+    {"sweep", cmd_sweep, "solve a grid of variants of one mechanism, one summary row each",
+     cmd_sweep_help},
 };
 #define NCOMMANDS (sizeof commands / sizeof commands[0])
 

@@ -219,5 +219,21 @@ fi
 run "mech batch --shard 2/2" 2 "$MECH" batch --shard 2/2 mechanisms/fourbar.yaml && pass
 run "mech batch no files" 2 "$MECH" batch -j 2 && pass
 
+# ---- mech sweep -----------------------------------------------------------
+
+if run "mech sweep" 0 "$MECH" sweep mechanisms/slider-crank.yaml --vary r=30mm:60mm:4 --list l=45mm,140mm --metric range:x_B.s -j 2 -o "$tmp/sw.csv"; then
+    has_line "$tmp/sw.csv" '^variant,r,l,status,rows,range:x_B.s$' "sweep header"
+    has_line "$tmp/sw.csv" '^7,60 mm,140mm,ok,73,0.12$' "sweep: stroke = 2 r"
+    has_line "$tmp/sw.csv" '^6,60 mm,45mm,no-assembly,' "sweep: a variant that cannot assemble is a row, not a failure"
+fi
+if run "mech sweep --shard" 0 "$MECH" sweep mechanisms/slider-crank.yaml --vary r=30mm:60mm:4 --list l=45mm,140mm --metric range:x_B.s --shard 1/3; then
+    rows=$(grep -c '^[0-9]' "$tmp/out")
+    [ "$rows" -eq 3 ] && grep -q '^4,' "$tmp/out" && pass || fail "sweep --shard 1/3 of 8: expected variants 1, 4, 7"
+fi
+if run "mech sweep unknown parameter" 2 "$MECH" sweep mechanisms/slider-crank.yaml --list rr=40mm; then
+    has_line "$tmp/err" "no parameter 'rr'" "sweep: unknown parameter named"
+fi
+run "mech sweep bad range" 2 "$MECH" sweep mechanisms/slider-crank.yaml --vary r=30mm:60:4 && pass
+
 echo "cli: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]

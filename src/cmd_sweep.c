@@ -1,0 +1,448 @@
+/* src/cmd_sweep.c: `mech sweep`, a grid of variants of one mechanism
+ * (docs/batch.md). Each variant re-loads the file with some `parameters:`
+ * replaced, solves it, and reduces the table to the metrics asked for.
+ * Variants run on worker threads; rows come out in variant order, so the
+ * result does not depend on the workers, and --shard K/M splits the grid
+ * over machines (variant index i % M == K) with the index as first column
+ * for a deterministic merge (sort -n). */
+#include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "commands.h"
+
+const char cmd_sweep_help[] =
+    "usage: mech sweep FILE --vary NAME=FROM:TO:COUNT [--vary ...] [--list NAME=A,B,...]\n"
+    "                  [--metric M ...] [-o OUT.csv] [-j N] [--shard K/M] [--forces]\n"
+    "\n"
+    "Solve a grid of variants of one mechanism, changing its named parameters\n"
+    "(the file's 'parameters:'), and write one summary row per variant: the\n"
+    "variant's index, its parameter values, its status, and the metrics.\n"
+    "A variant that cannot assemble over the driver range is reported as such\n"
+    "(status 'no-assembly' or 'singular'), not as a failure of the run.\n"
+    "\n"
+    "options:\n"
+    "  --vary NAME=FROM:TO:COUNT  COUNT values from FROM to TO (inclusive); a unit\n"
+    "                    may follow the numbers, the same on both: l=130mm:150mm:5\n"
+    "  --list NAME=A,B,...        the given values (each may carry a unit)\n"
+    "                    several --vary/--list make a grid (every combination)\n"
+    "  --metric M        a summary of one output column over the sweep; M is\n"
+    "                    range:COL (max - min, e.g. range:x_B.s, the stroke),\n"
+    "                    max:COL, min:COL, maxabs:COL (e.g. maxabs:driver.torque,\n"
+    "                    the peak torque), or transmission:LINK1,LINK2 (the\n"
+    "                    smallest angle between the two links, 0..90 deg, e.g. the\n"
+    "                    transmission angle of a four-bar: coupler,rocker)\n"
+    "                    (default: the number of rows solved)\n"
+    "  -o FILE           write the summary CSV to FILE (default: standard output)\n"
+    "  -j, --jobs N      worker threads (default: the number of processors)\n"
+    "  --shard K/M       only the variants with index % M == K\n"
+    "  --forces          also the force analysis (needed for driver.torque metrics)\n"
+    "  -h, --help        show this help\n"
+    "\n"
+    "exit status: 0 the sweep ran (whatever the variants did), 2 bad usage or an\n"
+    "invalid file or parameter name, 3 a file cannot be read or written\n";
+
+enum { MAX_VARY = 8, MAX_METRICS = 32 };
+
+typedef struct axis {
+    char name[64];
+    char **texts;    /* [count] parameter texts, e.g. "135 mm" */
+    int count;
+} axis;
+
+typedef enum { MET_RANGE, MET_MAX, MET_MIN, MET_MAXABS, MET_TRANSMISSION } metric_kind;
+
+typedef struct metric {
+    metric_kind kind;
+    char col[128], col2[128];  /* column names (transmission: two link names) */
+    char label[160];
+} metric;
+
+typedef struct variant {
+    int index;
+    const char *status;      /* ok, no-assembly, singular, invalid, error */
+    int rows;
+    double value[MAX_METRICS];
+    char *messages;
+    size_t msize;
+} variant;
+
+typedef struct sweep_run {
+    const char *file;
+    axis axes[MAX_VARY];
+    int naxes;
+    metric metrics[MAX_METRICS];
+    int nmetrics;
+    int forces;
+    variant *vars;
+    int nvars;            /* variants in this shard */
+    atomic_int next;
+} sweep_run;
+
+static int usage_error(const char *fmt, const char *arg)
+{
+    fputs("mech sweep: ", stderr);
+    fprintf(stderr, fmt, arg);
+    fputs(" (see 'mech sweep --help')\n", stderr);
+    return MECH_EXIT_INPUT;
+}
+
+/* "130mm" -> 130 and "mm" */
+static int split_number(const char *s, double *v, char *unit, size_t size)
+{
+    char *end;
+    *v = strtod(s, &end);
+    if (end == s)
+        return -1;
+    while (*end == ' ')
+        end++;
+    snprintf(unit, size, "%s", end);
+    return 0;
+}
+
+static int add_text(axis *a, const char *text)
+{
+    char **t = realloc(a->texts, (size_t)(a->count + 1) * sizeof *t);
+    if (!t)
+        return -1;
+    a->texts = t;
+    a->texts[a->count] = strdup(text);
+    return a->texts[a->count++] ? 0 : -1;
+}
+
+static int parse_vary(sweep_run *r, const char *arg, int is_list)
+{
+    if (r->naxes == MAX_VARY)
+        return usage_error("at most 8 --vary/--list options ('%s')", arg);
+    const char *eq = strchr(arg, '=');
+    if (!eq || eq == arg || (size_t)(eq - arg) >= sizeof r->axes[0].name)
+        return usage_error("expected NAME=..., not '%s'", arg);
+    axis *a = &r->axes[r->naxes];
+    memset(a, 0, sizeof *a);
+    snprintf(a->name, sizeof a->name, "%.*s", (int)(eq - arg), arg);
+    char *spec = strdup(eq + 1), *save = NULL;
+    if (!spec)
+        return MECH_EXIT_INPUT;
+    int bad = 0;
+    if (is_list) {
+        for (char *w = strtok_r(spec, ",", &save); w && !bad; w = strtok_r(NULL, ",", &save))
+            bad = add_text(a, w) < 0;
+        bad |= a->count == 0;
+    } else {
+        char *from = strtok_r(spec, ":", &save), *to = strtok_r(NULL, ":", &save);
+        char *count = strtok_r(NULL, ":", &save), *end = NULL;
+        double f, t;
+        char uf[32], ut[32];
+        long n = count ? strtol(count, &end, 10) : 0;
+        bad = !from || !to || !count || *end || n < 1 || n > 1000000 ||
+              split_number(from, &f, uf, sizeof uf) < 0 ||
+              split_number(to, &t, ut, sizeof ut) < 0 || strcmp(uf, ut) != 0;
+        for (long i = 0; !bad && i < n; i++) {
+            char text[96];
+            double v = n == 1 ? f : f + (t - f) * (double)i / (double)(n - 1);
+            snprintf(text, sizeof text, "%.15g %s", v, uf);
+            bad = add_text(a, text) < 0;
+        }
+    }
+    free(spec);
+    if (bad)
+        return usage_error(is_list ? "--list needs NAME=A,B,..., not '%s'"
+                                   : "--vary needs NAME=FROM:TO:COUNT with the same unit on "
+                                     "FROM and TO, not '%s'", arg);
+    r->naxes++;
+    return -1;
+}
+
+static int parse_metric(sweep_run *r, const char *arg)
+{
+    static const struct { const char *prefix; metric_kind kind; } kinds[] = {
+        {"range:", MET_RANGE}, {"max:", MET_MAX}, {"min:", MET_MIN},
+        {"maxabs:", MET_MAXABS}, {"transmission:", MET_TRANSMISSION}};
+    if (r->nmetrics == MAX_METRICS)
+        return usage_error("at most 32 metrics ('%s')", arg);
+    metric *mt = &r->metrics[r->nmetrics];
+    memset(mt, 0, sizeof *mt);
+    for (size_t k = 0; k < sizeof kinds / sizeof kinds[0]; k++) {
+        size_t n = strlen(kinds[k].prefix);
+        if (strncmp(arg, kinds[k].prefix, n) != 0 || !arg[n])
+            continue;
+        mt->kind = kinds[k].kind;
+        snprintf(mt->label, sizeof mt->label, "%s", arg);
+        for (char *c = mt->label; *c; c++)  /* the label is a CSV header cell */
+            if (*c == ',')
+                *c = '/';
+        if (mt->kind == MET_TRANSMISSION) {
+            const char *comma = strchr(arg + n, ',');
+            if (!comma || comma == arg + n || !comma[1])
+                return usage_error("transmission:LINK1,LINK2, not '%s'", arg);
+            snprintf(mt->col, sizeof mt->col, "%.*s.angle", (int)(comma - arg - n), arg + n);
+            snprintf(mt->col2, sizeof mt->col2, "%s.angle", comma + 1);
+        } else {
+            snprintf(mt->col, sizeof mt->col, "%s", arg + n);
+        }
+        r->nmetrics++;
+        return -1;
+    }
+    return usage_error("unknown metric '%s' (range:, max:, min:, maxabs:, transmission:)", arg);
+}
+
+/* ---- one variant ------------------------------------------------------ */
+
+/* The parameter texts of variant v: axis k's index is a mixed-radix digit. */
+static void variant_overrides(const sweep_run *r, int v, mech_override *ov)
+{
+    for (int k = r->naxes - 1; k >= 0; k--) {
+        const axis *a = &r->axes[k];
+        ov[k].name = a->name;
+        ov[k].text = a->texts[v % a->count];
+        v /= a->count;
+    }
+}
+
+static double metric_value(const metric *mt, const mech_table *t, FILE *msg)
+{
+    int c = mech_table_column(t, mt->col), c2 = -1;
+    if (mt->kind == MET_TRANSMISSION)
+        c2 = mech_table_column(t, mt->col2);
+    if (c < 0 || (mt->kind == MET_TRANSMISSION && c2 < 0)) {
+        fprintf(msg, "metric %s: no column %s in the output (see 'mech solve --outputs')\n",
+                mt->label, c < 0 ? mt->col : mt->col2);
+        return NAN;
+    }
+    double lo = INFINITY, hi = -INFINITY, big = 0.0, tmin = INFINITY;
+    for (int i = 0; i < t->nrows; i++) {
+        double x = mech_table_get(t, i, c);
+        lo = fmin(lo, x);
+        hi = fmax(hi, x);
+        big = fmax(big, fabs(x));
+        if (c2 >= 0) {  /* angle between the link axes, folded to 0..90 deg */
+            double d = fabs(remainder(x - mech_table_get(t, i, c2), 3.14159265358979323846));
+            tmin = fmin(tmin, fmin(d, 3.14159265358979323846 - d));
+        }
+    }
+    switch (mt->kind) {
+    case MET_RANGE: return hi - lo;
+    case MET_MAX: return hi;
+    case MET_MIN: return lo;
+    case MET_MAXABS: return big;
+    case MET_TRANSMISSION: return tmin * 180.0 / 3.14159265358979323846;
+    }
+    return NAN;
+}
+
+static void run_variant(const sweep_run *r, variant *var)
+{
+    FILE *msg = open_memstream(&var->messages, &var->msize);
+    FILE *out = msg ? msg : stderr;
+    mech_override ov[MAX_VARY];
+    variant_overrides(r, var->index, ov);
+    mech_diag d;
+    mech_diag_init(&d);
+    mech_model *m = NULL;
+    mech_summary sum;
+    mech_table t = {0};
+    int rc = mech_load_file_with(r->file, ov, r->naxes, &m, &d);
+    if (rc == MECH_OK)
+        rc = mech_check(m, &sum, &d);
+    if (rc == MECH_OK) {
+        mech_solve_options o;
+        mech_solve_options_default(&o);
+        o.forces = r->forces;
+        rc = mech_solve(m, &o, &t, NULL, &d);
+    }
+    int singular = 0;
+    for (size_t i = 0; i < d.count; i++)
+        singular |= d.entries[i].message && strstr(d.entries[i].message, "singular") != NULL;
+    fprintf(out, "variant %d:", var->index);
+    for (int k = 0; k < r->naxes; k++)
+        fprintf(out, " %s=%s", ov[k].name, ov[k].text);
+    fputc('\n', out);
+    mech_diag_print(&d, out);
+    mech_diag_free(&d);
+    var->rows = t.nrows;
+    var->status = rc == MECH_OK ? "ok"
+                  : rc == MECH_ESOLVE ? (singular ? "singular" : "no-assembly")
+                  : rc == MECH_EIO ? "error" : "invalid";
+    for (int k = 0; k < r->nmetrics; k++)
+        var->value[k] = rc == MECH_OK ? metric_value(&r->metrics[k], &t, out) : NAN;
+    mech_table_free(&t);
+    mech_model_free(&m);
+    if (msg)
+        fclose(msg);
+}
+
+static void *worker(void *arg)
+{
+    sweep_run *r = arg;
+    for (;;) {
+        int i = atomic_fetch_add(&r->next, 1);
+        if (i >= r->nvars)
+            return NULL;
+        run_variant(r, &r->vars[i]);
+    }
+}
+
+/* ---- output ------------------------------------------------------------ */
+
+static void write_summary(const sweep_run *r, FILE *f)
+{
+    mech_override ov[MAX_VARY];
+    fprintf(f, "variant");
+    for (int k = 0; k < r->naxes; k++)
+        fprintf(f, ",%s", r->axes[k].name);
+    fprintf(f, ",status,rows");
+    for (int k = 0; k < r->nmetrics; k++)
+        fprintf(f, ",%s", r->metrics[k].label);
+    fputc('\n', f);
+    for (int i = 0; i < r->nvars; i++) {
+        const variant *v = &r->vars[i];
+        variant_overrides(r, v->index, ov);
+        fprintf(f, "%d", v->index);
+        for (int k = 0; k < r->naxes; k++)
+            fprintf(f, ",%s", ov[k].text);
+        fprintf(f, ",%s,%d", v->status, v->rows);
+        for (int k = 0; k < r->nmetrics; k++)
+            fprintf(f, ",%.17g", v->value[k]);
+        fputc('\n', f);
+    }
+}
+
+/* Whole or not at all, as the solver's CSV. */
+static int write_file(const sweep_run *r, const char *path)
+{
+    if (!path) {
+        write_summary(r, stdout);
+        return fflush(stdout) == 0 ? MECH_EXIT_OK : MECH_EXIT_IO;
+    }
+    char tmp[4096];
+    snprintf(tmp, sizeof tmp, "%s.tmp%ld", path, (long)getpid());
+    FILE *f = fopen(tmp, "w");
+    if (!f) {
+        fprintf(stderr, "mech sweep: cannot write %s\n", path);
+        return MECH_EXIT_IO;
+    }
+    write_summary(r, f);
+    int bad = ferror(f);
+    bad |= fclose(f) != 0;
+    if (bad || rename(tmp, path) != 0) {
+        remove(tmp);
+        fprintf(stderr, "mech sweep: cannot write %s\n", path);
+        return MECH_EXIT_IO;
+    }
+    return MECH_EXIT_OK;
+}
+
+static void free_run(sweep_run *r)
+{
+    for (int k = 0; k < r->naxes; k++) {
+        for (int i = 0; i < r->axes[k].count; i++)
+            free(r->axes[k].texts[i]);
+        free(r->axes[k].texts);
+    }
+    if (r->vars)
+        for (int i = 0; i < r->nvars; i++)
+            free(r->vars[i].messages);
+    free(r->vars);
+}
+
+int cmd_sweep(int argc, char **argv)
+{
+    sweep_run r;
+    memset(&r, 0, sizeof r);
+    const char *out = NULL;
+    long nthreads = sysconf(_SC_NPROCESSORS_ONLN);
+    int shard_k = 0, shard_m = 1, code = -1;
+    for (int i = 1; i < argc && code < 0; i++) {
+        const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
+        int takes = !strcmp(a, "--vary") || !strcmp(a, "--list") || !strcmp(a, "--metric") ||
+                    !strcmp(a, "-o") || !strcmp(a, "-j") || !strcmp(a, "--jobs") ||
+                    !strcmp(a, "--shard");
+        if (cmd_wants_help(a)) {
+            fputs(cmd_sweep_help, stdout);
+            free_run(&r);
+            return MECH_EXIT_OK;
+        }
+        if (takes && !v) {
+            code = usage_error("option '%s' needs a value", a);
+            break;
+        }
+        char *end;
+        if (!strcmp(a, "--vary") || !strcmp(a, "--list"))
+            code = parse_vary(&r, v, a[2] == 'l');
+        else if (!strcmp(a, "--metric"))
+            code = parse_metric(&r, v);
+        else if (!strcmp(a, "-o"))
+            out = v;
+        else if (!strcmp(a, "-j") || !strcmp(a, "--jobs")) {
+            nthreads = strtol(v, &end, 10);
+            if (*end || nthreads < 1 || nthreads > 1024)
+                code = usage_error("-j needs a number of workers from 1 to 1024, not '%s'", v);
+        } else if (!strcmp(a, "--shard")) {
+            char *slash;
+            shard_k = (int)strtol(v, &slash, 10);
+            shard_m = *slash == '/' ? (int)strtol(slash + 1, &end, 10) : 0;
+            if (slash == v || *slash != '/' || *end || shard_m < 1 || shard_k < 0 ||
+                shard_k >= shard_m)
+                code = usage_error("--shard needs K/M with 0 <= K < M, not '%s'", v);
+        } else if (!strcmp(a, "--forces"))
+            r.forces = 1;
+        else if (a[0] == '-' && a[1])
+            code = usage_error("unknown option '%s'", a);
+        else if (r.file)
+            code = usage_error("one file at a time ('%s' is a second file)", a);
+        else
+            r.file = a;
+        if (takes)
+            i++;
+    }
+    if (code < 0 && !r.file)
+        code = usage_error("%s", "no file given (usage: mech sweep FILE --vary NAME=FROM:TO:COUNT)");
+    if (code < 0 && r.naxes == 0)
+        code = usage_error("%s", "nothing to vary: give --vary NAME=FROM:TO:COUNT or --list");
+    long total = 1;
+    for (int k = 0; code < 0 && k < r.naxes; k++)
+        if ((total *= r.axes[k].count) > 10000000)
+            code = usage_error("%s", "more than 10^7 variants");
+    if (code >= 0) {
+        free_run(&r);
+        return code;
+    }
+    /* the file and the parameter names, checked once before the grid */
+    mech_override ov[MAX_VARY];
+    variant_overrides(&r, 0, ov);
+    mech_diag d;
+    mech_diag_init(&d);
+    mech_model *m = NULL;
+    int rc = mech_load_file_with(r.file, ov, r.naxes, &m, &d);
+    mech_diag_print(&d, stderr);
+    mech_diag_free(&d);
+    mech_model_free(&m);
+    if (rc != MECH_OK) {
+        free_run(&r);
+        return rc == MECH_EIO ? MECH_EXIT_IO : MECH_EXIT_INPUT;
+    }
+    r.vars = calloc((size_t)total, sizeof *r.vars);
+    for (long i = 0; r.vars && i < total; i++)
+        if (i % shard_m == shard_k)
+            r.vars[r.nvars++].index = (int)i;
+    if (nthreads > r.nvars)
+        nthreads = r.nvars > 0 ? r.nvars : 1;
+    pthread_t tid[64];
+    int started = 0;
+    for (int t = 0; r.vars && t < nthreads && t < 64; t++)
+        started += pthread_create(&tid[t], NULL, worker, &r) == 0;
+    if (r.vars && started == 0)
+        worker(&r);
+    for (int t = 0; t < started; t++)
+        pthread_join(tid[t], NULL);
+    for (int i = 0; r.vars && i < r.nvars; i++)
+        if (r.vars[i].messages && strcmp(r.vars[i].status, "ok") != 0)
+            fputs(r.vars[i].messages, stderr);
+    code = r.vars ? write_file(&r, out) : MECH_EXIT_INPUT;
+    free_run(&r);
+    return code;
+}
