@@ -4,6 +4,7 @@
 #   make run        deps + build + the main job: solve the Stirling engine
 #   make test       deps + build + the full test suite
 #   make test-san   the test suite built with -fsanitize=address,undefined
+#   make test-browser  figures and animation rendered by headless chromium
 #   make bench      optimised benchmarks, printed as tables
 #   make golden     regenerate tests/golden/*.csv (review the diff by hand)
 #   make install PREFIX=/usr/local
@@ -33,7 +34,7 @@ LIB_OBJ  = $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o)
 TEST_SRC = $(wildcard tests/unit/*.c)
 TEST_OBJ = $(TEST_SRC:tests/unit/%.c=$(BUILD)/tests/%.o)
 
-.PHONY: all deps run test test-san bench golden install clean
+.PHONY: all deps run test test-san test-valgrind test-browser bench golden install clean
 
 all: $(BUILD)/mech
 
@@ -80,17 +81,41 @@ test-san:
 	@$(MAKE) --no-print-directory test BUILD=build/san OPT="-O1 -g -fno-omit-frame-pointer" \
 	    SAN="-fsanitize=address,undefined -fno-sanitize-recover=all"
 
+# mech under valgrind on every mechanism: no invalid accesses, no leaks.
+test-valgrind: $(BUILD)/mech
+	MECH=$(BUILD)/mech sh tests/valgrind.sh
+
+# Figures and animation seen by headless chromium (docs/plots.md).
+test-browser: $(BUILD)/mech
+	MECH=$(BUILD)/mech OUT=$(BUILD)/browser sh tests/browser/run.sh
+
 # Benchmarks: optimised, no sanitizers; prints tables (docs/performance.md).
 bench:
-	@$(MAKE) --no-print-directory BUILD=build/bench OPT="-O2 -DNDEBUG" build/bench/bench-eval build/bench/bench-solve
+	@$(MAKE) --no-print-directory BUILD=build/bench OPT="-O2 -DNDEBUG" build/bench/bench-eval \
+	    build/bench/bench-solve build/bench/bench-hand build/bench/bench-accuracy build/bench/bench-scale
 	build/bench/bench-eval mechanisms/*.yaml
 	build/bench/bench-solve mechanisms/*.yaml
+	build/bench/bench-hand mechanisms
+	build/bench/bench-accuracy mechanisms build/bench
+	build/bench/bench-scale build/bench
 
 $(BUILD)/bench-eval: bench/bench_eval.c $(BUILD)/libmech.a $(HEADERS)
 	$(CC) $(CFLAGS) -Isrc -o $@ $< $(BUILD)/libmech.a $(LDLIBS)
 
 $(BUILD)/bench-solve: bench/bench_solve.c $(BUILD)/libmech.a $(HEADERS)
 	$(CC) $(CFLAGS) -Isrc -o $@ $< $(BUILD)/libmech.a $(LDLIBS)
+
+$(BUILD)/bench-hand: bench/bench_hand.c bench/bench_util.h $(BUILD)/libmech.a $(HEADERS)
+	$(CC) $(CFLAGS) -o $@ $< $(BUILD)/libmech.a $(LDLIBS)
+
+# the high-precision references use GCC's __float128 (libquadmath)
+$(BUILD)/bench-accuracy: bench/bench_accuracy.c bench/bench_util.h tests/unit/closed_forms.h \
+    $(BUILD)/libmech.a $(HEADERS)
+	$(CC) $(CFLAGS) -Itests/unit -o $@ $< $(BUILD)/libmech.a $(LDLIBS) -lquadmath
+
+# dense LU for comparison: LAPACK (liblapack-dev, a dependency of libsuitesparse-dev)
+$(BUILD)/bench-scale: bench/bench_scale.c bench/bench_util.h $(BUILD)/libmech.a $(HEADERS)
+	$(CC) $(CFLAGS) -Isrc -o $@ $< $(BUILD)/libmech.a $(LDLIBS) -llapack -lblas
 
 # Regenerate tests/golden/NAME.csv from mechanisms/NAME.yaml. Review the diff
 # (git diff --stat tests/golden; mech compare) before committing new goldens.

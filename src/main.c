@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cmd_plot.h"
 #include "commands.h"
 #include "compare.h"
 
@@ -51,6 +52,8 @@ static const command commands[] = {
      cmd_batch_help},
     {"sweep", cmd_sweep, "solve a grid of variants of one mechanism, one summary row each",
      cmd_sweep_help},
+    {"plot", cmd_plot, "draw SVG figures of the sweep (docs/plots.md)", cmd_plot_help},
+    {"animate", cmd_animate, "write an animated SVG of the mechanism", cmd_animate_help},
 };
 #define NCOMMANDS (sizeof commands / sizeof commands[0])
 

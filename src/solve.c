@@ -10,6 +10,7 @@
  * equilibrated before every factorisation, so the condition estimate measures the
  * geometry, not the units. */
 #include <btf.h>
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -587,12 +588,21 @@ step_status solver_newton(solver *sv, double q)
     }
     double r = evaluate(sv, sv->x, q, sv->f), prev_step = INFINITY;
     int max_iter = sv->opt.max_iter > 0 ? sv->opt.max_iter : 50;
-    const double xtol = sv->opt.tol;
+    /* The converged x is returned without its last correction (so that the
+       factors belong to it), so that correction bounds the error of x: it
+       must be below tol/100, or below the rounding floor of the step, about
+       eps times the condition number (from the previous position): results
+       then are accurate to rounding (docs/solver.md, section 2). */
+    double xtol = 1e-2 * sv->opt.tol;
     for (int it = 0;; it++) {
         if (!isfinite(r))
             return STEP_NO_ASSEMBLY;
         if (factor(sv) < 0)
             return STEP_SINGULAR;
+        if (!(sv->rcond > 0.0))  /* the first factorisation: a condition for the floor */
+            condition(sv);
+        if (it == 0)
+            xtol = fmax(1e-2 * sv->opt.tol, 8.0 * DBL_EPSILON / fmax(sv->rcond, 1e-300));
         linear_solve(sv, sv->f, sv->dx);
         double step = solver_step_size(sv, sv->dx);
         /* converged: residual small, and the step too, or no longer shrinking

@@ -1,0 +1,342 @@
+/* bench/bench_scale.c: how the cost grows with the mechanism. Generated
+ * chains of N four-bar loops (the chain of tests/unit/test_hard.c, case 9:
+ * loop k's rocker is rigidly loop k+1's crank, one link with three points;
+ * every loop a parallelogram, so the exact solution is known and the guesses
+ * are exact), N = 10 ... 100 000, each in a child process (fork) so that its
+ * peak memory (getrusage ru_maxrss) is its own:
+ *
+ *   load+check  mech_load_string + mech_check of the generated text
+ *   set-up      mech_solve's set-up (system, tape, blocks, klu_analyze)
+ *   per step    mech_solve's sweep time per driver step (60..110 deg, 10 steps):
+ *               wall time (stats.seconds) and CPU time (difference of 20- and
+ *               10-step sweeps, so that other processes on the machine matter less)
+ *   KLU         one klu_refactor + klu_solve of the Jacobian (2N x 2N)
+ *   dense       the same Jacobian by LAPACK dgetrf + dgetrs (N <= 1000; the
+ *               cost grows as N^3, N = 10 000 would take ~1000 times longer)
+ *
+ * A child that takes longer than 150 s is stopped and reported.
+ * Usage: bench-scale [SVGDIR]; bench-scale --yaml N > chain.yaml writes the
+ * chain of N loops (to run `mech solve` on it, or profile). Not a test. */
+#include <math.h>
+#include <signal.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <sys/types.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <klu.h>
+
+#include "bench_util.h"
+#include "mech.h"
+#include "system.h"
+
+/* LAPACK (Fortran calling convention) */
+void dgetrf_(const int *m, const int *n, double *a, const int *lda, int *ipiv, int *info);
+void dgetrs_(const char *trans, const int *n, const int *nrhs, const double *a, const int *lda,
+             const int *ipiv, double *b, const int *ldb, int *info);
+
+enum { NN = 5, DENSE_MAX = 1000, STEPS = 10, TIMEOUT = 150 };
+
+typedef struct result {
+    int ok, n, nnz, rows;
+    double load, setup, us_step, cpu_us_step, it_step, min_rcond, rss_mb, klu_factor_us, klu_re_us, dense_us;
+    char msg[256];
+} result;
+
+/* ---- the chain (as in tests/unit/test_hard.c, with exact guesses) --------- */
+
+#define DEG (M_PI / 180)
+static double chain_arm(int k) { return 0.3 + 0.1 * (k % 3); }
+static double chain_beta(int k) { return k % 2 == 0 ? 10.0 : -10.0; }
+static double chain_gy(int k) { return 0.2 * (k % 2); }
+
+typedef struct {
+    char *s;
+    size_t n, cap;
+} buf;
+
+static void put(buf *b, const char *fmt, ...)
+{
+    for (;;) {
+        va_list ap;
+        va_start(ap, fmt);
+        int k = vsnprintf(b->s + b->n, b->cap - b->n, fmt, ap);
+        va_end(ap);
+        if (k < 0)
+            exit(3);
+        if (b->n + (size_t)k < b->cap) {
+            b->n += (size_t)k;
+            return;
+        }
+        b->cap = 2 * b->cap + (size_t)k + 1;
+        if (!(b->s = realloc(b->s, b->cap)))
+            exit(3);
+    }
+}
+
+static char *chain_text(int n, size_t *len)
+{
+    buf b = {malloc(4096), 0, 4096};
+    put(&b, "name: chain of %d four-bar loops\nunits: {angle: deg}\nground:\n", n);
+    for (int k = 0; k <= n; k++)
+        put(&b, "  G%d: [%d, %.17g]\n", k, k, chain_gy(k));
+    put(&b, "links:\n");
+    for (int k = 0; k <= n; k++) {
+        put(&b, "  L%d: {points: {G%d: [0, 0]", k, k);
+        if (k > 0)
+            put(&b, ", B%d: [%.17g, 0]", k, chain_arm(k));
+        if (k < n)
+            put(&b, ", A%d: {length: %.17g, angle: %.17g}", k + 1, chain_arm(k + 1),
+                chain_beta(k));
+        put(&b, "}}\n");
+    }
+    for (int k = 1; k <= n; k++)
+        put(&b, "  C%d: {points: {A%d: [0, 0], B%d: [%.17g, 0]}}\n", k, k, k,
+            hypot(1.0, chain_gy(k) - chain_gy(k - 1)));
+    put(&b, "driver: {link: L0, angle: {from: 60, to: 110, steps: %d}}\ninitial:\n", STEPS);
+    double th = 60;
+    for (int k = 1; k <= n; k++) {
+        th += chain_beta(k - 1);
+        put(&b, "  L%d: %.17g\n  C%d: %.17g\n", k, th, k,
+            atan2(chain_gy(k) - chain_gy(k - 1), 1.0) / DEG);
+    }
+    put(&b, "outputs: {points: [B%d], links: [L%d, C%d]}\n", n, n, n);
+    *len = b.n;
+    return b.s;
+}
+
+/* ---- one N, in the child --------------------------------------------------- */
+
+static void measure(int N, result *r)
+{
+    size_t len;
+    char *text = chain_text(N, &len);
+    mech_diag d;
+    mech_diag_init(&d);
+    mech_model *m = NULL;
+    mech_summary sum;
+    double t0 = bench_now();
+    if (mech_load_string(text, len, "chain.yaml", &m, &d) != MECH_OK ||
+        mech_check(m, &sum, &d) != MECH_OK) {
+        snprintf(r->msg, sizeof r->msg, "load: %s", d.count ? d.entries[0].message : "?");
+        return;
+    }
+    r->load = bench_now() - t0;
+    free(text);
+    /* the sweep: the best of up to 5 runs (fewer for large N); wall time per
+       step from mech_solve's stats, CPU time per step from the difference
+       between sweeps of 2*STEPS and STEPS steps over the same range (the
+       set-up cancels; robust when other processes share the machine) */
+    int reps = N <= 1000 ? 5 : N <= 10000 ? 3 : 1;
+    double best = INFINITY, cpu[2] = {INFINITY, INFINITY};
+    mech_solve_stats st;
+    for (int k = 0; k < reps; k++)
+        for (int twice = 1; twice >= 0; twice--) {
+            mech_solve_options o;
+            mech_solve_options_default(&o);
+            o.has_range = 1;
+            o.from = m->driver.values[0];
+            o.to = m->driver.values[m->driver.nvalues - 1];
+            o.steps = STEPS * (1 + twice);
+            mech_table t = {0};
+            double c0 = bench_cpu();
+            if (mech_solve(m, &o, &t, &st, &d) != MECH_OK) {
+                snprintf(r->msg, sizeof r->msg, "solve: %s",
+                         d.count ? d.entries[0].message : "?");
+                return;
+            }
+            cpu[twice] = fmin(cpu[twice], bench_cpu() - c0);
+            mech_table_free(&t);
+            if (!twice && st.seconds < best)
+                best = st.seconds, r->setup = st.setup_seconds;
+        }
+    r->us_step = best / st.steps * 1e6;
+    r->cpu_us_step = (cpu[1] - cpu[0]) / STEPS * 1e6;
+    r->rows = st.steps;
+    r->it_step = (double)st.iterations / st.steps;
+    r->min_rcond = st.min_rcond;
+    /* the Jacobian at the first position (exact guesses) */
+    mech_system *s = NULL;
+    if (mech_system_new(m, &s, &d) != MECH_OK) {
+        snprintf(r->msg, sizeof r->msg, "system: %s", d.count ? d.entries[0].message : "?");
+        return;
+    }
+    int n = s->n;
+    r->n = n, r->nnz = s->nnz;
+    double *x = calloc((size_t)n, sizeof *x), *f = calloc((size_t)s->m, sizeof *f);
+    double *J = calloc((size_t)s->nnz, sizeof *J), *b = calloc((size_t)n, sizeof *b);
+    for (int g = 0; g < m->nguesses; g++)
+        if (!m->guesses[g].is_slider && s->link_var[m->guesses[g].index] >= 0)
+            x[s->link_var[m->guesses[g].index]] = m->guesses[g].value;
+    sys_eval_position(s, x, m->driver.values[0], f, J);
+    klu_common c;
+    klu_defaults(&c);
+    c.scale = 0, c.tol = 0.1; /* as src/solve.c */
+    klu_symbolic *sym = klu_analyze(n, s->Jp, s->Ji, &c);
+    double tf = bench_now();
+    klu_numeric *num = sym ? klu_factor(s->Jp, s->Ji, J, sym, &c) : NULL;
+    r->klu_factor_us = (bench_now() - tf) * 1e6;
+    if (!num) {
+        snprintf(r->msg, sizeof r->msg, "klu_factor failed (status %d)", c.status);
+        return;
+    }
+    int kreps = N <= 1000 ? 200 : N <= 10000 ? 20 : 5;
+    double tk[200];
+    for (int k = 0; k < kreps; k++) {
+        memcpy(b, f, sizeof *b * (size_t)n);
+        double t1 = bench_now();
+        klu_refactor(s->Jp, s->Ji, J, sym, num, &c);
+        klu_solve(sym, num, n, 1, b, &c);
+        tk[k] = bench_now() - t1;
+    }
+    r->klu_re_us = bench_median(tk, kreps) * 1e6;
+    klu_free_numeric(&num, &c);
+    klu_free_symbolic(&sym, &c);
+    /* peak memory so far: before the dense matrix */
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    r->rss_mb = (double)ru.ru_maxrss / 1024.0;
+    r->dense_us = NAN;
+    if (N <= DENSE_MAX) {
+        double *A = malloc(sizeof *A * (size_t)n * (size_t)n), *A0 = calloc((size_t)n * (size_t)n, sizeof *A0);
+        int *ipiv = malloc(sizeof *ipiv * (size_t)n), info, one = 1, dreps = N <= 100 ? 50 : 1;
+        double td[50];
+        for (int j = 0; j < n; j++)
+            for (int p = s->Jp[j]; p < s->Jp[j + 1]; p++)
+                A0[(size_t)j * (size_t)n + (size_t)s->Ji[p]] = J[p];
+        for (int k = 0; k < dreps; k++) {
+            memcpy(A, A0, sizeof *A * (size_t)n * (size_t)n);
+            memcpy(b, f, sizeof *b * (size_t)n);
+            double t1 = bench_now();
+            dgetrf_(&n, &n, A, &n, ipiv, &info);
+            dgetrs_("N", &n, &one, A, &n, ipiv, b, &n, &info);
+            td[k] = bench_now() - t1;
+        }
+        r->dense_us = bench_median(td, dreps) * 1e6;
+        free(A), free(A0), free(ipiv);
+    }
+    free(x), free(f), free(J), free(b);
+    mech_system_free(&s);
+    mech_model_free(&m);
+    mech_diag_free(&d);
+    r->ok = 1;
+}
+
+static result run_child(int N)
+{
+    result r;
+    memset(&r, 0, sizeof r);
+    int fd[2];
+    if (pipe(fd))
+        exit(3);
+    fflush(stdout);
+    pid_t pid = fork();
+    if (pid == 0) {
+        close(fd[0]);
+        alarm(TIMEOUT);
+        measure(N, &r);
+        if (write(fd[1], &r, sizeof r) != (ssize_t)sizeof r)
+            _exit(3);
+        _exit(0);
+    }
+    close(fd[1]);
+    ssize_t got = read(fd[0], &r, sizeof r);
+    close(fd[0]);
+    int status = 0;
+    waitpid(pid, &status, 0);
+    if (got != (ssize_t)sizeof r) {
+        memset(&r, 0, sizeof r);
+        snprintf(r.msg, sizeof r.msg, "%s",
+                 WIFSIGNALED(status) && WTERMSIG(status) == SIGALRM
+                     ? "stopped after 150 s"
+                     : "the child process failed");
+    }
+    return r;
+}
+
+/* least-squares slope of log y against log x over the points with y > 0 */
+static double slope(const int *x, const double *y, int n)
+{
+    double sx = 0, sy = 0, sxx = 0, sxy = 0;
+    int k = 0;
+    for (int i = 0; i < n; i++)
+        if (svg_ok(y[i])) {
+            double lx = log((double)x[i]), ly = log(y[i]);
+            sx += lx, sy += ly, sxx += lx * lx, sxy += lx * ly, k++;
+        }
+    return k < 2 ? NAN : (k * sxy - sx * sy) / (k * sxx - sx * sx);
+}
+
+int main(int argc, char **argv)
+{
+    if (argc > 2 && strcmp(argv[1], "--yaml") == 0) {
+        size_t len;
+        char *text = chain_text(atoi(argv[2]), &len);
+        fwrite(text, 1, len, stdout);
+        free(text);
+        return 0;
+    }
+    const char *svgdir = argc > 1 ? argv[1] : NULL;
+    static const int Ns[NN] = {10, 100, 1000, 10000, 100000};
+    result r[NN];
+    printf("scaling: chains of N four-bar loops (2N unknowns), %d driver steps; each N in its own\n"
+           "process; KLU and dense: one factorisation + solve of the same 2N x 2N Jacobian\n", STEPS);
+    printf("%7s %7s %8s %8s %8s %10s %10s %7s %9s %8s %11s %11s %12s %8s\n", "N", "unknowns",
+           "nnz", "load s", "setup s", "us/step", "CPU us/st", "it/step", "min rcond", "RSS MB", "KLU fact us",
+           "KLU re+sol", "dense LU us", "dense/KLU");
+    for (int i = 0; i < NN; i++) {
+        r[i] = run_child(Ns[i]);
+        if (!r[i].ok) {
+            printf("%7d  not measured: %s\n", Ns[i], r[i].msg);
+            r[i].us_step = r[i].rss_mb = r[i].klu_re_us = r[i].load = r[i].cpu_us_step = NAN;
+            r[i].dense_us = NAN;
+            continue;
+        }
+        printf("%7d %7d %8d %8.3f %8.3f %10.1f %10.1f %7.2f %9.2e %8.1f %11.1f %11.1f %12.1f "
+               "%8.1f\n", Ns[i], r[i].n, r[i].nnz, r[i].load, r[i].setup, r[i].us_step,
+               r[i].cpu_us_step, r[i].it_step,
+               r[i].min_rcond, r[i].rss_mb, r[i].klu_factor_us, r[i].klu_re_us, r[i].dense_us,
+               r[i].dense_us / r[i].klu_re_us);
+        fflush(stdout);
+    }
+    double y[7][NN];
+    for (int i = 0; i < NN; i++) {
+        y[6][i] = r[i].cpu_us_step;
+        y[0][i] = r[i].us_step, y[1][i] = r[i].klu_re_us, y[2][i] = r[i].dense_us;
+        y[3][i] = r[i].load * 1e6, y[4][i] = r[i].rss_mb, y[5][i] = r[i].setup * 1e6;
+    }
+    /* slopes over N >= 100 (N = 10 is dominated by constant costs) */
+    printf("log-log slopes for N >= 100 (1 = linear): time per step %.2f (CPU %.2f), KLU refactor+solve %.2f, "
+           "load+check %.2f, set-up %.2f, peak RSS %.2f; dense LU (N = 100..1000) %.2f\n",
+           slope(Ns + 1, y[0] + 1, NN - 1), slope(Ns + 1, y[6] + 1, NN - 1),
+           slope(Ns + 1, y[1] + 1, NN - 1),
+           slope(Ns + 1, y[3] + 1, NN - 1), slope(Ns + 1, y[5] + 1, NN - 1),
+           slope(Ns + 1, y[4] + 1, NN - 1), slope(Ns + 1, y[2] + 1, 2));
+    if (!svgdir)
+        return 0;
+    double xs[NN];
+    for (int i = 0; i < NN; i++)
+        xs[i] = Ns[i];
+    svg_series s[] = {
+        {"mech_solve, per step", xs, y[0], NN, SVG_COLORS[0], NULL},
+        {"same, CPU time", xs, y[6], NN, SVG_COLORS[0], "2,3"},
+        {"KLU refactor+solve", xs, y[1], NN, SVG_COLORS[2], NULL},
+        {"dense LU (LAPACK)", xs, y[2], NN, SVG_COLORS[1], NULL},
+        {"load+check (once)", xs, y[3], NN, SVG_COLORS[3], "6,3"},
+        {"set-up (once)", xs, y[5], NN, SVG_COLORS[4], "6,3"},
+    };
+    char path[600];
+    snprintf(path, sizeof path, "%s/scaling-time.svg", svgdir);
+    svg_loglog(path, "chain of N four-bar loops: time", "N (loops; 2N unknowns)",
+               "time [us]", s, (int)(sizeof s / sizeof s[0]));
+    svg_series sm[] = {{"peak RSS", xs, y[4], NN, SVG_COLORS[0], NULL}};
+    snprintf(path, sizeof path, "%s/scaling-memory.svg", svgdir);
+    svg_loglog(path, "chain of N four-bar loops: peak memory (ru_maxrss)",
+               "N (loops; 2N unknowns)", "peak RSS [MB]", sm, 1);
+    printf("wrote %s/scaling-time.svg, %s/scaling-memory.svg\n", svgdir, svgdir);
+    return 0;
+}

@@ -1,0 +1,394 @@
+/* src/cmd_plot.c: `mech plot` (SVG figures of the sweep) and `mech animate`
+ * (an animated SVG of the mechanism). Option parsing and the solve; the
+ * drawing is src/plot.c (docs/plots.md). */
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "cmd_plot.h"
+#include "commands.h"
+#include "plot.h"
+
+const char cmd_plot_help[] =
+    "usage: mech plot FILE [--out DIR] [--outputs NAME,...] [--steps N]\n"
+    "                 [--forces] [--friction on|off|both]\n"
+    "\n"
+    "Solve the driver sweep and draw one SVG figure per group of quantities\n"
+    "against the driver (angle in deg, or displacement in mm): point positions,\n"
+    "velocities and accelerations (x and y of each point), link angles, angular\n"
+    "velocities and accelerations, slider displacements, velocities and\n"
+    "accelerations, and with forces the reaction components Fx, Fy of every joint\n"
+    "and the driver torque, with and without friction when the file has friction.\n"
+    "The figures follow the file's outputs. Units: mm, deg, m/s, m/s^2, rad/s,\n"
+    "rad/s^2, N, N*m. Files are DIR/STEM-GROUP.svg, STEM the file's name without\n"
+    ".yaml; each written path is printed on standard output.\n"
+    "\n"
+    "options:\n"
+    "  --out DIR, -d DIR   directory of the figures (created if missing; default .)\n"
+    "  --outputs LIST      comma-separated point, link and slider names to plot\n"
+    "                      instead of the file's outputs\n"
+    "  --steps N           N intervals over the file's driver range\n"
+    "  --forces            also the forces (as 'outputs: {forces: true}')\n"
+    "  --friction MODE     on, off or both (default: both when a joint has friction)\n"
+    "  -h, --help          show this help\n"
+    "\n"
+    "exit status: 0 written, 1 the mechanism cannot be solved somewhere in the range\n"
+    "(nothing written), 2 invalid file or usage, 3 a file cannot be read or written\n";
+
+const char cmd_animate_help[] =
+    "usage: mech animate FILE [-o OUT.svg] [--duration S] [--steps N] [--frames N]\n"
+    "                    [--frame K] [--test-colours] [--pause-at T]\n"
+    "\n"
+    "Solve the positions over the driver range and write one self-contained\n"
+    "animated SVG (SMIL, no script, no network) of the mechanism going through\n"
+    "the range: links as bars (2 points) or plates (3 or more), pins as circles,\n"
+    "ground pivots hatched, sliders as blocks on their guides, and the paths of\n"
+    "the file's output points. It plays in any web browser.\n"
+    "\n"
+    "options:\n"
+    "  -o, --output FILE   write the SVG to FILE (temporary file renamed when\n"
+    "                      complete; default: standard output)\n"
+    "  --duration S        seconds for one pass through the range (default 4)\n"
+    "  --steps N           N intervals over the file's driver range\n"
+    "  --frames N          use at most N evenly spread positions (default 1000)\n"
+    "  --frame K           a still picture of position K (0 = the first), no animation\n"
+    "  --test-colours      draw in grey with every point a disc of its own colour\n"
+    "                      (for tests/browser/run.sh)\n"
+    "  --pause-at T        add an inline script that stops the animation at T s\n"
+    "                      (for tests; the SVG has no script otherwise)\n"
+    "  -h, --help          show this help\n"
+    "\n"
+    "exit status: 0 written, 1 the mechanism cannot be solved somewhere in the range\n"
+    "(nothing written), 2 invalid file or usage, 3 a file cannot be read or written\n";
+
+typedef struct plot_args {
+    const char *cmd;          /* "plot" or "animate" */
+    const char *file, *out, *outputs;
+    int steps, forces, friction; /* friction: -1 = default */
+    plot_anim_options anim;
+} plot_args;
+
+static int usage_error(const plot_args *a, const char *fmt, const char *arg)
+{
+    fprintf(stderr, "mech %s: ", a->cmd);
+    fprintf(stderr, fmt, arg);
+    fprintf(stderr, " (see 'mech %s --help')\n", a->cmd);
+    return MECH_EXIT_INPUT;
+}
+
+static int parse_count(const char *text, int lo, int hi, int *v)
+{
+    char *end;
+    double x = strtod(text, &end);
+    if (end == text || *end != '\0' || x < lo || x > hi || x != (int)x)
+        return 0;
+    *v = (int)x;
+    return 1;
+}
+
+/* One option of either command; *i advances past its value.
+ * Returns -1 to go on, else the exit status. */
+static int parse_option(plot_args *a, int argc, char **argv, int *i)
+{
+    const char *arg = argv[*i];
+    int animate = strcmp(a->cmd, "animate") == 0;
+    static const char *const valued[] = {"--out", "-d", "-o", "--output", "--outputs", "--steps",
+                                         "--friction", "--duration", "--frame", "--frames",
+                                         "--pause-at"};
+    int has_value = 0;
+    for (size_t k = 0; k < sizeof valued / sizeof valued[0]; k++)
+        has_value |= strcmp(arg, valued[k]) == 0;
+    if (!has_value) {
+        if (!animate && strcmp(arg, "--forces") == 0)
+            a->forces = 1;
+        else if (animate && (strcmp(arg, "--test-colours") == 0 ||
+                             strcmp(arg, "--test-colors") == 0))
+            a->anim.test_colours = 1;
+        else
+            return usage_error(a, "unknown option '%s'", arg);
+        return -1;
+    }
+    if (*i + 1 >= argc)
+        return usage_error(a, "option '%s' needs a value", arg);
+    const char *val = argv[++*i];
+    if (strcmp(arg, "--steps") == 0) {
+        if (!parse_count(val, 1, 100000000, &a->steps))
+            return usage_error(a, "--steps needs a whole number from 1 to 1e8, not '%s'", val);
+    } else if (!animate && (strcmp(arg, "--out") == 0 || strcmp(arg, "-d") == 0)) {
+        a->out = val;
+    } else if (!animate && strcmp(arg, "--outputs") == 0) {
+        a->outputs = val;
+    } else if (!animate && strcmp(arg, "--friction") == 0) {
+        if (strcmp(val, "on") == 0)
+            a->friction = MECH_FRICTION_ON;
+        else if (strcmp(val, "off") == 0)
+            a->friction = MECH_FRICTION_OFF;
+        else if (strcmp(val, "both") == 0)
+            a->friction = MECH_FRICTION_BOTH;
+        else
+            return usage_error(a, "--friction is on, off or both, not '%s'", val);
+    } else if (animate && (strcmp(arg, "-o") == 0 || strcmp(arg, "--output") == 0)) {
+        a->out = val;
+    } else if (animate && strcmp(arg, "--duration") == 0) {
+        char *end;
+        double s = strtod(val, &end);
+        if (end == val || *end != '\0' || !(s >= 0.01 && s <= 86400))
+            return usage_error(a, "--duration needs seconds from 0.01 to 86400, not '%s'", val);
+        a->anim.duration = s;
+    } else if (animate && strcmp(arg, "--frame") == 0) {
+        if (!parse_count(val, 0, 100000000, &a->anim.frame))
+            return usage_error(a, "--frame needs a position number from 0, not '%s'", val);
+    } else if (animate && strcmp(arg, "--pause-at") == 0) {
+        char *end;
+        double s = strtod(val, &end);
+        if (end == val || *end != '\0' || !(s >= 0 && s <= 86400))
+            return usage_error(a, "--pause-at needs seconds from 0 to 86400, not '%s'", val);
+        a->anim.pause_at = s;
+    } else if (animate && strcmp(arg, "--frames") == 0) {
+        if (!parse_count(val, 2, 1000000, &a->anim.max_frames))
+            return usage_error(a, "--frames needs a whole number from 2 to 1e6, not '%s'", val);
+    } else {
+        return usage_error(a, "unknown option '%s'", arg);
+    }
+    return -1;
+}
+
+/* Returns -1 to go on, else the exit status. */
+static int parse_args(int argc, char **argv, plot_args *a)
+{
+    for (int i = 1; i < argc; i++) {
+        const char *arg = argv[i];
+        if (cmd_wants_help(arg)) {
+            fputs(strcmp(a->cmd, "plot") == 0 ? cmd_plot_help : cmd_animate_help, stdout);
+            return MECH_EXIT_OK;
+        }
+        if (arg[0] == '-' && arg[1] != '\0') {
+            int code = parse_option(a, argc, argv, &i);
+            if (code >= 0)
+                return code;
+        } else if (a->file) {
+            return usage_error(a, "one file at a time ('%s' is a second file)", arg);
+        } else {
+            a->file = arg;
+        }
+    }
+    if (!a->file)
+        return usage_error(a, "%s", "no file given");
+    return -1;
+}
+
+/* --steps: re-space the file's driver range. */
+static void apply_steps(const plot_args *a, const mech_model *m, mech_solve_options *o)
+{
+    if (a->steps > 0 && m->has_driver && m->driver.nvalues > 0) {
+        o->has_range = 1;
+        o->from = m->driver.values[0];
+        o->to = m->driver.values[m->driver.nvalues - 1];
+        o->steps = a->steps;
+    }
+}
+
+/* Solve, printing the diagnostics; returns an exit status. */
+static int solve(const plot_args *a, const mech_model *m, const mech_solve_options *o,
+                 mech_table *t)
+{
+    mech_diag d;
+    mech_diag_init(&d);
+    int rc = mech_solve(m, o, t, NULL, &d);
+    mech_diag_print(&d, stderr);
+    mech_diag_free(&d);
+    if (rc == MECH_ESOLVE)
+        fprintf(stderr, "mech %s: %d of the sweep's positions were solved before this; "
+                "nothing written\n", a->cmd, t->nrows);
+    return rc == MECH_OK ? MECH_EXIT_OK : rc == MECH_ESOLVE ? MECH_EXIT_SOLVE : MECH_EXIT_INPUT;
+}
+
+/* mkdir -p */
+static int make_dir(const char *dir)
+{
+    char *p = malloc(strlen(dir) + 1);
+    if (!p)
+        return -1;
+    strcpy(p, dir);
+    for (char *s = p + 1;; s++) {
+        if (*s == '/' || *s == '\0') {
+            char c = *s;
+            *s = '\0';
+            if (mkdir(p, 0777) != 0 && errno != EEXIST) {
+                free(p);
+                return -1;
+            }
+            *s = c;
+            if (c == '\0')
+                break;
+        }
+    }
+    free(p);
+    struct stat st;
+    return stat(dir, &st) == 0 && S_ISDIR(st.st_mode) ? 0 : -1;
+}
+
+/* The file's name without directory and .yaml/.yml. */
+static void file_stem(const char *path, char *buf, size_t n)
+{
+    const char *b = strrchr(path, '/');
+    snprintf(buf, n, "%s", b ? b + 1 : path);
+    size_t len = strlen(buf);
+    if (len > 5 && strcmp(buf + len - 5, ".yaml") == 0)
+        buf[len - 5] = '\0';
+    else if (len > 4 && strcmp(buf + len - 4, ".yml") == 0)
+        buf[len - 4] = '\0';
+}
+
+static int any_friction(const mech_model *m)
+{
+    for (int j = 0; j < m->njoints; j++)
+        if (m->joints[j].friction > 0)
+            return 1;
+    return 0;
+}
+
+static int write_figures(const plot_args *a, const mech_model *m, const mech_table *t)
+{
+    enum { MAXFIG = 4096 };
+    const char *dir = a->out ? a->out : ".";
+    if (make_dir(dir) != 0) {
+        fprintf(stderr, "%s: error: cannot create the directory: %s\n", dir, strerror(errno));
+        return MECH_EXIT_IO;
+    }
+    plot_figure *figs = calloc(MAXFIG, sizeof *figs);
+    if (!figs) {
+        fprintf(stderr, "mech plot: out of memory\n");
+        return MECH_EXIT_IO;
+    }
+    int n = plot_plan(m, t, figs, MAXFIG);
+    if (n == 0)
+        fprintf(stderr, "mech plot: %s: nothing to plot (no outputs)\n", a->file);
+    char stem[256];
+    file_stem(a->file, stem, sizeof stem);
+    int code = MECH_EXIT_OK;
+    for (int k = 0; k < n && code == MECH_EXIT_OK; k++) {
+        size_t len = strlen(dir) + strlen(stem) + strlen(figs[k].name) + 8;
+        char *path = malloc(len);
+        if (!path) {
+            code = MECH_EXIT_IO;
+            break;
+        }
+        snprintf(path, len, "%s/%s-%s.svg", dir, stem, figs[k].name);
+        mech_diag d;
+        mech_diag_init(&d);
+        if (plot_figure_write(m, t, &figs[k], m->name, path, &d) != MECH_OK)
+            code = MECH_EXIT_IO;
+        else
+            printf("%s\n", path);
+        mech_diag_print(&d, stderr);
+        mech_diag_free(&d);
+        free(path);
+    }
+    free(figs);
+    return code;
+}
+
+int cmd_plot(int argc, char **argv)
+{
+    plot_args a = {.cmd = "plot", .friction = -1};
+    plot_anim_options_default(&a.anim);
+    int code = parse_args(argc, argv, &a);
+    if (code >= 0)
+        return code;
+    mech_model *m = NULL;
+    if ((code = cmd_load_checked(a.file, &m)) != MECH_EXIT_OK)
+        return code;
+    char err[256];
+    if (a.outputs && mech_select_outputs(m, a.outputs, err, sizeof err) != MECH_OK) {
+        fprintf(stderr, "mech plot: --outputs: %s\n", err);
+        mech_model_free(&m);
+        return MECH_EXIT_INPUT;
+    }
+    mech_solve_options o;
+    mech_solve_options_default(&o);
+    o.forces = a.forces;
+    if (a.friction >= 0)
+        o.friction = a.friction;
+    else if ((a.forces || m->outputs.forces) && any_friction(m))
+        o.friction = MECH_FRICTION_BOTH;
+    apply_steps(&a, m, &o);
+    mech_table t = {0};
+    code = solve(&a, m, &o, &t);
+    if (code == MECH_EXIT_OK)
+        code = write_figures(&a, m, &t);
+    mech_table_free(&t);
+    mech_model_free(&m);
+    return code;
+}
+
+/* Outputs of the animation: every point name and every moving link; the
+ * file's output points are kept in *trace (owned by the caller). */
+static int select_everything(mech_model *m, int **trace, int *ntrace)
+{
+    int *pts = malloc(((size_t)m->npoint_names + 1) * sizeof *pts);
+    int *links = malloc(((size_t)m->nlinks + 1) * sizeof *links);
+    int *sliders = malloc(sizeof *sliders);
+    if (!pts || !links || !sliders) {
+        free(pts);
+        free(links);
+        free(sliders);
+        return -1;
+    }
+    for (int p = 0; p < m->npoint_names; p++)
+        pts[p] = p;
+    for (int i = 1; i < m->nlinks; i++)
+        links[i - 1] = i;
+    *trace = m->outputs.points;
+    *ntrace = m->outputs.npoints;
+    free(m->outputs.links);
+    free(m->outputs.sliders);
+    m->outputs.points = pts;
+    m->outputs.npoints = m->npoint_names;
+    m->outputs.links = links;
+    m->outputs.nlinks = m->nlinks - 1;
+    m->outputs.sliders = sliders;
+    m->outputs.nsliders = 0;
+    m->outputs.forces = 0;
+    return 0;
+}
+
+int cmd_animate(int argc, char **argv)
+{
+    plot_args a = {.cmd = "animate", .friction = -1};
+    plot_anim_options_default(&a.anim);
+    int code = parse_args(argc, argv, &a);
+    if (code >= 0)
+        return code;
+    mech_model *m = NULL;
+    if ((code = cmd_load_checked(a.file, &m)) != MECH_EXIT_OK)
+        return code;
+    int *trace = NULL, ntrace = 0;
+    if (select_everything(m, &trace, &ntrace) != 0) {
+        fprintf(stderr, "mech animate: out of memory\n");
+        mech_model_free(&m);
+        return MECH_EXIT_IO;
+    }
+    a.anim.trace = trace;
+    a.anim.ntrace = ntrace;
+    mech_solve_options o;
+    mech_solve_options_default(&o);
+    o.want = MECH_WANT_POSITION;
+    apply_steps(&a, m, &o);
+    mech_table t = {0};
+    code = solve(&a, m, &o, &t);
+    if (code == MECH_EXIT_OK) {
+        mech_diag d;
+        mech_diag_init(&d);
+        int rc = plot_animation_write(m, &t, &a.anim, a.out ? a.out : "-", &d);
+        mech_diag_print(&d, stderr);
+        mech_diag_free(&d);
+        code = rc == MECH_OK ? MECH_EXIT_OK : rc == MECH_EINPUT ? MECH_EXIT_INPUT : MECH_EXIT_IO;
+    }
+    free(trace);
+    mech_table_free(&t);
+    mech_model_free(&m);
+    return code;
+}

@@ -1,0 +1,34 @@
+#!/bin/sh
+# tests/valgrind.sh: `mech solve` (with forces) on every mechanism and the
+# failure cases under valgrind: no invalid reads or writes, no leaks.
+# Run from the repository root:  MECH=build/mech sh tests/valgrind.sh
+MECH=${MECH:-build/mech}
+command -v valgrind >/dev/null || { echo "valgrind: not installed (apt-get install valgrind)" >&2; exit 2; }
+tmp=${TMPDIR:-/tmp}/mech-valgrind.$$
+mkdir "$tmp" || exit 2
+trap 'rm -rf "$tmp"' EXIT
+passed=0
+failed=0
+check() {  # check LABEL ARGS...: valgrind must report nothing (exit 99 on errors)
+    label=$1
+    shift
+    valgrind -q --leak-check=full --show-leak-kinds=definite,indirect \
+        --errors-for-leak-kinds=definite,indirect --error-exitcode=99 \
+        "$MECH" "$@" >"$tmp/out" 2>"$tmp/err"
+    if [ $? -eq 99 ]; then
+        failed=$((failed + 1))
+        echo "FAIL: $label"
+        sed 's/^/    /' "$tmp/err" | head -n 30
+    else
+        passed=$((passed + 1))
+    fi
+}
+for f in mechanisms/*.yaml tests/solve/*.yaml tests/hard/*.yaml; do
+    check "mech solve --forces $f" solve "$f" --forces --friction both -o "$tmp/x.csv"
+done
+check "mech batch" batch -j 2 -q mechanisms/*.yaml tests/solve/*.yaml
+check "mech sweep" sweep mechanisms/slider-crank.yaml --list l=45mm,140mm --metric range:x_B.s -j 2
+check "mech plot" plot mechanisms/fourbar.yaml --out "$tmp/plots"
+check "mech animate" animate mechanisms/fourbar.yaml -o "$tmp/a.svg"
+echo "valgrind: $passed passed, $failed failed"
+[ "$failed" -eq 0 ]
