@@ -92,12 +92,14 @@ test-browser: $(BUILD)/mech
 # Benchmarks: optimised, no sanitizers; prints tables (docs/performance.md).
 bench:
 	@$(MAKE) --no-print-directory BUILD=build/bench OPT="-O2 -DNDEBUG" build/bench/bench-eval \
-	    build/bench/bench-solve build/bench/bench-hand build/bench/bench-accuracy build/bench/bench-scale
+	    build/bench/bench-solve build/bench/bench-hand build/bench/bench-accuracy build/bench/bench-scale \
+	    build/bench/mech
 	build/bench/bench-eval mechanisms/*.yaml
 	build/bench/bench-solve mechanisms/*.yaml
 	build/bench/bench-hand mechanisms
 	build/bench/bench-accuracy mechanisms build/bench
 	build/bench/bench-scale build/bench
+	MECH=build/bench/mech sh bench/bench_batch.sh
 
 $(BUILD)/bench-eval: bench/bench_eval.c $(BUILD)/libmech.a $(HEADERS)
 	$(CC) $(CFLAGS) -Isrc -o $@ $< $(BUILD)/libmech.a $(LDLIBS)
