@@ -31,6 +31,8 @@ const char cmd_solve_help[] =
     "  --max-iter N        Newton iterations per step before giving up (default 50)\n"
     "  --min-rcond R       reciprocal condition below which a position is reported\n"
     "                      singular (default 1e-6)\n"
+    "  --set NAME=VALUE    replace the file's parameter NAME by VALUE (repeatable),\n"
+    "                      e.g. --set 'l=150 mm'\n"
     "  --outputs LIST      comma-separated point, link and slider names to output\n"
     "                      instead of the file's outputs\n"
     "  --level L           positions, velocities or accelerations (default): the\n"
@@ -52,8 +54,13 @@ const char cmd_solve_help[] =
     "(the message gives the driver position, the loop and the unknowns involved;\n"
     "no output is written), 2 invalid file or usage, 3 a file cannot be read or written\n";
 
+enum { MAX_SET = 64 };
+
 typedef struct solve_args {
     const char *file, *out, *from, *to, *outputs;
+    mech_override set[MAX_SET];  /* --set NAME=VALUE: parameters replaced */
+    char *set_text[MAX_SET];
+    int nset;
     int steps, stats, verbose;
     mech_solve_options opt;
 } solve_args;
@@ -75,7 +82,7 @@ static int parse_number(const char *text, double *v)
 
 static const char *const value_options[] = {"-o", "--output", "--from", "--to", "--outputs",
                                            "--steps", "--tol", "--max-iter", "--min-rcond",
-                                           "--level", "--friction"};
+                                           "--level", "--friction", "--set"};
 
 static int takes_value(const char *arg)
 {
@@ -113,6 +120,17 @@ static int parse_valued(solve_args *a, const char *arg, const char *val)
         if (!parse_number(val, &num) || !(num > 0 && num < 1))
             return usage_error("--min-rcond needs a number between 0 and 1, not '%s'", val);
         a->opt.min_rcond = num;
+    } else if (strcmp(arg, "--set") == 0) {
+        const char *eq = strchr(val, '=');
+        if (!eq || eq == val || !eq[1] || a->nset == MAX_SET)
+            return usage_error("--set needs NAME=VALUE (at most 64), not '%s'", val);
+        char *copy = strdup(val);
+        if (!copy)
+            return MECH_EXIT_INPUT;
+        copy[eq - val] = '\0';
+        a->set_text[a->nset] = copy;
+        a->set[a->nset].name = copy;
+        a->set[a->nset++].text = copy + (eq - val) + 1;
     } else if (strcmp(arg, "--friction") == 0) {
         if (strcmp(val, "on") == 0)
             a->opt.friction = MECH_FRICTION_ON;
@@ -221,14 +239,37 @@ static void print_stats(const mech_model *m, const mech_solve_stats *st, FILE *o
             per * 1e6, st->seconds, st->setup_seconds);
 }
 
+/* Load and check with the --set parameters replaced. */
+static int load_with_set(solve_args *a, mech_model **m)
+{
+    mech_diag d;
+    mech_diag_init(&d);
+    mech_summary s;
+    int rc = mech_load_file_with(a->file, a->set, a->nset, m, &d);
+    if (rc == MECH_OK)
+        rc = mech_check(*m, &s, &d);
+    mech_diag_print(&d, stderr);
+    mech_diag_free(&d);
+    if (rc == MECH_OK)
+        return MECH_EXIT_OK;
+    mech_model_free(m);
+    return rc == MECH_EIO ? MECH_EXIT_IO : MECH_EXIT_INPUT;
+}
+
 int cmd_solve(int argc, char **argv)
 {
     solve_args a = {0};
     int code = parse_args(argc, argv, &a);
-    if (code >= 0)
+    if (code >= 0) {
+        for (int i = 0; i < a.nset; i++)
+            free(a.set_text[i]);
         return code;
+    }
     mech_model *m = NULL;
-    if ((code = cmd_load_checked(a.file, &m)) != MECH_EXIT_OK)
+    code = a.nset ? load_with_set(&a, &m) : cmd_load_checked(a.file, &m);
+    for (int i = 0; i < a.nset; i++)
+        free(a.set_text[i]);
+    if (code != MECH_EXIT_OK)
         return code;
     if ((code = apply_overrides(&a, m)) >= 0) {
         mech_model_free(&m);

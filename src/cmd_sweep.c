@@ -23,7 +23,8 @@ const char cmd_sweep_help[] =
     "(the file's 'parameters:'), and write one summary row per variant: the\n"
     "variant's index, its parameter values, its status, and the metrics.\n"
     "A variant that cannot assemble over the driver range is reported as such\n"
-    "(status 'no-assembly' or 'singular'), not as a failure of the run.\n"
+    "(status 'no-assembly', 'singular' or 'self-locking' when joint friction\n"
+    "locks it), not as a failure of the run.\n"
     "\n"
     "options:\n"
     "  --vary NAME=FROM:TO:COUNT  COUNT values from FROM to TO (inclusive); a unit\n"
@@ -254,9 +255,12 @@ static void run_variant(const sweep_run *r, variant *var)
         o.forces = r->forces;
         rc = mech_solve(m, &o, &t, NULL, &d);
     }
-    int singular = 0;
-    for (size_t i = 0; i < d.count; i++)
-        singular |= d.entries[i].message && strstr(d.entries[i].message, "singular") != NULL;
+    int singular = 0, locking = 0;
+    for (size_t i = 0; i < d.count; i++) {
+        const char *msgtext = d.entries[i].message ? d.entries[i].message : "";
+        singular |= strstr(msgtext, "singular") != NULL;
+        locking |= strstr(msgtext, "friction does not converge") != NULL;
+    }
     fprintf(out, "variant %d:", var->index);
     for (int k = 0; k < r->naxes; k++)
         fprintf(out, " %s=%s", ov[k].name, ov[k].text);
@@ -265,7 +269,7 @@ static void run_variant(const sweep_run *r, variant *var)
     mech_diag_free(&d);
     var->rows = t.nrows;
     var->status = rc == MECH_OK ? "ok"
-                  : rc == MECH_ESOLVE ? (singular ? "singular" : "no-assembly")
+                  : rc == MECH_ESOLVE ? (locking ? "self-locking" : singular ? "singular" : "no-assembly")
                   : rc == MECH_EIO ? "error" : "invalid";
     for (int k = 0; k < r->nmetrics; k++)
         var->value[k] = rc == MECH_OK ? metric_value(&r->metrics[k], &t, out) : NAN;

@@ -1,7 +1,8 @@
 #!/bin/sh
-# tests/golden.sh: solve every mechanism in mechanisms/ and compare the result
-# with its reviewed golden CSV in tests/golden/ (see tests/golden/README.md).
-# Run from the repository root:  MECH=build/mech sh tests/golden.sh
+# tests/golden.sh: solve every mechanism in mechanisms/ with `mech batch` and
+# compare each result with its reviewed golden CSV in tests/golden/ (see
+# tests/golden/README.md). Run from the repository root:
+#   MECH=build/mech sh tests/golden.sh
 # Regenerate the goldens with `make golden`, then review the diff by hand.
 MECH=${MECH:-build/mech}
 if [ ! -x "$MECH" ]; then
@@ -13,28 +14,16 @@ mkdir "$tmp" || exit 2
 trap 'rm -rf "$tmp"' EXIT
 trap 'exit 2' INT TERM HUP
 
-passed=0
-failed=0
-for f in mechanisms/*.yaml; do
-    name=$(basename "$f" .yaml)
-    golden=tests/golden/$name.csv
-    if [ ! -f "$golden" ]; then
-        failed=$((failed + 1))
-        echo "FAIL: $f has no golden file $golden (make golden, then review it)"
-        continue
-    fi
-    if ! "$MECH" solve "$f" -o "$tmp/$name.csv" 2>"$tmp/err"; then
-        failed=$((failed + 1))
-        echo "FAIL: mech solve $f: $(head -n 1 "$tmp/err")"
-        continue
-    fi
-    if "$MECH" compare "$tmp/$name.csv" "$golden" >"$tmp/report" 2>&1; then
-        passed=$((passed + 1))
-    else
-        failed=$((failed + 1))
-        echo "FAIL: $f differs from $golden:"
-        sed 's/^/    /' "$tmp/report"
-    fi
-done
+"$MECH" batch -j 2 --golden tests/golden mechanisms/*.yaml >"$tmp/table" 2>"$tmp/err"
+status=$?
+passed=$(grep -c ' ok .* match$' "$tmp/table")
+total=$(ls mechanisms/*.yaml | wc -l)
+failed=$((total - passed))
+if [ "$status" -ne 0 ] || [ "$failed" -ne 0 ]; then
+    echo "FAIL: mech batch --golden tests/golden exited $status:"
+    grep -v ' ok .* match$' "$tmp/table" | sed 's/^/    /'
+    sed 's/^/    /' "$tmp/err" | head -n 60
+    [ "$failed" -gt 0 ] || failed=1
+fi
 echo "golden: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]
