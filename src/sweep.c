@@ -43,6 +43,8 @@ typedef struct sweep {
     double q0, *x0, *xq0, *xqq0;
     double *guess;             /* [n] the file's guess of each unknown, NAN if none */
     int row_iters;             /* Newton iterations spent on the current row */
+    int row_substeps;          /* extra continuation steps the row needed (refinement) */
+    int refined_notes;         /* refinements reported so far */
     int det_sign;              /* sign of det J at the base (0: unknown) */
     int crossings;             /* sign changes reported */
     int searching;             /* looking for assembly limits: no crossing reports */
@@ -437,6 +439,8 @@ static step_status advance(sweep *w, double q, double hmin)
         if (s == STEP_OK) {
             note_stats(w, qn);
             accept(w, qn);
+            if (w->qc != q)
+                w->row_substeps++;
             if (fabs(2.0 * h) <= fabs(q - w->qc))
                 h *= 2.0;  /* recover the step after a difficulty */
             continue;
@@ -740,7 +744,7 @@ static int make_columns(mech_table *t, const mech_model *m, int level, int diagn
 {
     const mech_outputs *o = &m->outputs;
     int vel = level & MECH_WANT_VELOCITY, acc = level & MECH_WANT_ACCELERATION;
-    int max = 1 + 6 * o->npoints + 3 * o->nlinks + 3 * o->nsliders + 3 +
+    int max = 1 + 6 * o->npoints + 3 * o->nlinks + 3 * o->nsliders + 4 +
               (with_forces ? 2 * (4 * m->njoints + 2) + 2 : 0);
     t->columns = xcalloc((size_t)max, sizeof *t->columns);
     if (!t->columns)
@@ -780,7 +784,7 @@ static int make_columns(mech_table *t, const mech_model *m, int level, int diagn
     }
     if (diagnostics)
         rc |= add_column(t, "iterations", "", "-") | add_column(t, "residual", "", "m") |
-              add_column(t, "rcond", "", "-");
+              add_column(t, "rcond", "", "-") | add_column(t, "substeps", "", "-");
     return rc ? -1 : 0;
 }
 
@@ -854,6 +858,7 @@ static void fill_row(sweep *w, int row)
         *out++ = w->row_iters;
         *out++ = sv->resid;
         *out++ = sv->rcond;
+        *out++ = w->row_substeps;
     }
 }
 
@@ -997,6 +1002,7 @@ int mech_solve(const mech_model *m, const mech_solve_options *o, mech_table *out
     for (; rc == MECH_OK && row < nvalues; row++) {
         double q = values[row];
         w.row_iters = 0;
+        w.row_substeps = 0;
         if (row == 0) {
             rc = start(&w, q);
             w.q0 = q;
@@ -1014,6 +1020,14 @@ int mech_solve(const mech_model *m, const mech_solve_options *o, mech_table *out
         }
         if (rc != MECH_OK)
             break;
+        if (w.row_substeps > 0 && w.refined_notes++ < 5) {
+            char qb[64];
+            diag_note(d, m->file, m->driver.mark,
+                      "the step to %s = %s was refined into %d steps (reciprocal condition "
+                      "there %.2g): a difficult position, near a singular one or a fast change",
+                      driver_word(m), q_text(m, q, qb, sizeof qb), w.row_substeps + 1,
+                      w.sv.rcond);
+        }
         solver_publish(&w.sv, q, w.qd, w.qdd);
         if (w.want_forces && (rc = solve_forces(&w, q)) != MECH_OK)
             break;
