@@ -43,7 +43,7 @@ const char cmd_solve_help[] =
     "  --friction MODE     on: apply the joints' friction coefficients (default);\n"
     "                      off: frictionless; both: also the frictionless columns,\n"
     "                      suffixed .nofriction\n"
-    "  --diagnostics       add the columns iterations, residual [m], rcond\n"
+    "  --diagnostics       add the columns iterations, residual [m], rcond, substeps\n"
     "  --stats             print iterations per step, worst residual, smallest\n"
     "                      rcond and time per step to standard error\n"
     "  --verbose           say which blocks of equations are solved and why\n"
