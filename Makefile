@@ -94,19 +94,23 @@ test-browser: $(BUILD)/mech
 bench:
 	@$(MAKE) --no-print-directory BUILD=build/bench OPT="-O2 -DNDEBUG" build/bench/bench-eval \
 	    build/bench/bench-solve build/bench/bench-hand build/bench/bench-accuracy build/bench/bench-scale \
-	    build/bench/mech
+	    build/bench/mech build/bench/bench-alloc
 	build/bench/bench-eval mechanisms/*.yaml
 	build/bench/bench-solve mechanisms/*.yaml
 	build/bench/bench-hand mechanisms
 	build/bench/bench-accuracy mechanisms build/bench
 	build/bench/bench-scale build/bench
 	MECH=build/bench/mech sh bench/bench_batch.sh
+	build/bench/bench-alloc mechanisms/*.yaml
 
 $(BUILD)/bench-eval: bench/bench_eval.c $(BUILD)/libmech.a $(HEADERS)
 	$(CC) $(CFLAGS) -Isrc -o $@ $< $(BUILD)/libmech.a $(LDLIBS)
 
 $(BUILD)/bench-solve: bench/bench_solve.c $(BUILD)/libmech.a $(HEADERS)
 	$(CC) $(CFLAGS) -Isrc -o $@ $< $(BUILD)/libmech.a $(LDLIBS)
+
+$(BUILD)/bench-alloc: bench/bench_alloc.c $(BUILD)/libmech.a $(HEADERS)
+	$(CC) $(CFLAGS) -o $@ $< $(BUILD)/libmech.a $(LDLIBS)
 
 $(BUILD)/bench-hand: bench/bench_hand.c bench/bench_util.h $(BUILD)/libmech.a $(HEADERS)
 	$(CC) $(CFLAGS) -o $@ $< $(BUILD)/libmech.a $(LDLIBS)
