@@ -34,7 +34,7 @@ LIB_OBJ  = $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o)
 TEST_SRC = $(wildcard tests/unit/*.c)
 TEST_OBJ = $(TEST_SRC:tests/unit/%.c=$(BUILD)/tests/%.o)
 
-.PHONY: all deps run test test-san test-valgrind test-browser bench golden install clean
+.PHONY: all deps run test test-san test-valgrind test-browser fuzz fuzz-replay bench golden install clean
 
 all: $(BUILD)/mech
 
@@ -81,6 +81,13 @@ test: deps
 test-san:
 	@$(MAKE) --no-print-directory test BUILD=build/san OPT="-O1 -g -fno-omit-frame-pointer" \
 	    SAN="-fsanitize=address,undefined -fno-sanitize-recover=all"
+
+# Fuzzing with clang's libFuzzer (tests/fuzz/README.md): fuzz runs
+# FUZZ_SECONDS (default 60); fuzz-replay only the regression inputs.
+fuzz:
+	FUZZ_BUILD=$(BUILD)/fuzz sh tests/fuzz/run.sh
+fuzz-replay:
+	FUZZ_BUILD=$(BUILD)/fuzz sh tests/fuzz/run.sh replay
 
 # mech under valgrind on every mechanism: no invalid accesses, no leaks.
 test-valgrind: $(BUILD)/mech

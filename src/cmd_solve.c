@@ -105,8 +105,9 @@ static int parse_valued(solve_args *a, const char *arg, const char *val)
     else if (strcmp(arg, "--outputs") == 0)
         a->outputs = val;
     else if (strcmp(arg, "--steps") == 0) {
-        if (!parse_number(val, &num) || num < 1 || num > 1e8 || num != (int)num)
-            return usage_error("--steps needs a whole number from 1 to 1e8, not '%s'", val);
+        if (!parse_number(val, &num) || num < 1 || num > 1e6 || num != (int)num)
+            return usage_error("--steps needs a whole number from 1 to 1000000 (as in a file), "
+                               "not '%s'", val);
         a->steps = (int)num;
     } else if (strcmp(arg, "--tol") == 0) {
         if (!parse_number(val, &num) || !(num > 0 && num < 1))

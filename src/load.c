@@ -66,6 +66,7 @@ typedef struct loader {
     int *carrier_link;    /* are carrier_link[carrier_start[id] .. carrier_start[id + 1] - 1], */
     int *carrier_point;   /* ascending, with the point's index in each (carrier_point) */
     int carrier_ids;      /* point ids indexed (0: no index, search the links) */
+    name_map next_suffix; /* default joint name -> next suffix to try (keys: joint names) */
     const mech_override *ov; /* [nov] parameter definitions replaced (mech sweep) */
     int nov;
     unsigned char *ov_used;  /* [nov] the file defines it */
@@ -834,14 +835,21 @@ static void set_joint_name(loader *ld, mech_joint *j, const ynode *name_node, co
             return;
         }
     }
-    /* a default name, made unique with a suffix */
+    /* a default name, made unique with a suffix; the suffixes below the one
+     * remembered for this default are all taken (a pin on 10^5 links would
+     * otherwise try 2, 3, ... again for each of its joints) */
     char buf[MAX_NAME + 16];
+    int k = name_map_get(&ld->next_suffix, deflt);
     snprintf(buf, sizeof buf, "%s", deflt);
-    for (int k = 2; find_joint(ld, buf) >= 0; k++)
+    for (k = k < 2 ? 2 : k; find_joint(ld, buf) >= 0; k++)
         snprintf(buf, sizeof buf, "%s_%d", deflt, k);
     j->name = xstrdup(buf);
-    if (j->name)
-        name_map_put(&ld->joint_map, j->name, (int)(j - m->joints));
+    if (!j->name)
+        return;
+    name_map_put(&ld->joint_map, j->name, (int)(j - m->joints));
+    int first = find_joint(ld, deflt);  /* its name outlives the map: a stable key */
+    if (first >= 0)
+        name_map_put(&ld->next_suffix, m->joints[first].name, k);
 }
 
 static int get_friction(loader *ld, const ynode *map, mech_joint *j)
@@ -1792,6 +1800,7 @@ static int load_string_with(const char *text, size_t len, const char *name,
     free(ld.link_failed);
     name_map_free(&ld.bad_params);
     name_map_free(&ld.param_map);
+    name_map_free(&ld.next_suffix);
     free(ld.carrier_start);
     free(ld.carrier_link);
     free(ld.carrier_point);

@@ -922,6 +922,30 @@ static void free_sweep(sweep *w)
     solver_free(&w->sv);
 }
 
+/* Which friction columns: 0 none, 1 with friction, 2 with and without. */
+static int friction_columns(const sweep *w)
+{
+    if (!w->fc.has_friction || w->friction_mode == MECH_FRICTION_OFF)
+        return 0;
+    return w->friction_mode == MECH_FRICTION_BOTH ? 2 : 1;
+}
+
+/* The result table is kept in memory: refuse (clearly) one above 2 GiB
+ * rather than let an overcommitted allocation kill the run part-way. */
+static int too_large(sweep *w, int nvalues)
+{
+    const mech_outputs *o = &w->m->outputs;
+    double cols = 1 + 6.0 * o->npoints + 3.0 * o->nlinks + 3.0 * o->nsliders + 4 +
+                  (w->want_forces ? 8.0 * w->m->njoints + 6 : 0);
+    double bytes = cols * nvalues * sizeof(double);
+    if (bytes <= 2147483648.0)
+        return 0;
+    diag_error(w->d, w->m->file, w->m->driver.mark,
+               "the results would take %.3g GB in memory (%d rows of %.0f columns): ask for "
+               "fewer steps (--steps) or fewer outputs (--outputs)", bytes / 1e9, nvalues, cols);
+    return 1;
+}
+
 /* Driver positions of the sweep: the file's, or the options' range. */
 static double *sweep_values(const mech_model *m, const mech_solve_options *o, int *count)
 {
@@ -985,14 +1009,15 @@ int mech_solve(const mech_model *m, const mech_solve_options *o, mech_table *out
     if (rc == MECH_OK) {
         rc = MECH_ENOMEM;
         values = sweep_values(m, o, &nvalues);
-        if (values && alloc_sweep(&w) == 0 && make_columns(out, m, w.sv.level, o->diagnostics, w.want_forces,
-                                                   !w.fc.has_friction ? 0
-                                                   : w.friction_mode == MECH_FRICTION_OFF ? 0
-                                                   : w.friction_mode == MECH_FRICTION_BOTH ? 2
-                                                                                            : 1) == 0 &&
-            (out->values = xcalloc((size_t)nvalues * (size_t)out->ncolumns + 1, sizeof(double))))
+        if (values && too_large(&w, nvalues))
+            rc = MECH_EINPUT;
+        else if (values && alloc_sweep(&w) == 0 &&
+                 make_columns(out, m, w.sv.level, o->diagnostics, w.want_forces,
+                              friction_columns(&w)) == 0 &&
+                 (out->values = xcalloc((size_t)nvalues * (size_t)out->ncolumns + 1,
+                                        sizeof(double))))
             rc = MECH_OK;
-        else
+        else if (rc == MECH_ENOMEM)
             diag_error(d, m->file, (mech_mark){0, 0}, "out of memory");
     }
     w.qd = m->driver.speed;
