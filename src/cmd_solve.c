@@ -240,23 +240,6 @@ static void print_stats(const mech_model *m, const mech_solve_stats *st, FILE *o
             per * 1e6, st->seconds, st->setup_seconds);
 }
 
-/* Load and check with the --set parameters replaced. */
-static int load_with_set(solve_args *a, mech_model **m)
-{
-    mech_diag d;
-    mech_diag_init(&d);
-    mech_summary s;
-    int rc = mech_load_file_with(a->file, a->set, a->nset, m, &d);
-    if (rc == MECH_OK)
-        rc = mech_check(*m, &s, &d);
-    mech_diag_print(&d, stderr);
-    mech_diag_free(&d);
-    if (rc == MECH_OK)
-        return MECH_EXIT_OK;
-    mech_model_free(m);
-    return rc == MECH_EIO ? MECH_EXIT_IO : MECH_EXIT_INPUT;
-}
-
 int cmd_solve(int argc, char **argv)
 {
     solve_args a = {0};
@@ -267,7 +250,7 @@ int cmd_solve(int argc, char **argv)
         return code;
     }
     mech_model *m = NULL;
-    code = a.nset ? load_with_set(&a, &m) : cmd_load_checked(a.file, &m);
+    code = cmd_load_checked_with(a.file, a.set, a.nset, &m);
     for (int i = 0; i < a.nset; i++)
         free(a.set_text[i]);
     if (code != MECH_EXIT_OK)

@@ -10,6 +10,8 @@ int cmd_wants_help(const char *arg);
 /* Load and check one file, printing diagnostics; returns an exit status
  * (MECH_EXIT_OK with *m set, else *m is NULL). */
 int cmd_load_checked(const char *path, mech_model **m);
+/* The same with some of the file's parameters replaced (--set). */
+int cmd_load_checked_with(const char *path, const mech_override *ov, int nov, mech_model **m);
 
 extern const char cmd_solve_help[];
 int cmd_solve(int argc, char **argv);

@@ -4,6 +4,7 @@
 
 #include <stdarg.h>
 #include <stddef.h>
+#include <stdio.h>
 
 #include "mech.h"
 
@@ -134,6 +135,12 @@ ynode *ytree_parse(const char *text, size_t len, const char *file,
 void ytree_free(ynode *n);
 ynode *ymap_get(const ynode *map, const char *key);      /* value or NULL */
 const char *ynode_kind_name(ynode_kind k);
+
+/* ---- output.c: write a file whole or not at all: emit (returns 0 on
+ *      success) writes into a temporary file beside `path`, renamed over it
+ *      when complete; "-" is standard output. MECH_OK or MECH_EIO. */
+int write_file_whole(const char *path, int (*emit)(FILE *, const void *), const void *ctx,
+                     mech_diag *d);
 
 /* ---- model.c */
 int model_point_in_link(const mech_link *l, int name_id);  /* index or -1 */

@@ -161,10 +161,15 @@ static int cmd_check(int argc, char **argv)
 
 int cmd_load_checked(const char *path, mech_model **m)
 {
+    return cmd_load_checked_with(path, NULL, 0, m);
+}
+
+int cmd_load_checked_with(const char *path, const mech_override *ov, int nov, mech_model **m)
+{
     mech_diag d;
     mech_diag_init(&d);
     mech_summary s;
-    int rc = mech_load_file(path, m, &d);
+    int rc = mech_load_file_with(path, ov, nov, m, &d);
     if (rc == MECH_OK)
         rc = mech_check(*m, &s, &d);
     mech_diag_print(&d, stderr);

@@ -47,19 +47,21 @@ static int write_rows(const mech_table *t, FILE *f)
     return ferror(f) ? -1 : 0;
 }
 
-int mech_table_write_csv(const mech_table *t, const char *path, mech_diag *d)
+int write_file_whole(const char *path, int (*emit)(FILE *, const void *), const void *ctx,
+                     mech_diag *d)
 {
-    if (strcmp(path, "-") == 0)
-        return write_rows(t, stdout) == 0 && fflush(stdout) == 0
-                   ? MECH_OK
-                   : (diag_error(d, path, (mech_mark){0, 0}, "cannot write to standard output: %s",
-                                 strerror(errno)), MECH_EIO);
-    size_t n = strlen(path) + 16;
-    char *tmp = malloc(n + 16);
+    if (strcmp(path, "-") == 0) {
+        if (emit(stdout, ctx) == 0 && fflush(stdout) == 0 && !ferror(stdout))
+            return MECH_OK;
+        return diag_error(d, path, (mech_mark){0, 0}, "cannot write to standard output: %s",
+                          strerror(errno)), MECH_EIO;
+    }
+    size_t n = strlen(path) + 32;
+    char *tmp = malloc(n);
     if (!tmp)
         return diag_error(d, path, (mech_mark){0, 0}, "out of memory"), MECH_ENOMEM;
     /* beside the target (rename stays on one file system); 0666 less umask */
-    snprintf(tmp, n + 16, "%s.tmp%ld", path, (long)getpid());
+    snprintf(tmp, n, "%s.tmp%ld", path, (long)getpid());
     int fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
     FILE *f = fd >= 0 ? fdopen(fd, "w") : NULL;
     if (!f) {
@@ -72,7 +74,7 @@ int mech_table_write_csv(const mech_table *t, const char *path, mech_diag *d)
         return diag_error(d, path, (mech_mark){0, 0}, "cannot create the output file: %s",
                           strerror(e)), MECH_EIO;
     }
-    int bad = write_rows(t, f);
+    int bad = emit(f, ctx) != 0 || ferror(f);
     int e = errno;
     if (fclose(f) != 0 && !bad) {
         bad = 1;
@@ -86,8 +88,15 @@ int mech_table_write_csv(const mech_table *t, const char *path, mech_diag *d)
         unlink(tmp);
         free(tmp);
         return diag_error(d, path, (mech_mark){0, 0}, "cannot write the output file: %s",
-                          strerror(e)), MECH_EIO;
+                          strerror(e ? e : EIO)), MECH_EIO;
     }
     free(tmp);
     return MECH_OK;
+}
+
+static int emit_csv(FILE *f, const void *t) { return write_rows(t, f); }
+
+int mech_table_write_csv(const mech_table *t, const char *path, mech_diag *d)
+{
+    return write_file_whole(path, emit_csv, t, d);
 }

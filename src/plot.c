@@ -78,52 +78,6 @@ static void put_xy(FILE *f, const char *sep, double x, double y, int dec)
 
 typedef int (*emit_fn)(FILE *f, const void *ctx);
 
-/* Run emit into `path` (temporary file + rename) or stdout for "-". */
-static int write_whole(const char *path, emit_fn emit, const void *ctx, mech_diag *d)
-{
-    if (strcmp(path, "-") == 0) {
-        if (emit(stdout, ctx) == 0 && fflush(stdout) == 0 && !ferror(stdout))
-            return MECH_OK;
-        return diag_error(d, path, (mech_mark){0, 0}, "cannot write to standard output: %s",
-                          strerror(errno)), MECH_EIO;
-    }
-    size_t n = strlen(path) + 32;
-    char *tmp = malloc(n);
-    if (!tmp)
-        return diag_error(d, path, (mech_mark){0, 0}, "out of memory"), MECH_ENOMEM;
-    snprintf(tmp, n, "%s.tmp%ld", path, (long)getpid());
-    int fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-    FILE *f = fd >= 0 ? fdopen(fd, "w") : NULL;
-    if (!f) {
-        int e = errno;
-        if (fd >= 0) {
-            close(fd);
-            unlink(tmp);
-        }
-        free(tmp);
-        return diag_error(d, path, (mech_mark){0, 0}, "cannot create the output file: %s",
-                          strerror(e)), MECH_EIO;
-    }
-    int bad = emit(f, ctx) != 0 || ferror(f);
-    int e = errno;
-    if (fclose(f) != 0 && !bad) {
-        bad = 1;
-        e = errno;
-    }
-    if (!bad && rename(tmp, path) != 0) {
-        bad = 1;
-        e = errno;
-    }
-    if (bad) {
-        unlink(tmp);
-        free(tmp);
-        return diag_error(d, path, (mech_mark){0, 0}, "cannot write the output file: %s",
-                          strerror(e ? e : EIO)), MECH_EIO;
-    }
-    free(tmp);
-    return MECH_OK;
-}
-
 /* SI unit of a column -> display unit and factor (docs/plots.md, Units). */
 static const char *display_unit(const char *si, double *scale)
 {
@@ -547,7 +501,7 @@ int plot_figure_write(const mech_model *m, const mech_table *t, const plot_figur
                       const char *subtitle, const char *path, mech_diag *d)
 {
     fig_ctx c = {m, t, f, subtitle};
-    return write_whole(path, emit_figure, &c, d);
+    return write_file_whole(path, emit_figure, &c, d);
 }
 
 /* ------------------------------------------------------------------ */
@@ -1067,7 +1021,7 @@ int plot_animation_write(const mech_model *m, const mech_table *t, const plot_an
     c.o = o;
     int rc = anim_prepare(&c, d);
     if (rc == MECH_OK)
-        rc = write_whole(path, emit_animation, &c, d);
+        rc = write_file_whole(path, emit_animation, &c, d);
     anim_free(&c);
     return rc;
 }
