@@ -183,13 +183,17 @@ int kin_state_init(kin_state *st, const mech_model *m)
     st->th = xcalloc(nl, sizeof *st->th);
     st->om = xcalloc(nl, sizeof *st->om);
     st->al = xcalloc(nl, sizeof *st->al);
+    st->c = xcalloc(nl, sizeof *st->c);
+    st->s = xcalloc(nl, sizeof *st->s);
     st->o = xcalloc(2 * nl, sizeof *st->o);
     st->vo = xcalloc(2 * nl, sizeof *st->vo);
     st->ao = xcalloc(2 * nl, sizeof *st->ao);
-    if (!st->th || !st->om || !st->al || !st->o || !st->vo || !st->ao) {
+    if (!st->th || !st->om || !st->al || !st->c || !st->s || !st->o || !st->vo || !st->ao) {
         kin_state_free(st);
         return MECH_ENOMEM;
     }
+    for (size_t l = 0; l < nl; l++)
+        st->c[l] = 1.0;  /* angle 0 until updated; the ground stays so */
     return MECH_OK;
 }
 
@@ -198,6 +202,8 @@ void kin_state_free(kin_state *st)
     free(st->th);
     free(st->om);
     free(st->al);
+    free(st->c);
+    free(st->s);
     free(st->o);
     free(st->vo);
     free(st->ao);
@@ -209,7 +215,7 @@ static double var_value(const double *v, int var) { return v && var >= 0 ? v[var
 /* Point r of link l: position, and rates when the link's rates are known. */
 void kin_on_link(const kin_state *st, int l, const double *r, double *p, double *v, double *a)
 {
-    double c = cos(st->th[l]), s = sin(st->th[l]);
+    double c = st->c[l], s = st->s[l];
     double rx = c * r[0] - s * r[1], ry = s * r[0] + c * r[1];  /* R r */
     double w = st->om[l], al = st->al[l];
     p[0] = st->o[2 * l] + rx;
@@ -228,7 +234,7 @@ void kin_on_link(const kin_state *st, int l, const double *r, double *p, double 
 static void place_at(kin_state *st, int l, const double *r, const double *p, const double *v,
                      const double *a)
 {
-    double c = cos(st->th[l]), s = sin(st->th[l]);
+    double c = st->c[l], s = st->s[l];
     double rx = c * r[0] - s * r[1], ry = s * r[0] + c * r[1];
     double w = st->om[l], al = st->al[l];
     st->o[2 * l] = p[0] - rx;
@@ -297,6 +303,8 @@ void kin_update(const kin_tree *t, kin_state *st, const double *pos, const doubl
     for (int k = 0; k < t->norder; k++) {
         int l = t->order[k], var = t->angle_var[l];
         st->th[l] = var_value(pos, var);
+        st->c[l] = cos(st->th[l]);  /* once per link and update: on_link is hot */
+        st->s[l] = sin(st->th[l]);
         st->om[l] = var_value(vel, var);
         st->al[l] = var_value(acc, var);
     }

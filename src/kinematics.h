@@ -28,6 +28,7 @@ typedef struct kin_tree {
 /* Positions, velocities and accelerations of every active link frame. */
 typedef struct kin_state {
     double *th, *om, *al;   /* [nlinks] angle, angular velocity, angular acceleration */
+    double *c, *s;          /* [nlinks] cos and sin of the angle (ground: 1, 0) */
     double *o, *vo, *ao;    /* [2 nlinks] frame origin and its rates */
 } kin_state;
 

@@ -418,10 +418,12 @@ static step_status try_position(sweep *w, double qn, int continuing)
             return STEP_JUMP;
     }
     solver_rates(sv);
-    solver_publish(sv, qn, 1.0, 0.0);
     int b;
-    if (w->m->nbranches && !branches_hold(w, &b))
-        return STEP_BRANCH;
+    if (w->m->nbranches) {  /* the branch test needs the point positions */
+        solver_publish(sv, qn, 1.0, 0.0);
+        if (!branches_hold(w, &b))
+            return STEP_BRANCH;
+    }
     return STEP_OK;
 }
 
