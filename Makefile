@@ -97,18 +97,20 @@ test-valgrind: $(BUILD)/mech
 test-browser: $(BUILD)/mech
 	MECH=$(BUILD)/mech OUT=$(BUILD)/browser sh tests/browser/run.sh
 
-# Benchmarks: optimised, no sanitizers; prints tables (docs/performance.md).
+# Benchmarks: optimised, no sanitizers; prints tables and writes them, with
+# the plots, into docs/performance.md (bench/report.sh).
 bench:
 	@$(MAKE) --no-print-directory BUILD=build/bench OPT="-O2 -DNDEBUG" build/bench/bench-eval \
 	    build/bench/bench-solve build/bench/bench-hand build/bench/bench-accuracy build/bench/bench-scale \
 	    build/bench/mech build/bench/bench-alloc
-	build/bench/bench-eval mechanisms/*.yaml
-	build/bench/bench-solve mechanisms/*.yaml
-	build/bench/bench-hand mechanisms
-	build/bench/bench-accuracy mechanisms build/bench
-	build/bench/bench-scale build/bench
-	MECH=build/bench/mech sh bench/bench_batch.sh
-	build/bench/bench-alloc mechanisms/*.yaml
+	{ build/bench/bench-eval mechanisms/*.yaml && \
+	  build/bench/bench-solve mechanisms/*.yaml && \
+	  build/bench/bench-hand mechanisms && \
+	  build/bench/bench-accuracy mechanisms build/bench && \
+	  build/bench/bench-scale build/bench && \
+	  MECH=build/bench/mech sh bench/bench_batch.sh && \
+	  build/bench/bench-alloc mechanisms/*.yaml; } 2>&1 | tee build/bench/report.txt
+	sh bench/report.sh build/bench/report.txt
 
 $(BUILD)/bench-eval: bench/bench_eval.c $(BUILD)/libmech.a $(HEADERS)
 	$(CC) $(CFLAGS) -Isrc -o $@ $< $(BUILD)/libmech.a $(LDLIBS)
