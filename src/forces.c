@@ -49,12 +49,16 @@ static void point_motion(const solver *sv, int l, int i, double *p, double *v, d
     kin_on_link(&sv->ks, l, r, p, v, a);
 }
 
-/* Centre of mass of link l (the frame origin for a link without mass). */
-static void centre_motion(const solver *sv, int l, double *p, double *v, double *a)
+/* Centres of mass of every link (the frame origin for a link without mass)
+ * with their rates, once per step: every column, load and power term of a
+ * link needs them. */
+static void update_centres(forces *fc, const solver *sv)
 {
-    const mech_link *k = &sv->m->links[l];
-    double r[2] = {k->has_mass ? k->center[0] : 0.0, k->has_mass ? k->center[1] : 0.0};
-    kin_on_link(&sv->ks, l, r, p, v, a);
+    for (int l = 0; l < fc->m->nlinks; l++) {
+        const mech_link *k = &fc->m->links[l];
+        double r[2] = {k->has_mass ? k->center[0] : 0.0, k->has_mass ? k->center[1] : 0.0};
+        kin_on_link(&sv->ks, l, r, fc->g + 2 * l, fc->vg + 2 * l, fc->ag + 2 * l);
+    }
 }
 
 /* Contact point of joint j: the pin, or the sliding point. */
@@ -81,13 +85,12 @@ typedef struct entry {
     double val;
 } entry;
 
-static int push_force(entry *e, int n, const solver *sv, int l, const double *p, const double *f,
+static int push_force(entry *e, int n, const forces *fc, int l, const double *p, const double *f,
                       double sign)
 {
     if (l == 0)
         return n;
-    double g[2], vg[2], ag[2];
-    centre_motion(sv, l, g, vg, ag);
+    const double *g = fc->g + 2 * l;
     double r[2] = {p[0] - g[0], p[1] - g[1]};
     int row = moving_row(l);
     e[n++] = (entry){row, sign * f[0]};
@@ -127,8 +130,8 @@ static int column_entries(const forces *fc, const solver *sv, int c, entry *e)
             n = push_moment(e, n, a, 1.0);
             n = push_moment(e, n, b, -1.0);
         } else {
-            n = push_force(e, n, sv, a, p, dir, 1.0);
-            n = push_force(e, n, sv, b, p, dir, -1.0);
+            n = push_force(e, n, fc, a, p, dir, 1.0);
+            n = push_force(e, n, fc, b, p, dir, -1.0);
         }
     }
     for (int i = 1; i < n; i++)  /* insertion sort: at most 6 entries */
@@ -207,8 +210,11 @@ int forces_init(forces *fc, const solver *sv, int friction, mech_diag *d)
     fc->y0 = xcalloc(nr + nc, sizeof *fc->y0);
     fc->ynext = xcalloc(nr + nc, sizeof *fc->ynext);
     fc->fric = xcalloc(nr, sizeof *fc->fric);
+    fc->g = xcalloc(2 * (size_t)m->nlinks, sizeof *fc->g);
+    fc->vg = xcalloc(2 * (size_t)m->nlinks, sizeof *fc->vg);
+    fc->ag = xcalloc(2 * (size_t)m->nlinks, sizeof *fc->ag);
     if (!fc->kind || !fc->joint || !fc->jcol || !fc->Ap || !fc->cscale || !fc->b || !fc->y ||
-        !fc->y0 || !fc->ynext || !fc->fric)
+        !fc->y0 || !fc->ynext || !fc->fric || !fc->g || !fc->vg || !fc->ag)
         return diag_error(d, m->file, (mech_mark){0, 0}, "out of memory"), MECH_ENOMEM;
     make_columns(fc);
     fc->friction = friction && fc->has_friction;
@@ -242,7 +248,7 @@ void forces_free(forces *fc)
     if (fc->sym)
         klu_free_symbolic(&fc->sym, &fc->common);
     void *blocks[] = {fc->kind, fc->joint, fc->jcol, fc->Ap, fc->Ai, fc->Ax, fc->b, fc->y,
-                      fc->y0, fc->ynext, fc->fric, fc->cscale};
+                      fc->y0, fc->ynext, fc->fric, fc->cscale, fc->g, fc->vg, fc->ag};
     for (size_t i = 0; i < sizeof blocks / sizeof blocks[0]; i++)
         free(blocks[i]);
     memset(fc, 0, sizeof *fc);
@@ -251,12 +257,11 @@ void forces_free(forces *fc)
 /* ---- the right-hand side --------------------------------------------- */
 
 /* An external force f at point p of link l: moves to the right-hand side. */
-static void load_force(double *rhs, const solver *sv, int l, const double *p, const double *f)
+static void load_force(double *rhs, const forces *fc, int l, const double *p, const double *f)
 {
     if (l == 0)
         return;
-    double g[2], vg[2], ag[2];
-    centre_motion(sv, l, g, vg, ag);
+    const double *g = fc->g + 2 * l;
     double r[2] = {p[0] - g[0], p[1] - g[1]};
     int row = moving_row(l);
     rhs[row] -= f[0];
@@ -305,8 +310,7 @@ static void known_loads(const forces *fc, const solver *sv, double *rhs)
             rhs[row] = rhs[row + 1] = rhs[row + 2] = 0.0;
             continue;
         }
-        double g[2], vg[2], ag[2];
-        centre_motion(sv, l, g, vg, ag);
+        const double *ag = fc->ag + 2 * l;
         rhs[row] = k->mass * (ag[0] - m->gravity[0]);
         rhs[row + 1] = k->mass * (ag[1] - m->gravity[1]);
         rhs[row + 2] = k->inertia * sv->ks.al[l];
@@ -319,7 +323,7 @@ static void known_loads(const forces *fc, const solver *sv, double *rhs)
         }
         double f[2], p[2], v[2];
         load_resultant(sv, ld, f, p, v);
-        load_force(rhs, sv, ld->link, p, f);
+        load_force(rhs, fc, ld->link, p, f);
     }
 }
 
@@ -367,8 +371,8 @@ static double friction_loads(forces *fc, const solver *sv, const double *y)
             guide_dir(sv, jt, u);
             contact(sv, jt, p, v);
             double fa[2] = {-ff * u[0], -ff * u[1]}, fb[2] = {ff * u[0], ff * u[1]};
-            load_force(fc->fric, sv, a, p, fa);
-            load_force(fc->fric, sv, b, p, fb);
+            load_force(fc->fric, fc, a, p, fa);
+            load_force(fc->fric, fc, b, p, fb);
             power += ff * rel;
         }
     }
@@ -422,8 +426,7 @@ static double power_residual(const forces *fc, const solver *sv, double drive, d
         const mech_link *k = &m->links[l];
         if (!k->has_mass)
             continue;
-        double g[2], vg[2], ag[2];
-        centre_motion(sv, l, g, vg, ag);
+        const double *vg = fc->vg + 2 * l, *ag = fc->ag + 2 * l;
         double dk = k->mass * (vg[0] * ag[0] + vg[1] * ag[1]) + k->inertia * sv->ks.om[l] * sv->ks.al[l];
         double pg = k->mass * (m->gravity[0] * vg[0] + m->gravity[1] * vg[1]);
         kin += dk;
@@ -451,6 +454,7 @@ static double power_residual(const forces *fc, const solver *sv, double drive, d
 int forces_solve(forces *fc, const solver *sv)
 {
     int n = fc->nrows, drive = fc->ncols - 1;
+    update_centres(fc, sv);
     known_loads(fc, sv, fc->b);
     if (factor(fc, sv) < 0)
         return -1;

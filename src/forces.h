@@ -24,6 +24,7 @@ typedef struct forces {
     int nnz;
     double *b, *y, *y0;     /* [nrows] right-hand side; solution; frictionless solution */
     double *ynext;          /* [nrows] friction iterate */
+    double *g, *vg, *ag;    /* [2 nlinks] centres of mass and their rates, this step */
     double *fric;           /* [nrows] friction loads moved to the right-hand side */
     double *cscale;         /* [ncols] column equilibration */
     klu_common common;

@@ -23,6 +23,22 @@ enum { PHASE_POSITION, PHASE_VELOCITY, PHASE_ACCELERATION, NPHASES };
  * beyond it the linearisation says little. */
 static const double MAX_STEP = 1.0;
 
+/* Parity of a permutation (0 even, 1 odd), by its cycles. */
+static int parity(const int *perm, int n, unsigned char *seen)
+{
+    int odd = 0;
+    memset(seen, 0, (size_t)n);
+    for (int i = 0; i < n; i++) {
+        if (seen[i])
+            continue;
+        int len = 0;
+        for (int k = i; !seen[k]; k = perm[k], len++)
+            seen[k] = 1;
+        odd ^= (len - 1) & 1;
+    }
+    return odd;
+}
+
 /* ---- set-up ------------------------------------------------------------ */
 
 /* The length scale of tolerances and slide columns: the largest distance
@@ -344,10 +360,9 @@ static int alloc_state(solver *sv)
     sv->ft = xcalloc(nr, sizeof *sv->ft);
     sv->rhs = xcalloc(nr + ns, sizeof *sv->rhs);
     sv->cscale = xcalloc(ns, sizeof *sv->cscale);
-    sv->label = xcalloc(512, 1);
     sv->seen = xcalloc((size_t)(sv->nr + sv->ns) + 1, 1);
     if (!sv->pos || !sv->vel || !sv->acc || !sv->x || !sv->xq || !sv->xqq || !sv->f ||
-        !sv->dx || !sv->xt || !sv->ft || !sv->rhs || !sv->cscale || !sv->label || !sv->seen)
+        !sv->dx || !sv->xt || !sv->ft || !sv->rhs || !sv->cscale || !sv->seen)
         return -1;
     return kin_state_init(&sv->ks, sv->m) == MECH_OK ? 0 : -1;
 }
@@ -425,6 +440,8 @@ int solver_init(solver *sv, const mech_model *m, const mech_solve_options *o, me
     sv->common.tol = 0.1;
     if (sv->ns > 0) {
         sv->sym = klu_analyze(sv->N, sv->Ap, sv->Ai, &sv->common);
+        if (sv->sym)
+            sv->q_parity = parity(sv->sym->Q, sv->N, sv->seen);
         if (!sv->sym)
             return diag_error(d, m->file, (mech_mark){0, 0}, "KLU cannot analyse the Jacobian "
                               "(status %d)", sv->common.status), MECH_ENOMEM;
@@ -445,7 +462,7 @@ void solver_free(solver *sv)
     void *blocks[] = {sv->col, sv->row, sv->Ap, sv->Ai, sv->Ax, sv->Jv, sv->jpos, sv->rhs,
                       sv->cscale, sv->proot,
                       sv->vroot, sv->aroot, sv->pos, sv->vel, sv->acc, sv->x, sv->xq,
-                      sv->xqq, sv->f, sv->dx, sv->xt, sv->ft, sv->label, sv->seen};
+                      sv->xqq, sv->f, sv->dx, sv->xt, sv->ft, sv->seen};
     for (size_t i = 0; i < sizeof blocks / sizeof blocks[0]; i++)
         free(blocks[i]);
     memset(sv, 0, sizeof *sv);
@@ -486,7 +503,6 @@ static double evaluate(solver *sv, const double *x, double q, double *f)
         f[i] = tape_value(t, sv->proot[i]);
     for (int k = 0; k < sv->nnzJ; k++)
         sv->Jv[k] = tape_value(t, sv->proot[sv->nr + k]);
-    sv->factored = 0;
     return vec_norm_inf(f, sv->nr);
 }
 
@@ -525,6 +541,8 @@ static int fresh_factor(solver *sv)
         return -1;
     klu_rcond(sv->sym, sv->num, &sv->common);
     sv->pivot_ratio = sv->pivot_ratio_factor = sv->common.rcond;
+    /* refactoring keeps this pivot order: its parity holds until the next */
+    sv->perm_parity = parity(sv->num->Pnum, sv->N, sv->seen) ^ sv->q_parity;
     return 0;
 }
 
@@ -545,7 +563,6 @@ static int factor(solver *sv)
     } else if (fresh_factor(sv) < 0) {
         return -1;
     }
-    sv->factored = 1;
     return 0;
 }
 
@@ -634,29 +651,13 @@ step_status solver_newton(solver *sv, double q)
     }
 }
 
-/* Parity of a permutation (0 even, 1 odd), by its cycles. */
-static int parity(const int *perm, int n, unsigned char *seen)
-{
-    int odd = 0;
-    memset(seen, 0, (size_t)n);
-    for (int i = 0; i < n; i++) {
-        if (seen[i])
-            continue;
-        int len = 0;
-        for (int k = i; !seen[k]; k = perm[k], len++)
-            seen[k] = 1;
-        odd ^= (len - 1) & 1;
-    }
-    return odd;
-}
-
 int solver_det_sign(solver *sv)
 {
     if (!sv->num || sv->N == 0)
         return 1;
     /* L U = A(Pnum, Q) with unit-diagonal L; the column scaling is positive */
     const double *ud = sv->num->Udiag;
-    int neg = parity(sv->num->Pnum, sv->N, sv->seen) ^ parity(sv->sym->Q, sv->N, sv->seen);
+    int neg = sv->perm_parity;
     for (int k = 0; k < sv->N; k++) {
         if (ud[k] == 0.0)
             return 0;
@@ -674,19 +675,16 @@ void solver_velocity_rhs(solver *sv, double *out)
         out[i] = tape_value(t, sv->vroot[i]);
 }
 
-int solver_rates(solver *sv)
+void solver_rates(solver *sv)
 {
     if (sv->ns == 0)
-        return 0;
+        return;
     tape *t = &sv->tp;
     /* geometric rates (qdot = 1, qddot = 0); solver_publish scales them */
-    tape_set_var(t, SYS_VAR_QDOT(sv->n), 1.0);
-    tape_run(t, PHASE_VELOCITY);
-    for (int i = 0; i < sv->nr; i++)
-        sv->ft[i] = tape_value(t, sv->vroot[i]);
+    solver_velocity_rhs(sv, sv->ft);
     linear_solve(sv, sv->ft, sv->xq);
     if (!(sv->level & MECH_WANT_ACCELERATION))
-        return 0;
+        return;
     for (int i = 0; i < sv->ns; i++)
         tape_set_var(t, SYS_VAR_XDOT(sv->n, sv->col[i]), sv->xq[i]);
     tape_set_var(t, SYS_VAR_QDDOT(sv->n), 0.0);
@@ -694,7 +692,6 @@ int solver_rates(solver *sv)
     for (int i = 0; i < sv->nr; i++)
         sv->ft[i] = tape_value(t, sv->aroot[i]);
     linear_solve(sv, sv->ft, sv->xqq);
-    return 0;
 }
 
 /* xdot = x_q qd and xddot = x_qq qd^2 + x_q qdd (the loop equations do not

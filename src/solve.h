@@ -14,8 +14,7 @@ typedef enum {
     STEP_NO_ASSEMBLY,  /* Newton does not converge: the loops cannot close */
     STEP_SINGULAR,     /* converged (or stuck) where the Jacobian is singular */
     STEP_JUMP,         /* converged far from the prediction: possibly another branch */
-    STEP_BRANCH,       /* converged on the other side of a declared branch */
-    STEP_NOMEM
+    STEP_BRANCH        /* converged on the other side of a declared branch */
 } step_status;
 
 typedef struct solver {
@@ -52,7 +51,6 @@ typedef struct solver {
     double rcond;              /* 1 / klu_condest at the last converged position */
     double pivot_ratio;        /* klu_rcond (min/max pivot) now, and after the last */
     double pivot_ratio_factor; /* full factorisation: refactor or pivot afresh */
-    int factored;              /* num holds factors of the current x */
 
     double *pos, *vel, *acc;   /* [n+1] variable values (n = driver), SI */
     double *x;                 /* [ns] current solved unknowns */
@@ -65,8 +63,9 @@ typedef struct solver {
 
     kin_tree tree;
     kin_state ks;
-    char *label;               /* scratch for messages */
     unsigned char *seen;       /* [N] scratch for permutation parities */
+    int q_parity;              /* parity of KLU's column order (fixed by klu_analyze) */
+    int perm_parity;           /* of the row and column orders of the current factors */
 } solver;
 
 int solver_init(solver *sv, const mech_model *m, const mech_solve_options *o, mech_diag *d);
@@ -76,7 +75,7 @@ void solver_free(solver *sv);
  * of the converged Jacobian. */
 step_status solver_newton(solver *sv, double q);
 /* dx/dq and d2x/dq2 at the converged position (as far as sv->level needs). */
-int solver_rates(solver *sv);
+void solver_rates(solver *sv);
 /* Scatter x, and the rates for driver speed qd and acceleration qdd, into
  * pos, vel, acc and update the link frames. */
 void solver_publish(solver *sv, double q, double qd, double qdd);

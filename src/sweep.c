@@ -453,7 +453,7 @@ static step_status advance(sweep *w, double q, double hmin)
         }
         w->fail_q = qn;
         w->fail_status = s;
-        if (s == STEP_NOMEM || fabs(h) <= hmin)
+        if (fabs(h) <= hmin)
             return s;
         h *= 0.5;
     }
