@@ -7,7 +7,6 @@
  * workers. Work is handed out by an atomic counter; --shard K/M keeps only
  * the files whose index i satisfies i % M == K, for running one batch over
  * several machines (GNU Parallel, Slurm job arrays). */
-#include <pthread.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -57,7 +56,7 @@ typedef struct job {
 typedef struct batch {
     job *jobs;
     int njobs;
-    atomic_int next, done;
+    atomic_int done;
     const char *out_dir, *golden_dir;
     compare_options cmp;
     int forces, progress;
@@ -167,46 +166,11 @@ static void progress(const batch *b, int done)
         fputc('\n', stderr);
 }
 
-static void *worker(void *arg)
+static void batch_job(void *ctx, int i)
 {
-    batch *b = arg;
-    for (;;) {
-        int i = atomic_fetch_add(&b->next, 1);
-        if (i >= b->njobs)
-            return NULL;
-        run_job(b, &b->jobs[i]);
-        int done = atomic_fetch_add(&b->done, 1) + 1;
-        progress(b, done);
-    }
-}
-
-static int default_jobs(void)
-{
-    long n = sysconf(_SC_NPROCESSORS_ONLN);
-    return n > 0 && n < 1024 ? (int)n : 1;
-}
-
-static int usage_error(const char *fmt, const char *arg)
-{
-    fputs("mech batch: ", stderr);
-    fprintf(stderr, fmt, arg);
-    fputs(" (see 'mech batch --help')\n", stderr);
-    return MECH_EXIT_INPUT;
-}
-
-static int parse_shard(const char *s, int *k, int *mod)
-{
-    char *end;
-    long a = strtol(s, &end, 10);
-    if (end == s || *end != '/')
-        return -1;
-    const char *p = end + 1;
-    long bnum = strtol(p, &end, 10);
-    if (end == p || *end != '\0' || bnum < 1 || a < 0 || a >= bnum || bnum > 1000000)
-        return -1;
-    *k = (int)a;
-    *mod = (int)bnum;
-    return 0;
+    batch *b = ctx;
+    run_job(b, &b->jobs[i]);
+    progress(b, atomic_fetch_add(&b->done, 1) + 1);
 }
 
 static void print_table(const batch *b, FILE *out)
@@ -228,7 +192,7 @@ int cmd_batch(int argc, char **argv)
     memset(&b, 0, sizeof b);
     compare_options_default(&b.cmp);
     b.cmp.table = 0;
-    int nthreads = default_jobs(), quiet = 0, shard_k = 0, shard_m = 1;
+    int nthreads = cmd_default_jobs(), quiet = 0, shard_k = 0, shard_m = 1;
     const char **files = calloc((size_t)argc + 1, sizeof *files);
     int nfiles = 0;
     if (!files)
@@ -245,14 +209,14 @@ int cmd_batch(int argc, char **argv)
         }
         if (takes && !v) {
             free(files);
-            return usage_error("option '%s' needs a value", a);
+            return cmd_usage_error("batch", "option '%s' needs a value", a);
         }
         char *end;
         if (!strcmp(a, "-j") || !strcmp(a, "--jobs")) {
             long n = strtol(v, &end, 10);
             if (*end || n < 1 || n > 1024) {
                 free(files);
-                return usage_error("-j needs a number of workers from 1 to 1024, not '%s'", v);
+                return cmd_usage_error("batch", "-j needs a number of workers from 1 to 1024, not '%s'", v);
             }
             nthreads = (int)n;
         } else if (!strcmp(a, "--out-dir")) {
@@ -263,13 +227,13 @@ int cmd_batch(int argc, char **argv)
             double x = strtod(v, &end);
             if (*end || !(x >= 0)) {
                 free(files);
-                return usage_error("a tolerance must be a number >= 0, not '%s'", v);
+                return cmd_usage_error("batch", "a tolerance must be a number >= 0, not '%s'", v);
             }
             *(a[2] == 'r' ? &b.cmp.rtol : &b.cmp.atol) = x;
         } else if (!strcmp(a, "--shard")) {
-            if (parse_shard(v, &shard_k, &shard_m) < 0) {
+            if (cmd_parse_shard(v, &shard_k, &shard_m) < 0) {
                 free(files);
-                return usage_error("--shard needs K/M with 0 <= K < M, not '%s'", v);
+                return cmd_usage_error("batch", "--shard needs K/M with 0 <= K < M, not '%s'", v);
             }
         } else if (!strcmp(a, "--forces")) {
             b.forces = 1;
@@ -277,7 +241,7 @@ int cmd_batch(int argc, char **argv)
             quiet = 1;
         } else if (a[0] == '-' && a[1]) {
             free(files);
-            return usage_error("unknown option '%s'", a);
+            return cmd_usage_error("batch", "unknown option '%s'", a);
         } else {
             files[nfiles++] = a;
         }
@@ -286,7 +250,7 @@ int cmd_batch(int argc, char **argv)
     }
     if (nfiles == 0) {
         free(files);
-        return usage_error("%s", "no files given (usage: mech batch FILE... [-j N])");
+        return cmd_usage_error("batch", "%s", "no files given (usage: mech batch FILE... [-j N])");
     }
     b.jobs = calloc((size_t)nfiles, sizeof *b.jobs);
     if (!b.jobs) {
@@ -300,16 +264,7 @@ int cmd_batch(int argc, char **argv)
             base_name(files[i], jb->name, sizeof jb->name);
         }
     b.progress = !quiet && isatty(STDERR_FILENO);
-    if (nthreads > b.njobs)
-        nthreads = b.njobs > 0 ? b.njobs : 1;
-    pthread_t *tid = calloc((size_t)nthreads, sizeof *tid);
-    int started = 0;
-    for (int t = 0; tid && t < nthreads; t++)
-        started += pthread_create(&tid[t], NULL, worker, &b) == 0;
-    if (started == 0)
-        worker(&b);  /* no threads: do the work here */
-    for (int t = 0; t < started; t++)
-        pthread_join(tid[t], NULL);
+    cmd_run_parallel(b.njobs, nthreads, batch_job, &b);
     int code = MECH_EXIT_OK;
     for (int i = 0; i < b.njobs; i++) {
         job *jb = &b.jobs[i];
@@ -322,7 +277,6 @@ int cmd_batch(int argc, char **argv)
             code = jb->code;
     }
     print_table(&b, stdout);
-    free(tid);
     free(b.jobs);
     free(files);
     return code;

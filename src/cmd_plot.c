@@ -70,13 +70,6 @@ typedef struct plot_args {
     plot_anim_options anim;
 } plot_args;
 
-static int usage_error(const plot_args *a, const char *fmt, const char *arg)
-{
-    fprintf(stderr, "mech %s: ", a->cmd);
-    fprintf(stderr, fmt, arg);
-    fprintf(stderr, " (see 'mech %s --help')\n", a->cmd);
-    return MECH_EXIT_INPUT;
-}
 
 static int parse_count(const char *text, int lo, int hi, int *v)
 {
@@ -107,15 +100,15 @@ static int parse_option(plot_args *a, int argc, char **argv, int *i)
                              strcmp(arg, "--test-colors") == 0))
             a->anim.test_colours = 1;
         else
-            return usage_error(a, "unknown option '%s'", arg);
+            return cmd_usage_error(a->cmd, "unknown option '%s'", arg);
         return -1;
     }
     if (*i + 1 >= argc)
-        return usage_error(a, "option '%s' needs a value", arg);
+        return cmd_usage_error(a->cmd, "option '%s' needs a value", arg);
     const char *val = argv[++*i];
     if (strcmp(arg, "--steps") == 0) {
         if (!parse_count(val, 1, 100000000, &a->steps))
-            return usage_error(a, "--steps needs a whole number from 1 to 1e8, not '%s'", val);
+            return cmd_usage_error(a->cmd, "--steps needs a whole number from 1 to 1e8, not '%s'", val);
     } else if (!animate && (strcmp(arg, "--out") == 0 || strcmp(arg, "-d") == 0)) {
         a->out = val;
     } else if (!animate && strcmp(arg, "--outputs") == 0) {
@@ -128,29 +121,29 @@ static int parse_option(plot_args *a, int argc, char **argv, int *i)
         else if (strcmp(val, "both") == 0)
             a->friction = MECH_FRICTION_BOTH;
         else
-            return usage_error(a, "--friction is on, off or both, not '%s'", val);
+            return cmd_usage_error(a->cmd, "--friction is on, off or both, not '%s'", val);
     } else if (animate && (strcmp(arg, "-o") == 0 || strcmp(arg, "--output") == 0)) {
         a->out = val;
     } else if (animate && strcmp(arg, "--duration") == 0) {
         char *end;
         double s = strtod(val, &end);
         if (end == val || *end != '\0' || !(s >= 0.01 && s <= 86400))
-            return usage_error(a, "--duration needs seconds from 0.01 to 86400, not '%s'", val);
+            return cmd_usage_error(a->cmd, "--duration needs seconds from 0.01 to 86400, not '%s'", val);
         a->anim.duration = s;
     } else if (animate && strcmp(arg, "--frame") == 0) {
         if (!parse_count(val, 0, 100000000, &a->anim.frame))
-            return usage_error(a, "--frame needs a position number from 0, not '%s'", val);
+            return cmd_usage_error(a->cmd, "--frame needs a position number from 0, not '%s'", val);
     } else if (animate && strcmp(arg, "--pause-at") == 0) {
         char *end;
         double s = strtod(val, &end);
         if (end == val || *end != '\0' || !(s >= 0 && s <= 86400))
-            return usage_error(a, "--pause-at needs seconds from 0 to 86400, not '%s'", val);
+            return cmd_usage_error(a->cmd, "--pause-at needs seconds from 0 to 86400, not '%s'", val);
         a->anim.pause_at = s;
     } else if (animate && strcmp(arg, "--frames") == 0) {
         if (!parse_count(val, 2, 1000000, &a->anim.max_frames))
-            return usage_error(a, "--frames needs a whole number from 2 to 1e6, not '%s'", val);
+            return cmd_usage_error(a->cmd, "--frames needs a whole number from 2 to 1e6, not '%s'", val);
     } else {
-        return usage_error(a, "unknown option '%s'", arg);
+        return cmd_usage_error(a->cmd, "unknown option '%s'", arg);
     }
     return -1;
 }
@@ -169,13 +162,13 @@ static int parse_args(int argc, char **argv, plot_args *a)
             if (code >= 0)
                 return code;
         } else if (a->file) {
-            return usage_error(a, "one file at a time ('%s' is a second file)", arg);
+            return cmd_usage_error(a->cmd, "one file at a time ('%s' is a second file)", arg);
         } else {
             a->file = arg;
         }
     }
     if (!a->file)
-        return usage_error(a, "%s", "no file given");
+        return cmd_usage_error(a->cmd, "%s", "no file given");
     return -1;
 }
 

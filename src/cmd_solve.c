@@ -65,13 +65,6 @@ typedef struct solve_args {
     mech_solve_options opt;
 } solve_args;
 
-static int usage_error(const char *fmt, const char *arg)
-{
-    fputs("mech solve: ", stderr);
-    fprintf(stderr, fmt, arg);
-    fputs(" (see 'mech solve --help')\n", stderr);
-    return MECH_EXIT_INPUT;
-}
 
 static int parse_number(const char *text, double *v)
 {
@@ -106,25 +99,25 @@ static int parse_valued(solve_args *a, const char *arg, const char *val)
         a->outputs = val;
     else if (strcmp(arg, "--steps") == 0) {
         if (!parse_number(val, &num) || num < 1 || num > 1e6 || num != (int)num)
-            return usage_error("--steps needs a whole number from 1 to 1000000 (as in a file), "
+            return cmd_usage_error("solve", "--steps needs a whole number from 1 to 1000000 (as in a file), "
                                "not '%s'", val);
         a->steps = (int)num;
     } else if (strcmp(arg, "--tol") == 0) {
         if (!parse_number(val, &num) || !(num > 0 && num < 1))
-            return usage_error("--tol needs a number between 0 and 1, not '%s'", val);
+            return cmd_usage_error("solve", "--tol needs a number between 0 and 1, not '%s'", val);
         a->opt.tol = num;
     } else if (strcmp(arg, "--max-iter") == 0) {
         if (!parse_number(val, &num) || num < 1 || num > 10000 || num != (int)num)
-            return usage_error("--max-iter needs a whole number from 1 to 10000, not '%s'", val);
+            return cmd_usage_error("solve", "--max-iter needs a whole number from 1 to 10000, not '%s'", val);
         a->opt.max_iter = (int)num;
     } else if (strcmp(arg, "--min-rcond") == 0) {
         if (!parse_number(val, &num) || !(num > 0 && num < 1))
-            return usage_error("--min-rcond needs a number between 0 and 1, not '%s'", val);
+            return cmd_usage_error("solve", "--min-rcond needs a number between 0 and 1, not '%s'", val);
         a->opt.min_rcond = num;
     } else if (strcmp(arg, "--set") == 0) {
         const char *eq = strchr(val, '=');
         if (!eq || eq == val || !eq[1] || a->nset == MAX_SET)
-            return usage_error("--set needs NAME=VALUE (at most 64), not '%s'", val);
+            return cmd_usage_error("solve", "--set needs NAME=VALUE (at most 64), not '%s'", val);
         char *copy = strdup(val);
         if (!copy)
             return MECH_EXIT_INPUT;
@@ -140,7 +133,7 @@ static int parse_valued(solve_args *a, const char *arg, const char *val)
         else if (strcmp(val, "both") == 0)
             a->opt.friction = MECH_FRICTION_BOTH;
         else
-            return usage_error("--friction is on, off or both, not '%s'", val);
+            return cmd_usage_error("solve", "--friction is on, off or both, not '%s'", val);
     } else if (strncmp(val, "position", 8) == 0) {  /* --level */
         a->opt.want = MECH_WANT_POSITION;
     } else if (strncmp(val, "velocit", 7) == 0) {
@@ -148,7 +141,7 @@ static int parse_valued(solve_args *a, const char *arg, const char *val)
     } else if (strncmp(val, "acceleration", 12) == 0) {
         a->opt.want = MECH_WANT_ALL;
     } else {
-        return usage_error("--level is positions, velocities or accelerations, not '%s'", val);
+        return cmd_usage_error("solve", "--level is positions, velocities or accelerations, not '%s'", val);
     }
     return -1;
 }
@@ -166,7 +159,7 @@ static int parse_args(int argc, char **argv, solve_args *a)
         }
         if (takes_value(arg)) {
             if (i + 1 >= argc)
-                return usage_error("option '%s' needs a value", arg);
+                return cmd_usage_error("solve", "option '%s' needs a value", arg);
             code = parse_valued(a, arg, argv[++i]);
         } else if (strcmp(arg, "--stats") == 0)
             a->stats = 1;
@@ -179,18 +172,18 @@ static int parse_args(int argc, char **argv, solve_args *a)
         else if (strcmp(arg, "--forces") == 0)
             a->opt.forces = 1;
         else if (arg[0] == '-' && arg[1] != '\0')
-            return usage_error("unknown option '%s'", arg);
+            return cmd_usage_error("solve", "unknown option '%s'", arg);
         else if (a->file)
-            return usage_error("one file at a time ('%s' is a second file)", arg);
+            return cmd_usage_error("solve", "one file at a time ('%s' is a second file)", arg);
         else
             a->file = arg;
         if (code >= 0)
             return code;
     }
     if (!a->file)
-        return usage_error("%s", "no file given (usage: mech solve FILE [-o OUT.csv] ...)");
+        return cmd_usage_error("solve", "%s", "no file given (usage: mech solve FILE [-o OUT.csv] ...)");
     if ((a->from != NULL) != (a->to != NULL))
-        return usage_error("%s", "--from and --to go together");
+        return cmd_usage_error("solve", "%s", "--from and --to go together");
     return -1;
 }
 

@@ -6,8 +6,6 @@
  * over machines (variant index i % M == K) with the index as first column
  * for a deterministic merge (sort -n). */
 #include <math.h>
-#include <pthread.h>
-#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -81,16 +79,8 @@ typedef struct sweep_run {
     int forces;
     variant *vars;
     int nvars;            /* variants in this shard */
-    atomic_int next;
 } sweep_run;
 
-static int usage_error(const char *fmt, const char *arg)
-{
-    fputs("mech sweep: ", stderr);
-    fprintf(stderr, fmt, arg);
-    fputs(" (see 'mech sweep --help')\n", stderr);
-    return MECH_EXIT_INPUT;
-}
 
 /* "130mm" -> 130 and "mm" */
 static int split_number(const char *s, double *v, char *unit, size_t size)
@@ -118,10 +108,10 @@ static int add_text(axis *a, const char *text)
 static int parse_vary(sweep_run *r, const char *arg, int is_list)
 {
     if (r->naxes == MAX_VARY)
-        return usage_error("at most 8 --vary/--list options ('%s')", arg);
+        return cmd_usage_error("sweep", "at most 8 --vary/--list options ('%s')", arg);
     const char *eq = strchr(arg, '=');
     if (!eq || eq == arg || (size_t)(eq - arg) >= sizeof r->axes[0].name)
-        return usage_error("expected NAME=..., not '%s'", arg);
+        return cmd_usage_error("sweep", "expected NAME=..., not '%s'", arg);
     axis *a = &r->axes[r->naxes];
     memset(a, 0, sizeof *a);
     snprintf(a->name, sizeof a->name, "%.*s", (int)(eq - arg), arg);
@@ -151,7 +141,7 @@ static int parse_vary(sweep_run *r, const char *arg, int is_list)
     }
     free(spec);
     if (bad)
-        return usage_error(is_list ? "--list needs NAME=A,B,..., not '%s'"
+        return cmd_usage_error("sweep", is_list ? "--list needs NAME=A,B,..., not '%s'"
                                    : "--vary needs NAME=FROM:TO:COUNT with the same unit on "
                                      "FROM and TO, not '%s'", arg);
     r->naxes++;
@@ -164,7 +154,7 @@ static int parse_metric(sweep_run *r, const char *arg)
         {"range:", MET_RANGE}, {"max:", MET_MAX}, {"min:", MET_MIN},
         {"maxabs:", MET_MAXABS}, {"transmission:", MET_TRANSMISSION}};
     if (r->nmetrics == MAX_METRICS)
-        return usage_error("at most 32 metrics ('%s')", arg);
+        return cmd_usage_error("sweep", "at most 32 metrics ('%s')", arg);
     metric *mt = &r->metrics[r->nmetrics];
     memset(mt, 0, sizeof *mt);
     for (size_t k = 0; k < sizeof kinds / sizeof kinds[0]; k++) {
@@ -179,7 +169,7 @@ static int parse_metric(sweep_run *r, const char *arg)
         if (mt->kind == MET_TRANSMISSION) {
             const char *comma = strchr(arg + n, ',');
             if (!comma || comma == arg + n || !comma[1])
-                return usage_error("transmission:LINK1,LINK2, not '%s'", arg);
+                return cmd_usage_error("sweep", "transmission:LINK1,LINK2, not '%s'", arg);
             snprintf(mt->col, sizeof mt->col, "%.*s.angle", (int)(comma - arg - n), arg + n);
             snprintf(mt->col2, sizeof mt->col2, "%s.angle", comma + 1);
         } else {
@@ -188,7 +178,7 @@ static int parse_metric(sweep_run *r, const char *arg)
         r->nmetrics++;
         return -1;
     }
-    return usage_error("unknown metric '%s' (range:, max:, min:, maxabs:, transmission:)", arg);
+    return cmd_usage_error("sweep", "unknown metric '%s' (range:, max:, min:, maxabs:, transmission:)", arg);
 }
 
 /* ---- one variant ------------------------------------------------------ */
@@ -279,15 +269,10 @@ static void run_variant(const sweep_run *r, variant *var)
         fclose(msg);
 }
 
-static void *worker(void *arg)
+static void sweep_job(void *ctx, int i)
 {
-    sweep_run *r = arg;
-    for (;;) {
-        int i = atomic_fetch_add(&r->next, 1);
-        if (i >= r->nvars)
-            return NULL;
-        run_variant(r, &r->vars[i]);
-    }
+    sweep_run *r = ctx;
+    run_variant(r, &r->vars[i]);
 }
 
 /* ---- output ------------------------------------------------------------ */
@@ -358,7 +343,7 @@ int cmd_sweep(int argc, char **argv)
     sweep_run r;
     memset(&r, 0, sizeof r);
     const char *out = NULL;
-    long nthreads = sysconf(_SC_NPROCESSORS_ONLN);
+    long nthreads = cmd_default_jobs();
     int shard_k = 0, shard_m = 1, code = -1;
     for (int i = 1; i < argc && code < 0; i++) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -371,7 +356,7 @@ int cmd_sweep(int argc, char **argv)
             return MECH_EXIT_OK;
         }
         if (takes && !v) {
-            code = usage_error("option '%s' needs a value", a);
+            code = cmd_usage_error("sweep", "option '%s' needs a value", a);
             break;
         }
         char *end;
@@ -384,33 +369,29 @@ int cmd_sweep(int argc, char **argv)
         else if (!strcmp(a, "-j") || !strcmp(a, "--jobs")) {
             nthreads = strtol(v, &end, 10);
             if (*end || nthreads < 1 || nthreads > 1024)
-                code = usage_error("-j needs a number of workers from 1 to 1024, not '%s'", v);
+                code = cmd_usage_error("sweep", "-j needs a number of workers from 1 to 1024, not '%s'", v);
         } else if (!strcmp(a, "--shard")) {
-            char *slash;
-            shard_k = (int)strtol(v, &slash, 10);
-            shard_m = *slash == '/' ? (int)strtol(slash + 1, &end, 10) : 0;
-            if (slash == v || *slash != '/' || *end || shard_m < 1 || shard_k < 0 ||
-                shard_k >= shard_m)
-                code = usage_error("--shard needs K/M with 0 <= K < M, not '%s'", v);
+            if (cmd_parse_shard(v, &shard_k, &shard_m) < 0)
+                code = cmd_usage_error("sweep", "--shard needs K/M with 0 <= K < M, not '%s'", v);
         } else if (!strcmp(a, "--forces"))
             r.forces = 1;
         else if (a[0] == '-' && a[1])
-            code = usage_error("unknown option '%s'", a);
+            code = cmd_usage_error("sweep", "unknown option '%s'", a);
         else if (r.file)
-            code = usage_error("one file at a time ('%s' is a second file)", a);
+            code = cmd_usage_error("sweep", "one file at a time ('%s' is a second file)", a);
         else
             r.file = a;
         if (takes)
             i++;
     }
     if (code < 0 && !r.file)
-        code = usage_error("%s", "no file given (usage: mech sweep FILE --vary NAME=FROM:TO:COUNT)");
+        code = cmd_usage_error("sweep", "%s", "no file given (usage: mech sweep FILE --vary NAME=FROM:TO:COUNT)");
     if (code < 0 && r.naxes == 0)
-        code = usage_error("%s", "nothing to vary: give --vary NAME=FROM:TO:COUNT or --list");
+        code = cmd_usage_error("sweep", "%s", "nothing to vary: give --vary NAME=FROM:TO:COUNT or --list");
     long total = 1;
     for (int k = 0; code < 0 && k < r.naxes; k++)
         if ((total *= r.axes[k].count) > 10000000)
-            code = usage_error("%s", "more than 10^7 variants");
+            code = cmd_usage_error("sweep", "%s", "more than 10^7 variants");
     if (code >= 0) {
         free_run(&r);
         return code;
@@ -433,16 +414,8 @@ int cmd_sweep(int argc, char **argv)
     for (long i = 0; r.vars && i < total; i++)
         if (i % shard_m == shard_k)
             r.vars[r.nvars++].index = (int)i;
-    if (nthreads > r.nvars)
-        nthreads = r.nvars > 0 ? r.nvars : 1;
-    pthread_t tid[64];
-    int started = 0;
-    for (int t = 0; r.vars && t < nthreads && t < 64; t++)
-        started += pthread_create(&tid[t], NULL, worker, &r) == 0;
-    if (r.vars && started == 0)
-        worker(&r);
-    for (int t = 0; t < started; t++)
-        pthread_join(tid[t], NULL);
+    if (r.vars)
+        cmd_run_parallel(r.nvars, (int)nthreads, sweep_job, &r);
     for (int i = 0; r.vars && i < r.nvars; i++)
         if (r.vars[i].messages && strcmp(r.vars[i].status, "ok") != 0)
             fputs(r.vars[i].messages, stderr);

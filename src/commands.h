@@ -13,6 +13,15 @@ int cmd_load_checked(const char *path, mech_model **m);
 /* The same with some of the file's parameters replaced (--set). */
 int cmd_load_checked_with(const char *path, const mech_override *ov, int nov, mech_model **m);
 
+/* cmd_common.c: "mech COMMAND: MESSAGE (see 'mech COMMAND --help')" on
+ * stderr; returns MECH_EXIT_INPUT. fmt has one %s for arg. */
+int cmd_usage_error(const char *command, const char *fmt, const char *arg);
+/* "K/M" with 0 <= K < M: 0, or -1 when malformed. */
+int cmd_parse_shard(const char *s, int *k, int *mod);
+int cmd_default_jobs(void);  /* processors online */
+/* job(ctx, i) for i = 0 .. njobs-1 on up to nthreads threads (each i once). */
+void cmd_run_parallel(int njobs, int nthreads, void (*job)(void *ctx, int i), void *ctx);
+
 extern const char cmd_solve_help[];
 int cmd_solve(int argc, char **argv);
 
