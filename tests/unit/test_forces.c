@@ -7,25 +7,10 @@
 #include <math.h>
 #include <string.h>
 
-#include "mech.h"
+#include "helpers.h"
 
 static const double PI = 3.14159265358979323846;
 
-static mech_model *load_text(const char *text)
-{
-    mech_diag d;
-    mech_diag_init(&d);
-    mech_model *m = NULL;
-    mech_summary s;
-    int rc = mech_load_string(text, strlen(text), "<test>", &m, &d);
-    if (rc == MECH_OK)
-        rc = mech_check(m, &s, &d);
-    if (rc != MECH_OK)
-        mech_diag_print(&d, stderr);
-    mech_diag_free(&d);
-    cr_assert_eq(rc, MECH_OK);
-    return m;
-}
 
 static void solve(const mech_model *m, int friction, mech_table *t)
 {

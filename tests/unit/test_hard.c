@@ -39,6 +39,7 @@
 #include <time.h>
 
 #include "mech.h"
+#include "helpers.h"
 
 #define PI 3.14159265358979323846
 #define TWO_PI (2.0 * PI)
@@ -85,25 +86,7 @@ static double cpu_now(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static int ends_with(const char *s, const char *suffix)
-{
-    size_t n = strlen(s), k = strlen(suffix);
-    return n >= k && strcmp(s + n - k, suffix) == 0;
-}
 
-/* The kind of a column: 0 length, 1 speed, 2 acceleration, 3 angle,
- * 4 angular speed, 5 angular acceleration. */
-static int column_kind(const char *name)
-{
-    static const char *const suffix[] = {".x", ".y", ".s", ".vx", ".vy", ".v",
-                                         ".ax", ".ay", ".a", ".angle", ".omega", ".alpha"};
-    static const int kind[] = {0, 0, 0, 1, 1, 1, 2, 2, 2, 3, 4, 5};
-    for (int i = 0; i < (int)(sizeof kind / sizeof *kind); i++)
-        if (ends_with(name, suffix[i]))
-            return kind[i];
-    cr_assert_fail("column '%s' of no known kind", name);
-    return -1;
-}
 
 static const char *const KIND_NAME[6] = {"positions", "velocities", "accelerations",
                                          "angles", "angular velocities",

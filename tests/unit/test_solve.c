@@ -32,60 +32,13 @@
 /* ---- closed forms (tests/unit/closed_forms.h) ------------------------- */
 
 #include "closed_forms.h"
+#include "helpers.h"
 
 /* ---- helpers ----------------------------------------------------------- */
 
-static int ends_with(const char *s, const char *suffix)
-{
-    size_t n = strlen(s), k = strlen(suffix);
-    return n >= k && strcmp(s + n - k, suffix) == 0;
-}
 
-/* The kind of a column: 0 length, 1 speed, 2 acceleration, 3 angle,
- * 4 angular speed, 5 angular acceleration. */
-static int column_kind(const char *name)
-{
-    static const char *const suffix[] = {".x", ".y", ".s", ".vx", ".vy", ".v",
-                                         ".ax", ".ay", ".a", ".angle", ".omega", ".alpha"};
-    static const int kind[] = {0, 0, 0, 1, 1, 1, 2, 2, 2, 3, 4, 5};
-    for (int i = 0; i < (int)(sizeof kind / sizeof *kind); i++)
-        if (ends_with(name, suffix[i]))
-            return kind[i];
-    cr_assert_fail("column '%s' of no known kind", name);
-    return -1;
-}
 
-static mech_model *load_text(const char *text)
-{
-    mech_diag d;
-    mech_diag_init(&d);
-    mech_model *m = NULL;
-    mech_summary s;
-    int rc = mech_load_string(text, strlen(text), "<test>", &m, &d);
-    if (rc == MECH_OK)
-        rc = mech_check(m, &s, &d);
-    if (rc != MECH_OK)
-        mech_diag_print(&d, stderr);
-    mech_diag_free(&d);
-    cr_assert_eq(rc, MECH_OK, "the test mechanism does not load:\n%s", text);
-    return m;
-}
 
-static mech_model *load_path(const char *path)
-{
-    mech_diag d;
-    mech_diag_init(&d);
-    mech_model *m = NULL;
-    mech_summary s;
-    int rc = mech_load_file(path, &m, &d);
-    if (rc == MECH_OK)
-        rc = mech_check(m, &s, &d);
-    if (rc != MECH_OK)
-        mech_diag_print(&d, stderr);
-    mech_diag_free(&d);
-    cr_assert_eq(rc, MECH_OK, "%s does not load", path);
-    return m;
-}
 
 /* Solve with options o (NULL: the defaults); the solve must succeed. */
 static mech_table solve_ok(const mech_model *m, const mech_solve_options *o)

@@ -12,38 +12,12 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "helpers.h"
 #include "system.h"
 
 /* ---- helpers ----------------------------------------------------------- */
 
-static mech_model *load(const char *path)
-{
-    mech_diag d;
-    mech_diag_init(&d);
-    mech_model *m = NULL;
-    mech_summary s;
-    int rc = mech_load_file(path, &m, &d);
-    if (rc == MECH_OK)
-        rc = mech_check(m, &s, &d);
-    if (rc != MECH_OK)
-        mech_diag_print(&d, stderr);
-    mech_diag_free(&d);
-    cr_assert_eq(rc, MECH_OK, "%s does not load", path);
-    return m;
-}
 
-static mech_model *load_text(const char *text)
-{
-    mech_diag d;
-    mech_diag_init(&d);
-    mech_model *m = NULL;
-    int rc = mech_load_string(text, strlen(text), "<test>", &m, &d);
-    if (rc != MECH_OK)
-        mech_diag_print(&d, stderr);
-    mech_diag_free(&d);
-    cr_assert_eq(rc, MECH_OK);
-    return m;
-}
 
 static mech_system *build(const mech_model *m)
 {
@@ -126,7 +100,7 @@ static double cstep(const mech_system *s, ex e, const double *vars, const double
 
 static void check_derivatives(const char *path)
 {
-    mech_model *m = load(path);
+    mech_model *m = load_path(path);
     mech_system *s = build(m);
     int n = s->n, nv = SYS_NVARS(n);
     double size = mechanism_size(m);
@@ -198,7 +172,7 @@ static void check_derivatives(const char *path)
 /* The tape computes the same operations as the DAG, in the same order. */
 static void check_tape(const char *path)
 {
-    mech_model *m = load(path);
+    mech_model *m = load_path(path);
     mech_system *s = build(m);
     int n = s->n, nv = SYS_NVARS(n);
     double *vars = calloc((size_t)nv, sizeof *vars);
@@ -329,7 +303,7 @@ Test(system, a_loop_step_off_every_link_is_reported)
 
 Test(system, printed_fourbar_equations_match_the_reviewed_golden_text)
 {
-    mech_model *m = load("mechanisms/fourbar.yaml");
+    mech_model *m = load_path("mechanisms/fourbar.yaml");
     mech_system *s = build(m);
     char *buf = NULL;
     size_t len = 0;

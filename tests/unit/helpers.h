@@ -1,0 +1,54 @@
+/* tests/unit/helpers.h: what several test files need: load and check a
+ * mechanism (from text or a path; the test fails if it does not load), and
+ * the kind of a result column from its name. */
+#ifndef MECH_TEST_HELPERS_H
+#define MECH_TEST_HELPERS_H
+
+#include <criterion/criterion.h>
+#include <string.h>
+
+#include "mech.h"
+
+/* Load (mech_load_string or mech_load_file) and mech_check; fails the test
+ * with the diagnostics when either fails. `text` NULL: load `path`. */
+static inline mech_model *test_load(const char *text, const char *path)
+{
+    mech_diag d;
+    mech_diag_init(&d);
+    mech_model *m = NULL;
+    mech_summary s;
+    int rc = text ? mech_load_string(text, strlen(text), "<test>", &m, &d)
+                  : mech_load_file(path, &m, &d);
+    if (rc == MECH_OK)
+        rc = mech_check(m, &s, &d);
+    if (rc != MECH_OK)
+        mech_diag_print(&d, stderr);
+    mech_diag_free(&d);
+    cr_assert_eq(rc, MECH_OK, "the test mechanism does not load: %s", text ? text : path);
+    return m;
+}
+
+static inline mech_model *load_text(const char *text) { return test_load(text, NULL); }
+static inline mech_model *load_path(const char *path) { return test_load(NULL, path); }
+
+static inline int ends_with(const char *s, const char *suffix)
+{
+    size_t n = strlen(s), k = strlen(suffix);
+    return n >= k && strcmp(s + n - k, suffix) == 0;
+}
+
+/* The kind of a column: 0 length, 1 speed, 2 acceleration, 3 angle,
+ * 4 angular speed, 5 angular acceleration. */
+static inline int column_kind(const char *name)
+{
+    static const char *const suffix[] = {".x", ".y", ".s", ".vx", ".vy", ".v",
+                                         ".ax", ".ay", ".a", ".angle", ".omega", ".alpha"};
+    static const int kind[] = {0, 0, 0, 1, 1, 1, 2, 2, 2, 3, 4, 5};
+    for (int i = 0; i < (int)(sizeof kind / sizeof *kind); i++)
+        if (ends_with(name, suffix[i]))
+            return kind[i];
+    cr_assert_fail("column '%s' of no known kind", name);
+    return -1;
+}
+
+#endif
