@@ -171,6 +171,8 @@ run "mech solve --from with a wrong unit" 2 "$MECH" solve mechanisms/fourbar.yam
 run "mech solve missing file" 3 "$MECH" solve "$tmp/nonexistent.yaml" && pass
 run "mech solve unwritable output" 3 "$MECH" solve mechanisms/fourbar.yaml -o "$tmp/no/such/dir/x.csv" && pass
 
+# crank 40, coupler 50, rocker 45, ground 60 mm: the loop closes while
+# |CA| <= 50 + 45, i.e. cos q >= (40^2 + 60^2 - 95^2) / (2 40 60): |q| <= 142.833 deg
 echo "keep me" >"$tmp/old.csv"
 if run "mech solve non-Grashof" 1 "$MECH" solve tests/solve/non-grashof.yaml -o "$tmp/old.csv"; then
     has_line "$tmp/err" 'cannot assemble at driver angle = 143 deg.*assembles for driver angle from -142.83[0-9]* deg to 142.83[0-9]* deg' "non-Grashof message"
