@@ -262,7 +262,8 @@ typedef struct mech_solve_options {
     double tol;        /* Newton tolerance relative to the largest length (default 1e-12) */
     int max_iter;      /* Newton iterations per step before giving up (default 50) */
     double min_rcond;  /* a converged position with a smaller reciprocal condition
-                          estimate (klu_rcond, equilibrated) is singular (default 1e-6) */
+                          (of the column-equilibrated Jacobian's diagonal blocks) is
+                          singular (default 1e-6) */
     int want;          /* MECH_WANT_* bits (default MECH_WANT_ALL) */
     int all_blocks;    /* 1: solve every unknown, also those no output needs */
     int diagnostics;   /* 1: add the columns iterations, residual, rcond */
@@ -273,7 +274,14 @@ typedef struct mech_solve_options {
     int forces;        /* 1: joint reactions and driver torque even if the file's
                           outputs do not ask for them (outputs: forces: true) */
     int friction;      /* MECH_FRICTION_*: how joint friction enters the forces */
+    int linear_solver; /* MECH_LINEAR_*: how the Jacobians are factored */
 } mech_solve_options;
+
+enum {
+    MECH_LINEAR_AUTO = 0, /* dense LU of each block of the block triangular form when
+                             every block is at most 16x16, else KLU (default) */
+    MECH_LINEAR_KLU       /* SuiteSparse KLU always */
+};
 
 enum {
     MECH_FRICTION_ON = 0,  /* the joints' friction coefficients are applied (default) */
@@ -311,10 +319,10 @@ typedef struct mech_solve_stats {
     long iterations;         /* Newton iterations, all steps */
     int max_iterations;      /* worst step */
     double worst_residual;   /* largest converged closure residual, m */
-    double min_rcond;        /* smallest reciprocal pivot ratio (klu_rcond) */
+    double min_rcond;        /* smallest reciprocal condition (the rcond column) */
     double worst_rcond_q;    /* driver position where min_rcond occurred */
-    int factorizations;      /* full klu_factor calls */
-    int refactorizations;    /* klu_refactor calls */
+    int factorizations;      /* full factorisations (klu_factor, or dense blocks) */
+    int refactorizations;    /* klu_refactor calls (KLU only) */
     int nunknowns;           /* unknowns of the mechanism */
     int nsolved;             /* unknowns actually solved (the needed blocks) */
     int nblocks;             /* blocks of the block triangular form */

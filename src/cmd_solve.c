@@ -31,6 +31,9 @@ const char cmd_solve_help[] =
     "  --max-iter N        Newton iterations per step before giving up (default 50)\n"
     "  --min-rcond R       reciprocal condition below which a position is reported\n"
     "                      singular (default 1e-6)\n"
+    "  --linear-solver S   auto: dense LU of each block of the block triangular\n"
+    "                      form when all are at most 16x16, else KLU (default);\n"
+    "                      klu: SuiteSparse KLU always (docs/solver.md)\n"
     "  --set NAME=VALUE    replace the file's parameter NAME by VALUE (repeatable),\n"
     "                      e.g. --set 'l=150 mm'\n"
     "  --outputs LIST      comma-separated point, link and slider names to output\n"
@@ -75,7 +78,7 @@ static int parse_number(const char *text, double *v)
 
 static const char *const value_options[] = {"-o", "--output", "--from", "--to", "--outputs",
                                            "--steps", "--tol", "--max-iter", "--min-rcond",
-                                           "--level", "--friction", "--set"};
+                                           "--level", "--friction", "--set", "--linear-solver"};
 
 static int takes_value(const char *arg)
 {
@@ -114,6 +117,13 @@ static int parse_valued(solve_args *a, const char *arg, const char *val)
         if (!parse_number(val, &num) || !(num > 0 && num < 1))
             return cmd_usage_error("solve", "--min-rcond needs a number between 0 and 1, not '%s'", val);
         a->opt.min_rcond = num;
+    } else if (strcmp(arg, "--linear-solver") == 0) {
+        if (strcmp(val, "auto") == 0)
+            a->opt.linear_solver = MECH_LINEAR_AUTO;
+        else if (strcmp(val, "klu") == 0)
+            a->opt.linear_solver = MECH_LINEAR_KLU;
+        else
+            return cmd_usage_error("solve", "--linear-solver needs auto or klu, not '%s'", val);
     } else if (strcmp(arg, "--set") == 0) {
         const char *eq = strchr(val, '=');
         if (!eq || eq == val || !eq[1] || a->nset == MAX_SET)

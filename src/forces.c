@@ -230,11 +230,10 @@ int forces_init(forces *fc, const solver *sv, int friction, mech_diag *d)
     if (m->driver.kind == MECH_DRIVE_SLIDER)
         qd /= sv->lref;
     fc->speed_eps = 1e-6 * (qd > 0.0 ? qd : 1.0);
-    klu_defaults(&fc->common);
-    fc->common.scale = 0;
-    fc->common.tol = 0.1;
-    fc->sym = klu_analyze(fc->ncols, fc->Ap, fc->Ai, &fc->common);
-    if (!fc->sym)
+    int rc = linsys_init(&fc->ls, fc->ncols, fc->Ap, fc->Ai, sv->opt.linear_solver);
+    if (rc < 0)
+        return diag_error(d, m->file, (mech_mark){0, 0}, "out of memory"), MECH_ENOMEM;
+    if (rc > 0)
         return diag_error(d, m->file, m->driver.mark,
                           "the force analysis is structurally singular: some reaction appears in "
                           "no equilibrium equation that could determine it"), MECH_EINPUT;
@@ -243,10 +242,7 @@ int forces_init(forces *fc, const solver *sv, int friction, mech_diag *d)
 
 void forces_free(forces *fc)
 {
-    if (fc->num)
-        klu_free_numeric(&fc->num, &fc->common);
-    if (fc->sym)
-        klu_free_symbolic(&fc->sym, &fc->common);
+    linsys_free(&fc->ls);
     void *blocks[] = {fc->kind, fc->joint, fc->jcol, fc->Ap, fc->Ai, fc->Ax, fc->b, fc->y,
                       fc->y0, fc->ynext, fc->fric, fc->cscale, fc->g, fc->vg, fc->ag};
     for (size_t i = 0; i < sizeof blocks / sizeof blocks[0]; i++)
@@ -393,25 +389,18 @@ static int factor(forces *fc, const solver *sv)
         for (int k = 0; k < n; k++)
             fc->Ax[at + k] = e[k].val * fc->cscale[c];
     }
-    if (!fc->num || !klu_refactor(fc->Ap, fc->Ai, fc->Ax, fc->sym, fc->num, &fc->common)) {
-        if (fc->num)
-            klu_free_numeric(&fc->num, &fc->common);
-        fc->num = klu_factor(fc->Ap, fc->Ai, fc->Ax, fc->sym, &fc->common);
-        if (!fc->num) {
-            fc->rcond = 0.0;
-            return -1;
-        }
-    }
-    if (!klu_condest(fc->Ap, fc->Ax, fc->sym, fc->num, &fc->common) || !(fc->common.condest > 0))
+    fc->rcond = 0.0;
+    if (linsys_factor(&fc->ls, fc->Ax) < 0)
         return -1;
-    fc->rcond = 1.0 / fc->common.condest;
+    double whole;
+    linsys_condition(&fc->ls, fc->Ax, &fc->rcond, &whole);
     return fc->rcond < 1e-13 ? -1 : 0;
 }
 
 static void solve_rhs(forces *fc, const double *rhs, double *y)
 {
     memcpy(y, rhs, (size_t)fc->nrows * sizeof *y);
-    klu_solve(fc->sym, fc->num, fc->ncols, 1, y, &fc->common);
+    linsys_solve(&fc->ls, y);
     for (int c = 0; c < fc->ncols; c++)
         y[c] *= fc->cscale[c];
 }
@@ -503,7 +492,7 @@ void forces_singular_joints(forces *fc, char *buf, size_t size)
     unsigned char *mark = xcalloc((size_t)m->njoints + 2, 1);
     if (!mark)
         return;
-    if (fc->num) {
+    if (fc->ls.factored) {
         for (int r = 0; r < fc->nrows; r++)
             fc->ynext[r] = 1.0 + 0.1 * r;  /* a generic right-hand side */
         solve_rhs(fc, fc->ynext, fc->ynext);
@@ -511,8 +500,8 @@ void forces_singular_joints(forces *fc, char *buf, size_t size)
         for (int c = 0; c < ncols; c++)
             if (isfinite(big) && fabs(fc->ynext[c]) > 0.1 * big)
                 mark[fc->joint[c] >= 0 ? fc->joint[c] : m->njoints] = 1;
-    } else if (fc->common.singular_col >= 0 && fc->common.singular_col < ncols) {
-        int c = fc->common.singular_col;
+    } else if (linsys_singular_col(&fc->ls) >= 0) {
+        int c = linsys_singular_col(&fc->ls);
         mark[fc->joint[c] >= 0 ? fc->joint[c] : m->njoints] = 1;
     }
     for (int j = 0; j <= m->njoints && at < size; j++)

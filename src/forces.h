@@ -1,7 +1,7 @@
 /* src/forces.h: kinetostatics (docs/forces.md). Newton-Euler equations of
  * every moving link with D'Alembert inertia loads from the solved motion;
  * unknowns are the joint reactions and the driver torque or force. The
- * sparse pattern is fixed, so KLU analyses it once and refactors per step. */
+ * sparse pattern is fixed: analysed once (linsys.c), factored per step. */
 #ifndef MECH_FORCES_H
 #define MECH_FORCES_H
 
@@ -27,9 +27,7 @@ typedef struct forces {
     double *g, *vg, *ag;    /* [2 nlinks] centres of mass and their rates, this step */
     double *fric;           /* [nrows] friction loads moved to the right-hand side */
     double *cscale;         /* [ncols] column equilibration */
-    klu_common common;
-    klu_symbolic *sym;
-    klu_numeric *num;
+    linsys ls;              /* factors of the force system */
     /* per step results */
     int iterations;         /* friction fixed-point iterations */
     double residual0;       /* power balance, frictionless, relative */

@@ -302,9 +302,12 @@ void kin_update(const kin_tree *t, kin_state *st, const double *pos, const doubl
     /* angles first: a guide's angle may be needed before its frame */
     for (int k = 0; k < t->norder; k++) {
         int l = t->order[k], var = t->angle_var[l];
-        st->th[l] = var_value(pos, var);
-        st->c[l] = cos(st->th[l]);  /* once per link and update: on_link is hot */
-        st->s[l] = sin(st->th[l]);
+        double th = var_value(pos, var);
+        if (th != st->th[l]) {  /* c, s always belong to th (solver_publish may set all three) */
+            st->th[l] = th;
+            st->c[l] = cos(th);  /* once per link and angle: on_link is hot */
+            st->s[l] = sin(th);
+        }
         st->om[l] = var_value(vel, var);
         st->al[l] = var_value(acc, var);
     }

@@ -28,7 +28,8 @@ typedef struct kin_tree {
 /* Positions, velocities and accelerations of every active link frame. */
 typedef struct kin_state {
     double *th, *om, *al;   /* [nlinks] angle, angular velocity, angular acceleration */
-    double *c, *s;          /* [nlinks] cos and sin of the angle (ground: 1, 0) */
+    double *c, *s;          /* [nlinks] cos and sin of th (ground: 1, 0); kept while th
+                               does not change */
     double *o, *vo, *ao;    /* [2 nlinks] frame origin and its rates */
 } kin_state;
 

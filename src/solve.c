@@ -2,11 +2,11 @@
  *
  * Set-up, once per mechanism: choose the unknowns the outputs need (the
  * blocks of the block triangular form that contain them, and every block
- * those depend on), compile an evaluator of just those rows, and let KLU
- * analyse the pattern of their Jacobian.
- * Per driver position: Newton with damping on the closure residual, with
- * klu_refactor (a fresh klu_factor when the pivots degrade); then dx/dq and
- * d2x/dq2 by two solves with the converged factors. Columns are
+ * those depend on), compile an evaluator of just those rows, and analyse
+ * the pattern of their Jacobian (linsys.c: dense blocks or KLU).
+ * Per driver position: Newton with damping on the closure residual, one
+ * factorisation per iteration; then dx/dq and d2x/dq2 by two solves with
+ * the converged factors. Columns are
  * equilibrated before every factorisation, so the condition estimate measures the
  * geometry, not the units. */
 #include <btf.h>
@@ -22,22 +22,6 @@ enum { PHASE_POSITION, PHASE_VELOCITY, PHASE_ACCELERATION, NPHASES };
 /* A Newton step longer than this (rad, or lref for slides) is shortened:
  * beyond it the linearisation says little. */
 static const double MAX_STEP = 1.0;
-
-/* Parity of a permutation (0 even, 1 odd), by its cycles. */
-static int parity(const int *perm, int n, unsigned char *seen)
-{
-    int odd = 0;
-    memset(seen, 0, (size_t)n);
-    for (int i = 0; i < n; i++) {
-        if (seen[i])
-            continue;
-        int len = 0;
-        for (int k = i; !seen[k]; k = perm[k], len++)
-            seen[k] = 1;
-        odd ^= (len - 1) & 1;
-    }
-    return odd;
-}
 
 /* ---- set-up ------------------------------------------------------------ */
 
@@ -209,7 +193,7 @@ done:
     return status;
 }
 
-/* The KLU matrix of the least-squares mode: [I J; J^T 0] of size nr + ns,
+/* The matrix of the least-squares mode: [I J; J^T 0] of size nr + ns,
  * whose solution [r; dx] minimises |J dx - f| (Gauss-Newton). jpos[2k] and
  * jpos[2k+1] are where J entry k goes (in J and in J^T). */
 static int augmented_pattern(solver *sv, const int *Jp, const int *Ji)
@@ -263,6 +247,45 @@ done:
     free(rk);
     free(colof);
     return rc;
+}
+
+/* The loop equations hold cos and sin of most link angles; the link
+ * frames need the same (solver_publish takes them from the tape). Nodes
+ * first (interned: existing ones are found), registers after compiling. */
+static int trig_nodes(solver *sv)
+{
+    int nl = sv->m->nlinks;
+    sv->trig = xcalloc(3 * (size_t)nl + 1, sizeof *sv->trig);
+    if (!sv->trig)
+        return -1;
+    expr_ctx *c = &sv->sys->ex;
+    for (int l = 0; l < nl; l++) {
+        int var = sv->tree.angle_var[l];
+        sv->trig[3 * l] = -1;
+        if (var < 0)
+            continue;
+        ex v = expr_var(c, var), ce = v >= 0 ? expr_cos(c, v) : -1;
+        ex se = v >= 0 ? expr_sin(c, v) : -1;
+        if (ce < 0 || se < 0)
+            return -1;
+        sv->trig[3 * l] = var, sv->trig[3 * l + 1] = ce, sv->trig[3 * l + 2] = se;
+    }
+    return 0;
+}
+
+static void trig_registers(solver *sv)
+{
+    const tape *t = &sv->tp;
+    for (int l = 0; l < sv->m->nlinks; l++) {
+        int *g = sv->trig + 3 * l;
+        if (g[0] < 0)
+            continue;
+        g[0] = t->var_reg[g[0]];
+        g[1] = t->node_reg[g[1]];
+        g[2] = t->node_reg[g[2]];
+        if (g[0] < 0 || g[1] < 0 || g[2] < 0)
+            g[0] = -1;  /* not all in the tape: kin_update computes them */
+    }
 }
 
 /* Pattern of the solved rows and columns, and the tape computing them. */
@@ -326,7 +349,7 @@ static int compile_subset(solver *sv, const unsigned char *row_on, const unsigne
         rc = augmented_pattern(sv, Jp, Ji);
         free(Jp);
         free(Ji);
-    } else {  /* square: KLU factors J itself */
+    } else {  /* square: J itself is factored */
         sv->Ap = Jp;
         sv->Ai = Ji;
         sv->Ax = xcalloc((size_t)nnz + 1, sizeof *sv->Ax);
@@ -342,7 +365,20 @@ static int compile_subset(solver *sv, const unsigned char *row_on, const unsigne
     /* dx/dq feeds the predictor even for positions only: keep the velocity phase */
     if (nph < 2)
         nph = 2;
-    return tape_compile(&sv->tp, &sv->sys->ex, SYS_NVARS(n), nph, roots, nroots);
+    if (trig_nodes(sv) < 0 ||
+        tape_compile(&sv->tp, &sv->sys->ex, SYS_NVARS(n), nph, roots, nroots) < 0)
+        return -1;
+    trig_registers(sv);
+    /* what depends on the driver alone (its sines and cosines, the crank's
+       terms) is computed once per position, not per Newton iteration */
+    unsigned char *invariant = xcalloc((size_t)SYS_NVARS(n), 1);
+    if (!invariant)
+        return -1;
+    invariant[SYS_VAR_Q(n)] = 1;
+    tape_hoist(&sv->tp, PHASE_POSITION, invariant);
+    free(invariant);
+    sv->tape_q = NAN;
+    return 0;
 }
 
 static int alloc_state(solver *sv)
@@ -360,9 +396,8 @@ static int alloc_state(solver *sv)
     sv->ft = xcalloc(nr, sizeof *sv->ft);
     sv->rhs = xcalloc(nr + ns, sizeof *sv->rhs);
     sv->cscale = xcalloc(ns, sizeof *sv->cscale);
-    sv->seen = xcalloc((size_t)(sv->nr + sv->ns) + 1, 1);
     if (!sv->pos || !sv->vel || !sv->acc || !sv->x || !sv->xq || !sv->xqq || !sv->f ||
-        !sv->dx || !sv->xt || !sv->ft || !sv->rhs || !sv->cscale || !sv->seen)
+        !sv->dx || !sv->xt || !sv->ft || !sv->rhs || !sv->cscale)
         return -1;
     return kin_state_init(&sv->ks, sv->m) == MECH_OK ? 0 : -1;
 }
@@ -429,40 +464,28 @@ int solver_init(solver *sv, const mech_model *m, const mech_solve_options *o, me
         return diag_error(d, m->file, (mech_mark){0, 0}, "out of memory"), MECH_ENOMEM;
     if (rc != MECH_OK)
         return rc;
-    klu_defaults(&sv->common);
-    /* Every row is a length in metres already, and columns are equilibrated
-       per factorisation; KLU's row scaling would blow a row that is small
-       for a geometric reason (a dead centre) up to 1 and hide the
-       singularity from the condition estimate. */
-    sv->common.scale = 0;
-    /* Diagonal preference only within a factor 10 of the largest pivot
-       candidate (KLU's default 1e-3 allows growth of 1e3 per column). */
-    sv->common.tol = 0.1;
-    if (sv->ns > 0) {
-        sv->sym = klu_analyze(sv->N, sv->Ap, sv->Ai, &sv->common);
-        if (sv->sym)
-            sv->q_parity = parity(sv->sym->Q, sv->N, sv->seen);
-        if (!sv->sym)
-            return diag_error(d, m->file, (mech_mark){0, 0}, "KLU cannot analyse the Jacobian "
-                              "(status %d)", sv->common.status), MECH_ENOMEM;
+    if (sv->ns > 0 && linsys_init(&sv->ls, sv->N, sv->Ap, sv->Ai, sv->opt.linear_solver) != 0)
+        return diag_error(d, m->file, (mech_mark){0, 0}, "cannot analyse the Jacobian "
+                          "(out of memory)"), MECH_ENOMEM;
+    if (sv->opt.log) {
+        char method[96];
+        fprintf(sv->opt.log, "linear solves: %s\n",
+                sv->ns > 0 ? linsys_method_name(&sv->ls, method, sizeof method) : "none");
     }
     return MECH_OK;
 }
 
 void solver_free(solver *sv)
 {
-    if (sv->num)
-        klu_free_numeric(&sv->num, &sv->common);
-    if (sv->sym)
-        klu_free_symbolic(&sv->sym, &sv->common);
+    linsys_free(&sv->ls);
     tape_free(&sv->tp);
     kin_state_free(&sv->ks);
     kin_tree_free(&sv->tree);
     mech_system_free(&sv->sys);
     void *blocks[] = {sv->col, sv->row, sv->Ap, sv->Ai, sv->Ax, sv->Jv, sv->jpos, sv->rhs,
                       sv->cscale, sv->proot,
-                      sv->vroot, sv->aroot, sv->pos, sv->vel, sv->acc, sv->x, sv->xq,
-                      sv->xqq, sv->f, sv->dx, sv->xt, sv->ft, sv->seen};
+                      sv->vroot, sv->aroot, sv->trig, sv->pos, sv->vel, sv->acc, sv->x, sv->xq,
+                      sv->xqq, sv->f, sv->dx, sv->xt, sv->ft};
     for (size_t i = 0; i < sizeof blocks / sizeof blocks[0]; i++)
         free(blocks[i]);
     memset(sv, 0, sizeof *sv);
@@ -470,11 +493,15 @@ void solver_free(solver *sv)
 
 /* ---- one driver position ------------------------------------------------ */
 
+/* (fmax is a library call at -O2, and would drop a NaN: here a NaN
+ * entry makes the norm NaN.) */
 double vec_norm_inf(const double *v, int n)
 {
     double r = 0.0;
-    for (int i = 0; i < n; i++)
-        r = fmax(r, fabs(v[i]));
+    for (int i = 0; i < n; i++) {
+        double a = fabs(v[i]);
+        r = a > r || a != a ? a : r;
+    }
     return r;
 }
 
@@ -486,7 +513,7 @@ double solver_step_size(const solver *sv, const double *dx)
         double v = fabs(dx[i]);
         if (sv->sys->unk_kind[sv->col[i]] == UNK_SLIDE)
             v /= sv->lref;
-        r = fmax(r, v);
+        r = v > r || v != v ? v : r;
     }
     return r;
 }
@@ -495,10 +522,14 @@ double solver_step_size(const solver *sv, const double *dx)
 static double evaluate(solver *sv, const double *x, double q, double *f)
 {
     tape *t = &sv->tp;
+    if (!(q == sv->tape_q)) {
+        tape_set_var(t, SYS_VAR_Q(sv->n), q);
+        tape_run_invariant(t, PHASE_POSITION);
+        sv->tape_q = q;
+    }
     for (int i = 0; i < sv->ns; i++)
         tape_set_var(t, sv->col[i], x[i]);
-    tape_set_var(t, SYS_VAR_Q(sv->n), q);
-    tape_run(t, PHASE_POSITION);
+    tape_run_variant(t, PHASE_POSITION);
     for (int i = 0; i < sv->nr; i++)
         f[i] = tape_value(t, sv->proot[i]);
     for (int k = 0; k < sv->nnzJ; k++)
@@ -507,7 +538,7 @@ static double evaluate(solver *sv, const double *x, double q, double *f)
 }
 
 /* Scale every column of J to unit largest entry (J C), remembering C, and
- * place the values in the KLU matrix (J itself, or [I JC; (JC)^T 0]). */
+ * place the values in the factored matrix (J itself, or [I JC; (JC)^T 0]). */
 static void equilibrate(solver *sv)
 {
     const int *Jp = sv->aug ? sv->Ap + sv->nr : sv->Ap;  /* column starts of J's entries */
@@ -516,7 +547,7 @@ static void equilibrate(solver *sv)
         int len = sv->aug ? Jp[c + 1] - Jp[c] : sv->Ap[c + 1] - sv->Ap[c];
         double big = 0.0;
         for (int p = 0; p < len; p++)
-            big = fmax(big, fabs(sv->Jv[k + p]));
+            big = fabs(sv->Jv[k + p]) > big ? fabs(sv->Jv[k + p]) : big;
         double cs = big > 0.0 && isfinite(big) ? 1.0 / big : 1.0;
         sv->cscale[c] = cs;
         for (int p = 0; p < len; p++, k++) {
@@ -531,51 +562,18 @@ static void equilibrate(solver *sv)
     }
 }
 
-static int fresh_factor(solver *sv)
-{
-    if (sv->num)
-        klu_free_numeric(&sv->num, &sv->common);
-    sv->num = klu_factor(sv->Ap, sv->Ai, sv->Ax, sv->sym, &sv->common);
-    sv->stats_factor++;
-    if (!sv->num)
-        return -1;
-    klu_rcond(sv->sym, sv->num, &sv->common);
-    sv->pivot_ratio = sv->pivot_ratio_factor = sv->common.rcond;
-    /* refactoring keeps this pivot order: its parity holds until the next */
-    sv->perm_parity = parity(sv->num->Pnum, sv->N, sv->seen) ^ sv->q_parity;
-    return 0;
-}
-
-/* Factor the Jacobian in Ax: refactor with the old pivots while they hold. */
+/* Factor the Jacobian of the last evaluation, columns equilibrated. */
 static int factor(solver *sv)
 {
     equilibrate(sv);
-    for (int p = 0; p < sv->nnz; p++)
-        if (!isfinite(sv->Ax[p]))
-            return -1;
-    if (sv->num && klu_refactor(sv->Ap, sv->Ai, sv->Ax, sv->sym, sv->num, &sv->common)) {
-        sv->stats_refactor++;
-        klu_rcond(sv->sym, sv->num, &sv->common);
-        sv->pivot_ratio = sv->common.rcond;
-        /* pivots chosen for another position have degraded: pivot afresh */
-        if (!(sv->pivot_ratio >= 1e-3 * sv->pivot_ratio_factor) && fresh_factor(sv) < 0)
-            return -1;
-    } else if (fresh_factor(sv) < 0) {
-        return -1;
-    }
-    return 0;
+    return linsys_factor(&sv->ls, sv->Ax);
 }
 
-/* Reciprocal 1-norm condition estimate of the equilibrated Jacobian
- * (klu_condest, Hager's method: a few solves). klu_rcond's pivot ratio is
- * not a condition estimate: pivoting that prefers the diagonal can make it
- * 1e-6 at a perfectly regular position. */
+/* Reciprocal 1-norm condition of the equilibrated Jacobian at the current
+ * factors (docs/solver.md, section 4). */
 static double condition(solver *sv)
 {
-    if (klu_condest(sv->Ap, sv->Ax, sv->sym, sv->num, &sv->common) && sv->common.condest > 0.0)
-        sv->rcond = 1.0 / sv->common.condest;
-    else
-        sv->rcond = 0.0;
+    linsys_condition(&sv->ls, sv->Ax, &sv->rcond, &sv->rcond_whole);
     return sv->rcond;
 }
 
@@ -588,7 +586,7 @@ static void linear_solve(solver *sv, const double *b, double *dx)
     memcpy(w, b, (size_t)sv->nr * sizeof *w);
     for (int i = sv->nr; i < sv->N; i++)
         w[i] = 0.0;
-    klu_solve(sv->sym, sv->num, sv->N, 1, w, &sv->common);
+    linsys_solve(&sv->ls, w);
     const double *y = sv->aug ? w + sv->nr : w;
     for (int i = 0; i < sv->ns; i++)
         dx[i] = y[i] * sv->cscale[i];
@@ -619,7 +617,7 @@ step_status solver_newton(solver *sv, double q)
         if (!(sv->rcond > 0.0))  /* the first factorisation: a condition for the floor */
             condition(sv);
         if (it == 0)
-            xtol = fmax(1e-2 * sv->opt.tol, 8.0 * DBL_EPSILON / fmax(sv->rcond, 1e-300));
+            xtol = fmax(1e-2 * sv->opt.tol, 8.0 * DBL_EPSILON / fmax(sv->rcond_whole, 1e-300));
         linear_solve(sv, sv->f, sv->dx);
         double step = solver_step_size(sv, sv->dx);
         /* converged: residual small, and the step too, or no longer shrinking
@@ -653,17 +651,8 @@ step_status solver_newton(solver *sv, double q)
 
 int solver_det_sign(solver *sv)
 {
-    if (!sv->num || sv->N == 0)
-        return 1;
-    /* L U = A(Pnum, Q) with unit-diagonal L; the column scaling is positive */
-    const double *ud = sv->num->Udiag;
-    int neg = sv->perm_parity;
-    for (int k = 0; k < sv->N; k++) {
-        if (ud[k] == 0.0)
-            return 0;
-        neg ^= ud[k] < 0.0;
-    }
-    return neg ? -1 : 1;
+    /* the column scaling is positive: the sign is that of the factors */
+    return sv->N == 0 ? 1 : linsys_det_sign(&sv->ls);
 }
 
 void solver_velocity_rhs(solver *sv, double *out)
@@ -696,7 +685,7 @@ void solver_rates(solver *sv)
 
 /* xdot = x_q qd and xddot = x_qq qd^2 + x_q qdd (the loop equations do not
  * depend on time explicitly). */
-void solver_publish(solver *sv, double q, double qd, double qdd)
+static void publish(solver *sv, double q, double qd, double qdd, int rates)
 {
     int n = sv->n;
     sv->pos[n] = q;
@@ -708,6 +697,21 @@ void solver_publish(solver *sv, double q, double qd, double qdd)
         sv->vel[c] = sv->xq[i] * qd;
         sv->acc[c] = sv->xqq[i] * qd * qd + sv->xq[i] * qdd;
     }
-    kin_update(&sv->tree, &sv->ks, sv->pos, sv->level & MECH_WANT_VELOCITY ? sv->vel : NULL,
-               sv->level & MECH_WANT_ACCELERATION ? sv->acc : NULL);
+    /* cos and sin of the angles the tape computed at these values */
+    const double *reg = sv->tp.reg;
+    for (int l = 1; l < sv->m->nlinks; l++) {
+        const int *g = sv->trig + 3 * l;
+        if (g[0] >= 0 && reg[g[0]] == sv->pos[sv->tree.angle_var[l]]) {
+            sv->ks.th[l] = reg[g[0]];
+            sv->ks.c[l] = reg[g[1]];
+            sv->ks.s[l] = reg[g[2]];
+        }
+    }
+    kin_update(&sv->tree, &sv->ks, sv->pos,
+               rates && sv->level & MECH_WANT_VELOCITY ? sv->vel : NULL,
+               rates && sv->level & MECH_WANT_ACCELERATION ? sv->acc : NULL);
 }
+
+void solver_publish(solver *sv, double q, double qd, double qdd) { publish(sv, q, qd, qdd, 1); }
+
+void solver_publish_positions(solver *sv, double q) { publish(sv, q, 0.0, 0.0, 0); }

@@ -4,9 +4,8 @@
 #ifndef MECH_SOLVE_H
 #define MECH_SOLVE_H
 
-#include <klu.h>
-
 #include "kinematics.h"
+#include "linsys.h"
 #include "system.h"
 
 typedef enum {
@@ -33,8 +32,8 @@ typedef struct solver {
     int *col;                  /* [ns] unknown of each solved column */
     int *row;                  /* [nr] equation of each solved row */
     int nblocks, nblocks_solved;
-    int N;                     /* order of the KLU matrix: ns, or nr + ns */
-    int *Ap, *Ai;              /* [N+1], [nnz] pattern of the KLU matrix */
+    int N;                     /* order of the factored matrix: ns, or nr + ns */
+    int *Ap, *Ai;              /* [N+1], [nnz] pattern of the factored matrix */
     double *Ax;                /* [nnz] values, columns equilibrated */
     int nnz;
     double *Jv;                /* [nnzJ] the Jacobian's values, in J's CSC order */
@@ -43,14 +42,16 @@ typedef struct solver {
     double *rhs;               /* [N] solve work */
     double *cscale;            /* [ns] column scaling of the last factorisation */
     tape tp;                   /* evaluator of the solved rows only */
+    double tape_q;             /* driver position of the tape's invariant part */
+    int *trig;                 /* [3 nlinks] registers of each link's angle, its cos and
+                                  sin in the tape (first -1: not there) */
     ex *proot, *vroot, *aroot; /* roots of the three phases */
 
-    klu_common common;
-    klu_symbolic *sym;
-    klu_numeric *num;
-    double rcond;              /* 1 / klu_condest at the last converged position */
-    double pivot_ratio;        /* klu_rcond (min/max pivot) now, and after the last */
-    double pivot_ratio_factor; /* full factorisation: refactor or pivot afresh */
+    linsys ls;                 /* factors of the equilibrated Jacobian */
+    double rcond;              /* reciprocal condition at the last converged position
+                                  (the worst diagonal block's) */
+    double rcond_whole;        /* the whole Jacobian's (the rounding floor of Newton's
+                                  step): far smaller along a chain of blocks */
 
     double *pos, *vel, *acc;   /* [n+1] variable values (n = driver), SI */
     double *x;                 /* [ns] current solved unknowns */
@@ -59,13 +60,9 @@ typedef struct solver {
     double *dx, *xt;           /* [ns] work */
     double resid;              /* |f|inf at x */
     int iters;                 /* Newton iterations of the last solve */
-    int stats_factor, stats_refactor;
 
     kin_tree tree;
     kin_state ks;
-    unsigned char *seen;       /* [N] scratch for permutation parities */
-    int q_parity;              /* parity of KLU's column order (fixed by klu_analyze) */
-    int perm_parity;           /* of the row and column orders of the current factors */
 } solver;
 
 int solver_init(solver *sv, const mech_model *m, const mech_solve_options *o, mech_diag *d);
@@ -79,6 +76,8 @@ void solver_rates(solver *sv);
 /* Scatter x, and the rates for driver speed qd and acceleration qdd, into
  * pos, vel, acc and update the link frames. */
 void solver_publish(solver *sv, double q, double qd, double qdd);
+/* The same for positions only (the frames' rates are left zero). */
+void solver_publish_positions(solver *sv, double q);
 
 /* Sign of det of the factored matrix (+1, -1, 0 singular): a change between
  * two positions means the sweep crossed a singular one. */

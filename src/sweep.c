@@ -256,9 +256,9 @@ static void report_singular(sweep *w, double q)
         size_t at = strlen(what);
         snprintf(what + at, sizeof what - at, " are not determined by ");
         list_large(sv, left, 1, what, sizeof what);
-    } else if (sv->common.singular_col >= 0 && sv->common.singular_col < sv->ns) {
+    } else if (linsys_singular_col(&sv->ls) >= 0 && linsys_singular_col(&sv->ls) < sv->ns) {
         snprintf(what, sizeof what, ": the unknown %s is not determined",
-                 sv->sys->names[sv->col[sv->common.singular_col]]);
+                 sv->sys->names[sv->col[linsys_singular_col(&sv->ls)]]);
     }
     free(right);
     free(left);
@@ -420,7 +420,7 @@ static step_status try_position(sweep *w, double qn, int continuing)
     solver_rates(sv);
     int b;
     if (w->m->nbranches) {  /* the branch test needs the point positions */
-        solver_publish(sv, qn, 1.0, 0.0);
+        solver_publish_positions(sv, qn);
         if (!branches_hold(w, &b))
             return STEP_BRANCH;
     }
@@ -971,8 +971,8 @@ static void finish_stats(sweep *w, int rows, double t0)
     mech_solve_stats *st = w->st;
     st->steps = rows;
     st->seconds = now_seconds() - t0;  /* t0: after the set-up */
-    st->factorizations = w->sv.stats_factor;
-    st->refactorizations = w->sv.stats_refactor;
+    st->factorizations = w->sv.ls.factorizations;
+    st->refactorizations = w->sv.ls.refactorizations;
     st->nunknowns = w->sv.n;
     st->nsolved = w->sv.ns;
     st->nblocks = w->sv.nblocks;

@@ -97,6 +97,82 @@ static int emit(tape *t, const expr_ctx *c, ex root, work_stack *st, size_t *cap
     return 0;
 }
 
+/* sin(x) and cos(x) of the same register in one phase become one SINCOS
+ * at the first of the two (a loop equation's Jacobian has both of every
+ * angle): glibc's sincos costs little more than one of them. The later
+ * instruction is removed; registers are single-assignment, so computing
+ * its value earlier is harmless. */
+static int fuse_sincos(tape *t)
+{
+    int *first = xcalloc((size_t)t->nreg + 1, sizeof *first);  /* 1 + where, by argument */
+    if (!first)
+        return -1;
+    int out = 0;
+    for (int k = 0; k < t->nphases; k++) {
+        int start = t->phase_start[k], end = t->phase_start[k + 1];
+        t->phase_start[k] = out;
+        for (int i = start; i < end; i++) {
+            tape_ins in = t->ins[i];
+            if (in.op == TOP_SIN || in.op == TOP_COS) {
+                int f = first[in.a] - 1;
+                if (f >= t->phase_start[k] && t->ins[f].op != in.op &&
+                    t->ins[f].op != TOP_SINCOS) {
+                    int sin_d = in.op == TOP_SIN ? in.d : t->ins[f].d;
+                    int cos_d = in.op == TOP_COS ? in.d : t->ins[f].d;
+                    t->ins[f] = (tape_ins){TOP_SINCOS, sin_d, in.a, cos_d};
+                    continue;  /* dropped */
+                }
+                if (f < t->phase_start[k])
+                    first[in.a] = out + 1;
+            }
+            t->ins[out++] = in;
+        }
+        t->phase_split[k] = t->phase_start[k];
+    }
+    t->phase_start[t->nphases] = t->nins = out;
+    free(first);
+    return 0;
+}
+
+void tape_hoist(tape *t, int phase, const unsigned char *invariant)
+{
+    unsigned char *variant = xcalloc((size_t)t->nreg + 1, 1);
+    tape_ins *moved = xcalloc((size_t)t->nins + 1, sizeof *moved);
+    int start = t->phase_start[phase], end = t->phase_start[phase + 1];
+    if (!variant || !moved) {  /* no hoisting: still correct, run whole */
+        free(variant);
+        free(moved);
+        return;
+    }
+    for (int v = 0; v < t->nvars; v++)
+        if (t->var_reg[v] >= 0 && !invariant[v])
+            variant[t->var_reg[v]] = 1;
+    /* registers written by earlier phases count as variant: their inputs
+       may change between runs of this phase */
+    for (int i = 0; i < start; i++) {
+        variant[t->ins[i].d] = 1;
+        if (t->ins[i].op == TOP_SINCOS)
+            variant[t->ins[i].b] = 1;
+    }
+    int nfixed = 0, nvar = 0;
+    for (int i = start; i < end; i++) {
+        tape_ins in = t->ins[i];
+        int binary = in.op == TOP_ADD || in.op == TOP_MUL;
+        int v = variant[in.a] | (binary ? variant[in.b] : 0);
+        variant[in.d] = (unsigned char)v;
+        if (in.op == TOP_SINCOS)
+            variant[in.b] = (unsigned char)v;
+        if (v)
+            moved[nvar++] = in;
+        else
+            t->ins[start + nfixed++] = in;  /* stable: order within each part kept */
+    }
+    memcpy(t->ins + start + nfixed, moved, (size_t)nvar * sizeof *moved);
+    t->phase_split[phase] = start + nfixed;
+    free(variant);
+    free(moved);
+}
+
 int tape_compile(tape *t, expr_ctx *c, int nvars, int nphases, const ex *const *roots,
                  const int *nroots)
 {
@@ -121,7 +197,11 @@ int tape_compile(tape *t, expr_ctx *c, int nvars, int nphases, const ex *const *
                 goto fail;
     }
     t->phase_start[nphases] = t->nins;
+    for (int k = 0; k < nphases; k++)
+        t->phase_split[k] = t->phase_start[k];
     free(stack.v);
+    if (fuse_sincos(t) < 0)
+        goto fail;
     return 0;
 fail:
     free(stack.v);
@@ -129,11 +209,11 @@ fail:
     return -1;
 }
 
-void tape_run(tape *t, int phase)
+static void run_range(tape *t, int from, int to)
 {
     double *r = t->reg;
     const tape_ins *ins = t->ins;
-    for (int i = t->phase_start[phase], end = t->phase_start[phase + 1]; i < end; i++) {
+    for (int i = from; i < to; i++) {
         const tape_ins *p = &ins[i];
         switch (p->op) {
         case TOP_ADD: r[p->d] = r[p->a] + r[p->b]; break;
@@ -141,6 +221,24 @@ void tape_run(tape *t, int phase)
         case TOP_NEG: r[p->d] = -r[p->a]; break;
         case TOP_SIN: r[p->d] = sin(r[p->a]); break;
         case TOP_COS: r[p->d] = cos(r[p->a]); break;
+        case TOP_SINCOS: {
+            double x = r[p->a];  /* the compiler makes this one sincos call */
+            r[p->d] = sin(x);
+            r[p->b] = cos(x);
+            break;
+        }
         }
     }
+}
+
+void tape_run(tape *t, int phase) { run_range(t, t->phase_start[phase], t->phase_start[phase + 1]); }
+
+void tape_run_invariant(tape *t, int phase)
+{
+    run_range(t, t->phase_start[phase], t->phase_split[phase]);
+}
+
+void tape_run_variant(tape *t, int phase)
+{
+    run_range(t, t->phase_split[phase], t->phase_start[phase + 1]);
 }

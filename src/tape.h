@@ -13,7 +13,8 @@ typedef enum {
     TOP_MUL, /* r[d] = r[a] * r[b] */
     TOP_NEG, /* r[d] = -r[a] */
     TOP_SIN, /* r[d] = sin(r[a]) */
-    TOP_COS  /* r[d] = cos(r[a]) */
+    TOP_COS, /* r[d] = cos(r[a]) */
+    TOP_SINCOS /* r[d] = sin(r[a]), r[b] = cos(r[a]): one sincos call */
 } tape_op;
 
 typedef struct tape_ins {
@@ -29,6 +30,8 @@ typedef struct tape {
     tape_ins *ins;      /* [nins] instructions, grouped by phase */
     int nins;
     int phase_start[TAPE_MAX_PHASES + 1]; /* phase k: phase_start[k] .. phase_start[k+1]-1 */
+    int phase_split[TAPE_MAX_PHASES];     /* phase k's instructions before this one depend
+                                             only on the invariant variables (tape_hoist) */
     int nphases;
     int *var_reg;       /* [nvars] register of each variable (-1: not used) */
     int nvars;
@@ -40,8 +43,15 @@ typedef struct tape {
 int tape_compile(tape *t, expr_ctx *c, int nvars, int nphases, const ex *const *roots,
                  const int *nroots);
 void tape_free(tape *t);
-/* Run the instructions of one phase. */
+/* Move the instructions of a phase that depend only on constants and the
+ * variables with invariant[var] != 0 to its start, so that they can be run
+ * once while the other variables change (tape_run_invariant). */
+void tape_hoist(tape *t, int phase, const unsigned char *invariant);
+/* Run the instructions of one phase; or only its invariant part, or only
+ * the rest (valid while the invariant variables have not changed). */
 void tape_run(tape *t, int phase);
+void tape_run_invariant(tape *t, int phase);
+void tape_run_variant(tape *t, int phase);
 static inline double tape_value(const tape *t, ex e) { return t->reg[t->node_reg[e]]; }
 static inline void tape_set_var(tape *t, int var, double v)
 {

@@ -197,6 +197,25 @@ for f in mechanisms/*.yaml; do
     run "mech solve $f" 0 "$MECH" solve "$f" -o "$tmp/all.csv" && pass
 done
 
+# --linear-solver: KLU and the dense blocks give the same table (to 1e-12 of
+# each column's values), --verbose says which ran, a bad value is a usage error
+if run "mech solve --linear-solver klu" 0 "$MECH" solve mechanisms/stirling.yaml \
+       --linear-solver klu --verbose -o "$tmp/klu.csv" &&
+   grep -q '^linear solves: KLU$' "$tmp/err" &&
+   run "mech solve --linear-solver auto" 0 "$MECH" solve mechanisms/stirling.yaml \
+       --verbose -o "$tmp/auto.csv" &&
+   grep -q '^linear solves: dense blocks (6 blocks, largest 2x2)$' "$tmp/err" &&
+   run "compare klu with auto" 0 "$MECH" compare "$tmp/auto.csv" "$tmp/klu.csv" \
+       --rtol 1e-12 --atol 1e-13; then
+    pass
+else
+    fail "mech solve --linear-solver: KLU and dense blocks differ, or --verbose does not say"
+fi
+if run "mech solve --linear-solver bad" 2 "$MECH" solve mechanisms/stirling.yaml \
+       --linear-solver lapack; then
+    has_line "$tmp/err" "needs auto or klu, not 'lapack'" "--linear-solver lapack"
+fi
+
 # ---- mech batch -----------------------------------------------------------
 
 if run "mech batch --help" 0 "$MECH" batch --help; then

@@ -1,0 +1,469 @@
+/* src/blocklu.c: dense LU of the small diagonal blocks of a block
+ * triangular form (blocklu.h, docs/solver.md "Linear solves").
+ *
+ * Planar mechanisms give Jacobians whose block triangular form has blocks
+ * of one or two loops (1x1 to 8x8). At that size KLU's per-call overhead
+ * (its own block loop, pivot bookkeeping, a general sparse kernel) costs
+ * more than the arithmetic; a dense kernel per block is several times
+ * faster and still exploits the sparsity that matters, the triangular
+ * coupling between blocks, which stays sparse. */
+#include <btf.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "blocklu.h"
+#include "internal.h"
+
+/* Exact inverse norm up to this block size; Hager's estimate above. */
+enum { EXACT_NORM_MAX = 8, HAGER_ITERATIONS = 5 };
+
+static int permutation_parity(const int *perm, int n, unsigned char *seen)
+{
+    int odd = 0;
+    memset(seen, 0, (size_t)n);
+    for (int i = 0; i < n; i++) {
+        int len = 0;
+        for (int k = i; !seen[k]; k = perm[k], len++)
+            seen[k] = 1;
+        if (len > 0)
+            odd ^= (len - 1) & 1;
+    }
+    return odd;
+}
+
+void blocklu_free(blocklu *b)
+{
+    void *blocks[] = {b->P, b->Q, b->R, b->at, b->where, b->v, b->op, b->oi, b->piv,
+                      b->anorm, b->colnorm, b->w};
+    for (size_t i = 0; i < sizeof blocks / sizeof blocks[0]; i++)
+        free(blocks[i]);
+    memset(b, 0, sizeof *b);
+}
+
+/* Where each entry of A goes: its block's dense storage, or the list of
+ * entries above the blocks (CSC by permuted column). */
+static int place_entries(blocklu *b, const int *Ap, const int *Ai, const int *pinv,
+                         const int *blk)
+{
+    int n = b->n, nnz = Ap[n], above = 0;
+    for (int k = 0; k < n; k++) {  /* permuted column k is column Q[k] of A */
+        int c = b->Q[k];
+        for (int p = Ap[c]; p < Ap[c + 1]; p++)
+            above += blk[pinv[Ai[p]]] != blk[k];
+    }
+    b->op = xcalloc((size_t)n + 1, sizeof *b->op);
+    b->oi = xcalloc((size_t)above + 1, sizeof *b->oi);
+    b->where = xcalloc((size_t)nnz + 1, sizeof *b->where);
+    b->v = xcalloc((size_t)(b->ndense + above) + 1, sizeof *b->v);
+    if (!b->op || !b->oi || !b->where || !b->v)
+        return -1;
+    int e = 0;
+    for (int k = 0; k < n; k++) {
+        int c = b->Q[k], bk = blk[k], k0 = b->R[bk], size = b->R[bk + 1] - k0;
+        b->op[k] = e;
+        for (int p = Ap[c]; p < Ap[c + 1]; p++) {
+            int i = pinv[Ai[p]];
+            if (blk[i] == bk) {
+                b->where[p] = b->at[bk] + (i - k0) + (k - k0) * size;
+            } else {
+                b->oi[e] = i;
+                b->where[p] = b->ndense + e++;
+            }
+        }
+    }
+    b->op[n] = e;
+    b->nnz = nnz;
+    return 0;
+}
+
+int blocklu_analyze(blocklu *b, int n, const int *Ap, const int *Ai, int max_block)
+{
+    memset(b, 0, sizeof *b);
+    b->n = n;
+    b->singular_col = -1;
+    b->P = xcalloc((size_t)n + 1, sizeof *b->P);
+    b->Q = xcalloc((size_t)n + 1, sizeof *b->Q);
+    b->R = xcalloc((size_t)n + 2, sizeof *b->R);
+    b->piv = xcalloc((size_t)n + 1, sizeof *b->piv);
+    int *work = xcalloc(5 * (size_t)n + 1, sizeof *work);
+    int *pinv = xcalloc((size_t)n + 1, sizeof *pinv), *blk = xcalloc((size_t)n + 1, sizeof *blk);
+    int rc = -1;
+    if (!b->P || !b->Q || !b->R || !b->piv || !work || !pinv || !blk)
+        goto done;
+    double maxwork_done;
+    int nmatch = 0;
+    /* btf_order takes non-const arrays but does not modify them */
+    b->nblocks = btf_order(n, (int *)Ap, (int *)Ai, 0.0, &maxwork_done, b->P, b->Q, b->R,
+                           &nmatch, work);
+    if (nmatch < n) {
+        rc = 1;
+        goto done;
+    }
+    b->at = xcalloc((size_t)b->nblocks + 1, sizeof *b->at);
+    b->anorm = xcalloc((size_t)b->nblocks + 1, sizeof *b->anorm);
+    if (!b->at || !b->anorm)
+        goto done;
+    for (int k = 0; k < b->nblocks; k++) {
+        int size = b->R[k + 1] - b->R[k];
+        if (size > b->largest)
+            b->largest = size;
+        b->at[k] = b->ndense;
+        b->ndense += size * size;
+        for (int i = b->R[k]; i < b->R[k + 1]; i++)
+            blk[i] = k;
+    }
+    if (b->largest > max_block) {
+        rc = 2;
+        goto done;
+    }
+    for (int k = 0; k < n; k++)
+        pinv[b->P[k]] = k;
+    b->w = xcalloc(4 * (size_t)n + 3 * (size_t)b->largest + 1, sizeof *b->w);
+    b->colnorm = xcalloc((size_t)n + 1, sizeof *b->colnorm);
+    if (!b->w || !b->colnorm || place_entries(b, Ap, Ai, pinv, blk) < 0)
+        goto done;
+    unsigned char *seen = (unsigned char *)work;  /* 5n ints: room for n bytes */
+    b->pq_parity = permutation_parity(b->P, n, seen) ^ permutation_parity(b->Q, n, seen);
+    rc = 0;
+done:
+    free(work);
+    free(pinv);
+    free(blk);
+    return rc;
+}
+
+/* ---- one dense block, k x k column major ----------------------------- */
+
+/* LU with partial pivoting in place: P a = L U, unit L below the diagonal.
+ * Returns the local column of a zero pivot, or -1. */
+static int block_factor_general(double *a, int k, int *piv, int *swaps)
+{
+    for (int j = 0; j < k; j++) {
+        int p = j;
+        for (int i = j + 1; i < k; i++)
+            if (fabs(a[i + j * k]) > fabs(a[p + j * k]))
+                p = i;
+        piv[j] = p;
+        if (!(a[p + j * k] != 0.0))
+            return j;
+        if (p != j) {
+            *swaps ^= 1;
+            for (int c = 0; c < k; c++) {
+                double t = a[j + c * k];
+                a[j + c * k] = a[p + c * k];
+                a[p + c * k] = t;
+            }
+        }
+        double inv = 1.0 / a[j + j * k];
+        for (int i = j + 1; i < k; i++)
+            a[i + j * k] *= inv;
+        for (int c = j + 1; c < k; c++) {
+            double t = a[j + c * k];
+            if (t != 0.0)
+                for (int i = j + 1; i < k; i++)
+                    a[i + c * k] -= a[i + j * k] * t;
+        }
+    }
+    return -1;
+}
+
+static inline int block_factor(double *a, int k, int *piv, int *swaps)
+{
+    if (k == 1) {
+        piv[0] = 0;
+        return a[0] != 0.0 ? -1 : 0;
+    }
+    if (k == 2) {
+        piv[0] = fabs(a[1]) > fabs(a[0]);
+        piv[1] = 1;
+        if (piv[0]) {
+            double t = a[0];
+            a[0] = a[1], a[1] = t;
+            t = a[2];
+            a[2] = a[3], a[3] = t;
+            *swaps ^= 1;
+        }
+        if (!(a[0] != 0.0))
+            return 0;
+        a[1] /= a[0];
+        a[3] -= a[1] * a[2];
+        return a[3] != 0.0 ? -1 : 1;
+    }
+    return block_factor_general(a, k, piv, swaps);
+}
+
+/* y := (P^T L U)^-1 y */
+static void block_solve_general(const double *a, int k, const int *piv, double *y)
+{
+    for (int j = 0; j < k; j++) {
+        double t = y[piv[j]];
+        y[piv[j]] = y[j];
+        y[j] = t;
+    }
+    for (int j = 0; j < k; j++)
+        for (int i = j + 1; i < k; i++)
+            y[i] -= a[i + j * k] * y[j];
+    for (int j = k - 1; j >= 0; j--) {
+        y[j] /= a[j + j * k];
+        for (int i = 0; i < j; i++)
+            y[i] -= a[i + j * k] * y[j];
+    }
+}
+
+/* Blocks of one and two equations (most of them: one loop's two unknowns)
+ * unrolled; the loops' overhead is most of the work at this size. */
+static inline void block_solve(const double *a, int k, const int *piv, double *y)
+{
+    if (k == 1) {
+        y[0] /= a[0];
+    } else if (k == 2) {
+        if (piv[0]) {
+            double t = y[0];
+            y[0] = y[1];
+            y[1] = t;
+        }
+        double y1 = (y[1] - a[1] * y[0]) / a[3];
+        y[0] = (y[0] - a[2] * y1) / a[0];
+        y[1] = y1;
+    } else {
+        block_solve_general(a, k, piv, y);
+    }
+}
+
+/* y := (P^T L U)^-T y = P^T L^-T U^-T y */
+static void block_solve_transposed(const double *a, int k, const int *piv, double *y)
+{
+    for (int j = 0; j < k; j++) {
+        double s = y[j];
+        for (int i = 0; i < j; i++)
+            s -= a[i + j * k] * y[i];
+        y[j] = s / a[j + j * k];
+    }
+    for (int j = k - 1; j >= 0; j--) {
+        double s = y[j];
+        for (int i = j + 1; i < k; i++)
+            s -= a[i + j * k] * y[i];
+        y[j] = s;
+    }
+    for (int j = k - 1; j >= 0; j--) {
+        double t = y[piv[j]];
+        y[piv[j]] = y[j];
+        y[j] = t;
+    }
+}
+
+static double norm1(const double *y, int k)
+{
+    double s = 0.0;
+    for (int i = 0; i < k; i++)
+        s += fabs(y[i]);
+    return s;
+}
+
+/* |B^-1|_1 exactly: the largest column sum of the inverse. */
+static double inverse_norm_exact(const double *a, int k, const int *piv, double *y)
+{
+    double big = 0.0;
+    for (int j = 0; j < k; j++) {
+        memset(y, 0, (size_t)k * sizeof *y);
+        y[j] = 1.0;
+        block_solve(a, k, piv, y);
+        double ny = norm1(y, k);
+        big = ny > big ? ny : big;
+    }
+    return big;
+}
+
+/* Hager's estimate of |B^-1|_1 (a lower bound, usually exact): climb the
+ * convex function |B^-1 x|_1 over the unit 1-ball from its centre, moving
+ * to the vertex its gradient points to, until that stops increasing it. */
+static double inverse_norm_hager(const double *a, int k, const int *piv, double *w)
+{
+    double *x = w, *y = w + k, *z = w + 2 * k, est = 0.0;
+    for (int i = 0; i < k; i++)
+        x[i] = 1.0 / k;
+    for (int it = 0; it < HAGER_ITERATIONS; it++) {
+        memcpy(y, x, (size_t)k * sizeof *y);
+        block_solve(a, k, piv, y);
+        double ny = norm1(y, k);
+        if (it > 0 && ny <= est)
+            break;
+        est = ny;
+        for (int i = 0; i < k; i++)
+            z[i] = y[i] >= 0.0 ? 1.0 : -1.0;
+        block_solve_transposed(a, k, piv, z);
+        int j = 0;
+        double ztx = 0.0;
+        for (int i = 0; i < k; i++) {
+            ztx += z[i] * x[i];
+            if (fabs(z[i]) > fabs(z[j]))
+                j = i;
+        }
+        if (it > 0 && fabs(z[j]) <= ztx)
+            break;
+        memset(x, 0, (size_t)k * sizeof *x);
+        x[j] = 1.0;
+    }
+    return est;
+}
+
+/* ---- the whole matrix -------------------------------------------------- */
+
+/* The 1-norm of each column of A (colnorm), and of the block columns of A
+ * (anorm: a block's columns with the entries above the block). A block's
+ * reciprocal condition is measured against its whole columns: after the
+ * columns are equilibrated a 1x1 block is always 1 on its own, yet near
+ * zero next to the entries above it at a singular position. */
+static void column_norms(blocklu *b)
+{
+    const double *above = b->v + b->ndense;
+    for (int k = 0; k < b->nblocks; k++) {
+        int k0 = b->R[k], size = b->R[k + 1] - k0;
+        const double *a = b->v + b->at[k];
+        double big = 0.0;
+        for (int j = 0; j < size; j++) {
+            double sum = 0.0;
+            for (int i = 0; i < size; i++)
+                sum += fabs(a[i + j * size]);
+            for (int p = b->op[k0 + j]; p < b->op[k0 + j + 1]; p++)
+                sum += fabs(above[p]);
+            b->colnorm[k0 + j] = sum;
+            big = sum > big ? sum : big;
+        }
+        b->anorm[k] = big;
+    }
+}
+
+int blocklu_factor(blocklu *b, const double *Ax)
+{
+    memset(b->v, 0, (size_t)b->ndense * sizeof *b->v);
+    b->singular_col = -1;
+    for (int p = 0; p < b->nnz; p++) {
+        if (!isfinite(Ax[p]))
+            return -1;
+        b->v[b->where[p]] = Ax[p];
+    }
+    column_norms(b);
+    b->swap_parity = 0;
+    for (int k = 0; k < b->nblocks; k++) {
+        int k0 = b->R[k], size = b->R[k + 1] - k0;
+        double *a = b->v + b->at[k];
+        int zero = block_factor(a, size, b->piv + k0, &b->swap_parity);
+        if (zero >= 0) {
+            b->singular_col = b->Q[k0 + zero];
+            return -1;
+        }
+    }
+    return 0;
+}
+
+/* Backward over the blocks (the form is upper block triangular): solve the
+ * block, then move its columns' entries above it to the right-hand side. */
+void blocklu_solve(blocklu *b, double *x)
+{
+    double *y = b->w;
+    const double *above = b->v + b->ndense;
+    for (int k = 0; k < b->n; k++)
+        y[k] = x[b->P[k]];
+    for (int k = b->nblocks - 1; k >= 0; k--) {
+        int k0 = b->R[k], size = b->R[k + 1] - k0;
+        block_solve(b->v + b->at[k], size, b->piv + k0, y + k0);
+        for (int j = k0; j < k0 + size; j++)
+            for (int p = b->op[j]; p < b->op[j + 1]; p++)
+                y[b->oi[p]] -= above[p] * y[j];
+    }
+    for (int k = 0; k < b->n; k++)
+        x[b->Q[k]] = y[k];
+}
+
+/* x := A^-T x: forward over the blocks (A^T is lower block triangular). */
+static void solve_transposed(blocklu *b, double *x)
+{
+    double *y = b->w;
+    const double *above = b->v + b->ndense;
+    for (int k = 0; k < b->n; k++)
+        y[k] = x[b->Q[k]];
+    for (int k = 0; k < b->nblocks; k++) {
+        int k0 = b->R[k], size = b->R[k + 1] - k0;
+        for (int j = k0; j < k0 + size; j++)
+            for (int p = b->op[j]; p < b->op[j + 1]; p++)
+                y[j] -= above[p] * y[b->oi[p]];
+        block_solve_transposed(b->v + b->at[k], size, b->piv + k0, y + k0);
+    }
+    for (int k = 0; k < b->n; k++)
+        x[b->P[k]] = y[k];
+}
+
+static double whole_norm1(const blocklu *b)
+{
+    double big = 0.0;
+    for (int j = 0; j < b->n; j++)
+        big = fmax(big, b->colnorm[j]);
+    return big;
+}
+
+double blocklu_rcond_whole(blocklu *b)
+{
+    int n = b->n;
+    double *x = b->w + n, *y = b->w + 2 * n, *z = b->w + 3 * n, est = 0.0;
+    for (int i = 0; i < n; i++)
+        x[i] = 1.0 / n;
+    for (int it = 0; it < HAGER_ITERATIONS; it++) {  /* as inverse_norm_hager */
+        memcpy(y, x, (size_t)n * sizeof *y);
+        blocklu_solve(b, y);
+        double ny = norm1(y, n);
+        if (it > 0 && ny <= est)
+            break;
+        est = ny;
+        for (int i = 0; i < n; i++)
+            z[i] = y[i] >= 0.0 ? 1.0 : -1.0;
+        solve_transposed(b, z);
+        int j = 0;
+        double ztx = 0.0;
+        for (int i = 0; i < n; i++) {
+            ztx += z[i] * x[i];
+            if (fabs(z[i]) > fabs(z[j]))
+                j = i;
+        }
+        if (it > 0 && fabs(z[j]) <= ztx)
+            break;
+        memset(x, 0, (size_t)n * sizeof *x);
+        x[j] = 1.0;
+    }
+    double anorm = whole_norm1(b), r = anorm > 0.0 && est > 0.0 ? 1.0 / (anorm * est) : 0.0;
+    return r >= 0.0 ? r : 0.0;
+}
+
+double blocklu_rcond(blocklu *b)
+{
+    double worst = 1.0;
+    double *w = b->w + 4 * b->n;
+    for (int k = 0; k < b->nblocks; k++) {
+        int k0 = b->R[k], size = b->R[k + 1] - k0;
+        const double *a = b->v + b->at[k];
+        double inv = size <= EXACT_NORM_MAX ? inverse_norm_exact(a, size, b->piv + k0, w)
+                                            : inverse_norm_hager(a, size, b->piv + k0, w);
+        double r = b->anorm[k] > 0.0 && inv > 0.0 ? 1.0 / (b->anorm[k] * inv) : 0.0;
+        if (!(r >= 0.0))  /* NaN: an overflowed inverse, singular */
+            r = 0.0;
+        worst = fmin(worst, r);
+    }
+    return worst;
+}
+
+int blocklu_det_sign(const blocklu *b)
+{
+    int neg = b->pq_parity ^ b->swap_parity;
+    for (int k = 0; k < b->nblocks; k++) {
+        int k0 = b->R[k], size = b->R[k + 1] - k0;
+        const double *a = b->v + b->at[k];
+        for (int j = 0; j < size; j++) {
+            double d = a[j + j * size];
+            if (d == 0.0)
+                return 0;
+            neg ^= d < 0.0;
+        }
+    }
+    return neg ? -1 : 1;
+}

@@ -1,0 +1,57 @@
+/* src/blocklu.h: LU factors of a square sparse matrix whose block
+ * triangular form has only small diagonal blocks (docs/solver.md, section
+ * "Linear solves"). Each diagonal block is stored dense and factored with
+ * partial pivoting; the entries above the blocks stay sparse. Analysis
+ * allocates once; factor, solve and the condition estimate do not. */
+#ifndef MECH_BLOCKLU_H
+#define MECH_BLOCKLU_H
+
+/* Largest diagonal block factored dense: beyond it KLU is used (linsys.c). */
+enum { BLOCKLU_MAX_BLOCK = 16 };
+
+typedef struct blocklu {
+    int n, nblocks, largest;   /* order, number of blocks, largest block */
+    int *P, *Q;                /* [n] A(P,Q) is upper block triangular (btf_order) */
+    int *R;                    /* [nblocks+1] first row/column of each block */
+    int *at;                   /* [nblocks] start of each block's dense storage in v */
+    int nnz;
+    int *where;                /* [nnz] slot in v of each entry of A (CSC order) */
+    int nv;                    /* dense storage, then one slot per entry above the blocks */
+    double *v;                 /* [nv + above] block k x k column major, then those entries */
+    int *op, *oi;              /* [n+1], [above]: entries above the blocks, by permuted
+                                  column: their permuted rows; values v[ndense + p] */
+    int ndense;
+    int *piv;                  /* [n] row swapped into each position within its block */
+    double *anorm;             /* [nblocks] 1-norm of each block's columns (with the
+                                  entries above the block) before factoring */
+    double *colnorm;           /* [n] 1-norm of each column of A */
+    double *w;                 /* [4 n + 3 largest] solve and estimator work */
+    int pq_parity;             /* parity of P and Q together */
+    int swap_parity;           /* parity of the row swaps of the last factorisation */
+    int singular_col;          /* column of A with a zero pivot, or -1 */
+} blocklu;
+
+/* Block triangular form of the pattern (Ap, Ai: CSC, n columns). Returns 0,
+ * 1 when the pattern is structurally singular, 2 when some diagonal block is
+ * larger than max_block, -1 when out of memory. */
+int blocklu_analyze(blocklu *b, int n, const int *Ap, const int *Ai, int max_block);
+void blocklu_free(blocklu *b);
+
+/* Factor the values Ax (the analysed pattern). Returns 0, or -1 for a zero
+ * pivot or a value that is not finite (b->singular_col says where). */
+int blocklu_factor(blocklu *b, const double *Ax);
+/* x := A^-1 x with the last factors. */
+void blocklu_solve(blocklu *b, double *x);
+/* Smallest reciprocal 1-norm condition of the diagonal blocks, each block's
+ * inverse measured against its whole columns: 1 / (|A(:,b)|_1 |A_bb^-1|_1).
+ * The inverse's norm is exact for blocks up to 8x8 (column by column),
+ * Hager's estimate for larger ones. */
+double blocklu_rcond(blocklu *b);
+/* Reciprocal 1-norm condition of the whole A (Hager's estimate with whole
+ * solves): with many blocks in a chain it can be far smaller than the
+ * blocks', since errors pass from block to block. */
+double blocklu_rcond_whole(blocklu *b);
+/* Sign of det A: +1, -1, 0. */
+int blocklu_det_sign(const blocklu *b);
+
+#endif
