@@ -1,9 +1,9 @@
 /* bench/bench_scale.c: how the cost grows with the mechanism. Generated
- * chains of N four-bar loops (the chain of tests/unit/test_hard.c, case 9:
- * loop k's rocker is rigidly loop k+1's crank, one link with three points;
- * every loop a parallelogram, so the exact solution is known and the guesses
- * are exact), N = 10 ... 100 000, each in a child process (fork) so that its
- * peak memory (getrusage ru_maxrss) is its own:
+ * chains of N four-bar loops (loop k's rocker is rigidly loop k+1's crank,
+ * one link with three points; crank-rocker loops alternating with their
+ * mirror images, chain_text; exact guesses at the first position), N = 10
+ * ... 100 000, each in a child process (fork) so that its peak memory
+ * (getrusage ru_maxrss) is its own:
  *
  *   load+check  mech_load_string + mech_check of the generated text
  *   set-up      mech_solve's set-up (system, tape, blocks, klu_analyze)
@@ -47,12 +47,34 @@ typedef struct result {
     char msg[256];
 } result;
 
-/* ---- the chain (as in tests/unit/test_hard.c, with exact guesses) --------- */
+/* ---- the chain ----------------------------------------------------------- */
 
+/* Loop 1 is a crank-rocker four-bar: crank CH_A on L0 at G0, coupler CH_B,
+ * rocker CH_C on L1 at G1, ground CH_D. Loop 2 is loop 1 reflected through
+ * G1 (its input is L1's second arm, opposite the first; its output arm has
+ * CH_A), so it undoes loop 1: L2 turns exactly as L0 (plus 180 deg), and
+ * the pattern repeats. The odd links turn as the rocker, a nonlinear
+ * function of the driver, so Newton has work at every step (the predictor
+ * is not exact), and the motion neither grows nor dies out along the
+ * chain. Every link L1 .. LN is a straight bar pivoted at its middle. */
 #define DEG (M_PI / 180)
-static double chain_arm(int k) { return 0.3 + 0.1 * (k % 3); }
-static double chain_beta(int k) { return k % 2 == 0 ? 10.0 : -10.0; }
-static double chain_gy(int k) { return 0.2 * (k % 2); }
+#define CH_A 0.3
+#define CH_B 1.0
+#define CH_C 0.6
+#define CH_D 1.0
+#define CH_Q0 60.0
+
+/* Loop 1 at driver angle q (deg), open assembly (B above the ground line):
+ * rocker angle phi and coupler angle psi, deg. */
+static void chain_loop1(double q, double *phi, double *psi)
+{
+    double ax = CH_A * cos(q * DEG), ay = CH_A * sin(q * DEG);
+    double dx = CH_D - ax, dy = -ay, L = hypot(dx, dy);
+    double p = (CH_B * CH_B - CH_C * CH_C + L * L) / (2 * L), h = sqrt(CH_B * CH_B - p * p);
+    double bx = ax + (p * dx - h * dy) / L, by = ay + (p * dy + h * dx) / L;
+    *phi = atan2(by, bx - CH_D) / DEG;
+    *psi = atan2(by - ay, bx - ax) / DEG;
+}
 
 typedef struct {
     char *s;
@@ -83,27 +105,23 @@ static char *chain_text(int n, size_t *len)
     buf b = {malloc(4096), 0, 4096};
     put(&b, "name: chain of %d four-bar loops\nunits: {angle: deg}\nground:\n", n);
     for (int k = 0; k <= n; k++)
-        put(&b, "  G%d: [%d, %.17g]\n", k, k, chain_gy(k));
-    put(&b, "links:\n");
-    for (int k = 0; k <= n; k++) {
-        put(&b, "  L%d: {points: {G%d: [0, 0]", k, k);
-        if (k > 0)
-            put(&b, ", B%d: [%.17g, 0]", k, chain_arm(k));
+        put(&b, "  G%d: [%.17g, 0]\n", k, k * CH_D);
+    put(&b, "links:\n  L0: {points: {G0: [0, 0], A1: [%.17g, 0]}}\n", CH_A);
+    for (int k = 1; k <= n; k++) {
+        double arm = k % 2 ? CH_C : CH_A;  /* odd: a rocker; even: a crank again */
+        put(&b, "  L%d: {points: {G%d: [0, 0], B%d: [%.17g, 0]", k, k, k, arm);
         if (k < n)
-            put(&b, ", A%d: {length: %.17g, angle: %.17g}", k + 1, chain_arm(k + 1),
-                chain_beta(k));
+            put(&b, ", A%d: [%.17g, 0]", k + 1, -arm);
         put(&b, "}}\n");
     }
     for (int k = 1; k <= n; k++)
-        put(&b, "  C%d: {points: {A%d: [0, 0], B%d: [%.17g, 0]}}\n", k, k, k,
-            hypot(1.0, chain_gy(k) - chain_gy(k - 1)));
-    put(&b, "driver: {link: L0, angle: {from: 60, to: 110, steps: %d}}\ninitial:\n", STEPS);
-    double th = 60;
-    for (int k = 1; k <= n; k++) {
-        th += chain_beta(k - 1);
-        put(&b, "  L%d: %.17g\n  C%d: %.17g\n", k, th, k,
-            atan2(chain_gy(k) - chain_gy(k - 1), 1.0) / DEG);
-    }
+        put(&b, "  C%d: {points: {A%d: [0, 0], B%d: [%.17g, 0]}}\n", k, k, k, CH_B);
+    put(&b, "driver: {link: L0, angle: {from: %g, to: 110, steps: %d}}\ninitial:\n", CH_Q0,
+        STEPS);
+    double phi, psi;
+    chain_loop1(CH_Q0, &phi, &psi);
+    for (int k = 1; k <= n; k++)  /* even loops: loop 1 reflected, couplers parallel */
+        put(&b, "  L%d: %.17g\n  C%d: %.17g\n", k, k % 2 ? phi : CH_Q0 + 180.0, k, psi);
     put(&b, "outputs: {points: [B%d], links: [L%d, C%d]}\n", n, n, n);
     *len = b.n;
     return b.s;

@@ -51,6 +51,9 @@ double blocklu_rcond(blocklu *b);
  * solves): with many blocks in a chain it can be far smaller than the
  * blocks', since errors pass from block to block. */
 double blocklu_rcond_whole(blocklu *b);
+/* Smallest |pivot| / largest column 1-norm of its block, over the blocks
+ * (cheap: no solves; tiny at an exactly singular matrix). */
+double blocklu_pivot_ratio(const blocklu *b);
 /* Sign of det A: +1, -1, 0. */
 int blocklu_det_sign(const blocklu *b);
 

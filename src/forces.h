@@ -24,6 +24,8 @@ typedef struct forces {
     int nnz;
     double *b, *y, *y0;     /* [nrows] right-hand side; solution; frictionless solution */
     double *ynext;          /* [nrows] friction iterate */
+    double *aa_g, *aa_r;    /* [nrows] Anderson: the last image G(y) and residual */
+    double *aa_dg, *aa_dr;  /* [3 nrows] their last differences (a ring) */
     double *g, *vg, *ag;    /* [2 nlinks] centres of mass and their rates, this step */
     double *fric;           /* [nrows] friction loads moved to the right-hand side */
     double *cscale;         /* [ncols] column equilibration */
@@ -34,7 +36,8 @@ typedef struct forces {
     double residual;        /* power balance with friction (friction losses included) */
     double friction_power;  /* W dissipated by joint friction */
     double drive_power;     /* W supplied by the driver */
-    double rcond;
+    double rcond;           /* reciprocal condition at the first step, or when last checked */
+    int condition_known;    /* rcond computed (forces_solve, at the first step) */
     double speed_eps;       /* smoothing of sign(relative speed), rad/s */
 } forces;
 

@@ -124,14 +124,25 @@ void linsys_condition(linsys *ls, double *Ax, double *rcond_blocks, double *rcon
     double rb = 0.0, rw = 0.0;
     if (ls->factored && !ls->use_klu) {
         rb = blocklu_rcond(&ls->blu);
-        rw = ls->blu.nblocks == 1 ? rb : blocklu_rcond_whole(&ls->blu);
+        rw = ls->blu.nblocks == 1 || !rcond_whole ? rb : blocklu_rcond_whole(&ls->blu);
     } else if (ls->factored &&
                klu_condest(ls->Ap, Ax, ls->sym, ls->num, &ls->common) &&
                ls->common.condest > 0.0) {
         rb = rw = 1.0 / ls->common.condest;
     }
     *rcond_blocks = rb;
-    *rcond_whole = rw;
+    if (rcond_whole)
+        *rcond_whole = rw;
+}
+
+double linsys_pivot_ratio(linsys *ls)
+{
+    if (!ls->factored)
+        return 0.0;
+    if (!ls->use_klu)
+        return blocklu_pivot_ratio(&ls->blu);
+    klu_rcond(ls->sym, ls->num, &ls->common);
+    return ls->common.rcond;
 }
 
 void linsys_solve(linsys *ls, double *x)

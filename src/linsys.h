@@ -41,8 +41,13 @@ int linsys_factor(linsys *ls, double *Ax);
  * factored): of the worst diagonal block against its whole columns
  * (blocklu_rcond; KLU: of the whole matrix), and of the whole matrix. They
  * differ when errors pass along a chain of blocks: the first says whether
- * the position is singular, the second how far rounding reaches. */
+ * the position is singular, the second how far rounding reaches (NULL:
+ * not wanted, saves whole solves). */
 void linsys_condition(linsys *ls, double *Ax, double *rcond_blocks, double *rcond_whole);
+/* Smallest pivot against the largest column (dense blocks: per block, of
+ * the block's columns; KLU: klu_rcond). Not a condition estimate, but tiny
+ * (about eps) at an exactly singular matrix; 0 when not factored. */
+double linsys_pivot_ratio(linsys *ls);
 /* x := A^-1 x with the current factors. */
 void linsys_solve(linsys *ls, double *x);
 /* Sign of det A with the current factors (+1, -1; 0 singular). */

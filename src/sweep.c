@@ -1006,6 +1006,11 @@ int mech_solve(const mech_model *m, const mech_solve_options *o, mech_table *out
     int rc = solver_init(&w.sv, m, o, d), nvalues = 0;
     if (rc == MECH_OK && w.want_forces)
         rc = forces_init(&w.fc, &w.sv, w.friction_mode != MECH_FRICTION_OFF, d);
+    if (rc == MECH_OK && w.want_forces && o->log) {
+        char method[96];
+        fprintf(o->log, "force system: %d reactions; linear solves: %s\n", w.fc.ncols,
+                linsys_method_name(&w.fc.ls, method, sizeof method));
+    }
     w.st->setup_seconds = now_seconds() - t0;
     double *values = NULL;
     if (rc == MECH_OK) {
