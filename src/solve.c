@@ -603,11 +603,12 @@ step_status solver_newton(solver *sv, double q)
     }
     double r = evaluate(sv, sv->x, q, sv->f), prev_step = INFINITY;
     int max_iter = sv->opt.max_iter > 0 ? sv->opt.max_iter : 50;
-    /* The converged x is returned without its last correction (so that the
-       factors belong to it), so that correction bounds the error of x: it
-       must be below tol/100, or below the rounding floor of the step, about
-       eps times the condition number (from the previous position): results
-       then are accurate to rounding (docs/solver.md, section 2). */
+    /* Converged when the correction is below tol/100, or below its
+       rounding floor, eps over the whole Jacobian's condition (from the
+       previous position). The correction is applied to x (its error is then
+       of the order of its square), but the factors, and so the rates, stay
+       those of x before it: less than tol/100 away, which moves the rates
+       by about that relative to the condition (docs/solver.md, section 2). */
     double xtol = 1e-2 * sv->opt.tol;
     for (int it = 0;; it++) {
         if (!isfinite(r))
@@ -617,7 +618,7 @@ step_status solver_newton(solver *sv, double q)
         if (!(sv->rcond > 0.0))  /* the first factorisation: a condition for the floor */
             condition(sv);
         if (it == 0)
-            xtol = fmax(1e-2 * sv->opt.tol, 8.0 * DBL_EPSILON / fmax(sv->rcond_whole, 1e-300));
+            xtol = fmax(1e-2 * sv->opt.tol, 1.0 * DBL_EPSILON / fmax(sv->rcond_whole, 1e-300));
         linear_solve(sv, sv->f, sv->dx);
         double step = solver_step_size(sv, sv->dx);
         /* converged: residual small, and the step too, or no longer shrinking
@@ -625,6 +626,9 @@ step_status solver_newton(solver *sv, double q)
         if (r <= sv->ftol && (step <= xtol || step >= 0.9 * prev_step)) {
             sv->resid = r;
             sv->iters = it;
+            if (step <= xtol)  /* a real (not noise) correction: take it */
+                for (int i = 0; i < ns; i++)
+                    sv->x[i] -= sv->dx[i];
             return condition(sv) < sv->opt.min_rcond ? STEP_SINGULAR : STEP_OK;
         }
         if (it == max_iter) {
