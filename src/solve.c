@@ -414,6 +414,7 @@ static int level_of(int want)
 int solver_init(solver *sv, const mech_model *m, const mech_solve_options *o, mech_diag *d)
 {
     memset(sv, 0, sizeof *sv);
+    sv->published = -1;
     sv->m = m;
     sv->opt = *o;
     sv->level = level_of(o->want ? o->want : MECH_WANT_ALL);
@@ -594,6 +595,7 @@ static void linear_solve(solver *sv, const double *b, double *dx)
 
 step_status solver_newton(solver *sv, double q)
 {
+    sv->generation++;  /* x changes: what was published is stale */
     int ns = sv->ns;
     sv->iters = 0;
     if (ns == 0) {
@@ -670,6 +672,7 @@ void solver_velocity_rhs(solver *sv, double *out)
 
 void solver_rates(solver *sv)
 {
+    sv->generation++;
     if (sv->ns == 0)
         return;
     tape *t = &sv->tp;
@@ -689,8 +692,14 @@ void solver_rates(solver *sv)
 
 /* xdot = x_q qd and xddot = x_qq qd^2 + x_q qdd (the loop equations do not
  * depend on time explicitly). */
-static void publish(solver *sv, double q, double qd, double qdd, int rates)
+void solver_publish(solver *sv, double q, double qd, double qdd)
 {
+    /* the same state published again (the branch check, then the row) */
+    if (sv->published == sv->generation && q == sv->pub_q && qd == sv->pub_qd &&
+        qdd == sv->pub_qdd)
+        return;
+    sv->published = sv->generation;
+    sv->pub_q = q, sv->pub_qd = qd, sv->pub_qdd = qdd;
     int n = sv->n;
     sv->pos[n] = q;
     sv->vel[n] = qd;
@@ -712,10 +721,9 @@ static void publish(solver *sv, double q, double qd, double qdd, int rates)
         }
     }
     kin_update(&sv->tree, &sv->ks, sv->pos,
-               rates && sv->level & MECH_WANT_VELOCITY ? sv->vel : NULL,
-               rates && sv->level & MECH_WANT_ACCELERATION ? sv->acc : NULL);
+               sv->level & MECH_WANT_VELOCITY ? sv->vel : NULL,
+               sv->level & MECH_WANT_ACCELERATION ? sv->acc : NULL);
 }
 
-void solver_publish(solver *sv, double q, double qd, double qdd) { publish(sv, q, qd, qdd, 1); }
 
-void solver_publish_positions(solver *sv, double q) { publish(sv, q, 0.0, 0.0, 0); }
+

@@ -61,6 +61,9 @@ typedef struct solver {
     double resid;              /* |f|inf at x */
     int iters;                 /* Newton iterations of the last solve */
 
+    int generation;            /* counts changes of x and its rates */
+    int published;             /* generation of the last full publish (-1: none) */
+    double pub_q, pub_qd, pub_qdd; /* and its driver state */
     kin_tree tree;
     kin_state ks;
 } solver;
@@ -75,9 +78,7 @@ step_status solver_newton(solver *sv, double q);
 void solver_rates(solver *sv);
 /* Scatter x, and the rates for driver speed qd and acceleration qdd, into
  * pos, vel, acc and update the link frames. */
-void solver_publish(solver *sv, double q, double qd, double qdd);
-/* The same for positions only (the frames' rates are left zero). */
-void solver_publish_positions(solver *sv, double q);
+void solver_publish(solver *sv, double q, double qd, double qdd);  /* again: no work */
 
 /* Sign of det of the factored matrix (+1, -1, 0 singular): a change between
  * two positions means the sweep crossed a singular one. */

@@ -431,7 +431,7 @@ static step_status try_position(sweep *w, double qn, int continuing)
     solver_rates(sv);
     int b;
     if (w->m->nbranches) {  /* the branch test needs the point positions */
-        solver_publish_positions(sv, qn);
+        solver_publish(sv, qn, w->qd, w->qdd);  /* the row's own, unless rejected */
         if (!branches_hold(w, &b))
             return STEP_BRANCH;
     }
