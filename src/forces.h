@@ -14,6 +14,8 @@ typedef struct forces {
     const mech_model *m;
     int friction;           /* 1: Coulomb friction of the joints is applied */
     int has_friction;       /* some joint has a friction coefficient */
+    int want_frictionless;  /* the frictionless reactions are output too (y0) */
+    int have_previous;      /* y holds the last step's reactions (friction start) */
     int nrows;              /* 3 per moving link */
     int ncols;
     fc_kind *kind;          /* [ncols] */
@@ -32,7 +34,8 @@ typedef struct forces {
     linsys ls;              /* factors of the force system */
     /* per step results */
     int iterations;         /* friction fixed-point iterations */
-    double residual0;       /* power balance, frictionless, relative */
+    double residual0;       /* power balance, frictionless, relative (0 when y0 was not
+                               solved: friction on and its columns not wanted) */
     double residual;        /* power balance with friction (friction losses included) */
     double friction_power;  /* W dissipated by joint friction */
     double drive_power;     /* W supplied by the driver */

@@ -1018,6 +1018,8 @@ int mech_solve(const mech_model *m, const mech_solve_options *o, mech_table *out
     int rc = solver_init(&w.sv, m, o, d), nvalues = 0;
     if (rc == MECH_OK && w.want_forces)
         rc = forces_init(&w.fc, &w.sv, w.friction_mode != MECH_FRICTION_OFF, d);
+    if (rc == MECH_OK && w.want_forces)
+        w.fc.want_frictionless = w.friction_mode == MECH_FRICTION_BOTH;
     if (rc == MECH_OK && w.want_forces && o->log) {
         char method[96];
         fprintf(o->log, "force system: %d reactions; linear solves: %s\n", w.fc.ncols,
