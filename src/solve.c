@@ -361,10 +361,10 @@ static int compile_subset(solver *sv, const unsigned char *row_on, const unsigne
         return -1;
     const ex *roots[NPHASES] = {sv->proot, sv->vroot, sv->aroot};
     int nroots[NPHASES] = {nr + nnz, nr, nr};
-    int nph = sv->level & MECH_WANT_ACCELERATION ? 3 : sv->level & MECH_WANT_VELOCITY ? 2 : 1;
-    /* dx/dq feeds the predictor even for positions only: keep the velocity phase */
-    if (nph < 2)
-        nph = 2;
+    /* dx/dq and d2x/dq2 feed the predictor even for positions only: all three
+       phases (two solves with factors already there cost less than the
+       Newton iteration a second-order predictor needs) */
+    int nph = NPHASES;
     if (trig_nodes(sv) < 0 ||
         tape_compile(&sv->tp, &sv->sys->ex, SYS_NVARS(n), nph, roots, nroots) < 0)
         return -1;
@@ -679,8 +679,6 @@ void solver_rates(solver *sv)
     /* geometric rates (qdot = 1, qddot = 0); solver_publish scales them */
     solver_velocity_rhs(sv, sv->ft);
     linear_solve(sv, sv->ft, sv->xq);
-    if (!(sv->level & MECH_WANT_ACCELERATION))
-        return;
     for (int i = 0; i < sv->ns; i++)
         tape_set_var(t, SYS_VAR_XDOT(sv->n, sv->col[i]), sv->xq[i]);
     tape_set_var(t, SYS_VAR_QDDOT(sv->n), 0.0);

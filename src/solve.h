@@ -74,7 +74,8 @@ void solver_free(solver *sv);
 /* Newton from sv->x at driver position q; on STEP_OK the factors are those
  * of the converged Jacobian. */
 step_status solver_newton(solver *sv, double q);
-/* dx/dq and d2x/dq2 at the converged position (as far as sv->level needs). */
+/* dx/dq and d2x/dq2 at the converged position (both always: the predictor
+ * uses them). */
 void solver_rates(solver *sv);
 /* Scatter x, and the rates for driver speed qd and acceleration qdd, into
  * pos, vel, acc and update the link frames. */

@@ -35,7 +35,6 @@ typedef struct sweep {
     /* the last accepted position and its rates (the continuation's base) */
     double qc;
     double *xc, *xqc, *xqqc;   /* [ns] */
-    double *xq_prev;           /* [ns] dx/dq at the position before, for positions-only */
     double *xqq_prev;          /* [ns] d2x/dq2 there: the predictor's third derivative */
     double q_prev;
     int have_prev;
@@ -323,8 +322,8 @@ static void report_redundant(sweep *w, double q)
 /* ---- continuation ----------------------------------------------------- */
 
 /* Taylor: x + h x_q + h^2/2 x_qq + h^3/6 x_qqq, with x_qqq from the last two
- * x_qq (when accelerations are computed; without them x_qq comes from the
- * last two slopes and the cubic term is left out). The cubic term makes
+ * x_qq (x_q and x_qq are solved at every position, whatever the output
+ * level: solver_rates). The cubic term makes
  * the error of a 1-degree step about 1e-8 instead of 1e-6, so that one
  * Newton correction reaches rounding and the second iteration only
  * confirms it: two evaluations and factorisations per step instead of three
@@ -333,14 +332,10 @@ static void predict(sweep *w, double qn)
 {
     solver *sv = &w->sv;
     double h = qn - w->qc, dq = w->qc - w->q_prev;
-    int prev = w->have_prev && dq != 0.0, acc = sv->level & MECH_WANT_ACCELERATION;
+    int prev = w->have_prev && dq != 0.0;
     for (int i = 0; i < sv->ns; i++) {
-        double xqq = w->xqqc[i], xqqq = 0.0;
-        if (!acc)
-            xqq = prev ? (w->xqc[i] - w->xq_prev[i]) / dq : 0.0;
-        else if (prev)
-            xqqq = (w->xqqc[i] - w->xqq_prev[i]) / dq;
-        w->xpred[i] = w->xc[i] + h * (w->xqc[i] + h * (0.5 * xqq + h * xqqq / 6.0));
+        double xqqq = prev ? (w->xqqc[i] - w->xqq_prev[i]) / dq : 0.0;
+        w->xpred[i] = w->xc[i] + h * (w->xqc[i] + h * (0.5 * w->xqqc[i] + h * xqqq / 6.0));
     }
     memcpy(sv->x, w->xpred, (size_t)sv->ns * sizeof *sv->x);
 }
@@ -388,7 +383,6 @@ static void accept(sweep *w, double qn)
     solver *sv = &w->sv;
     note_crossing(w, qn);
     size_t bytes = (size_t)sv->ns * sizeof(double);
-    memcpy(w->xq_prev, w->xqc, bytes);
     memcpy(w->xqq_prev, w->xqqc, bytes);
     w->q_prev = w->qc;
     w->have_prev = 1;
@@ -918,7 +912,7 @@ void mech_solve_options_default(mech_solve_options *o)
 static int alloc_sweep(sweep *w)
 {
     size_t ns = (size_t)w->sv.ns + 1;
-    double **arrays[] = {&w->xc, &w->xqc, &w->xqqc, &w->xq_prev, &w->xqq_prev, &w->xpred,
+    double **arrays[] = {&w->xc, &w->xqc, &w->xqqc, &w->xqq_prev, &w->xpred,
                          &w->x0, &w->xq0, &w->xqq0};
     for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
         if (!(*arrays[i] = xcalloc(ns, sizeof(double))))
@@ -928,7 +922,7 @@ static int alloc_sweep(sweep *w)
 
 static void free_sweep(sweep *w)
 {
-    double *arrays[] = {w->xc, w->xqc, w->xqqc, w->xq_prev, w->xqq_prev, w->xpred, w->x0,
+    double *arrays[] = {w->xc, w->xqc, w->xqqc, w->xqq_prev, w->xpred, w->x0,
                         w->xq0, w->xqq0,
                         w->guess};
     for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
