@@ -18,20 +18,6 @@
 /* Exact inverse norm up to this block size; Hager's estimate above. */
 enum { EXACT_NORM_MAX = 8, HAGER_ITERATIONS = 5, WHOLE_HAGER_ITERATIONS = 2 };
 
-static int permutation_parity(const int *perm, int n, unsigned char *seen)
-{
-    int odd = 0;
-    memset(seen, 0, (size_t)n);
-    for (int i = 0; i < n; i++) {
-        int len = 0;
-        for (int k = i; !seen[k]; k = perm[k], len++)
-            seen[k] = 1;
-        if (len > 0)
-            odd ^= (len - 1) & 1;
-    }
-    return odd;
-}
-
 void blocklu_free(blocklu *b)
 {
     void *blocks[] = {b->P, b->Q, b->R, b->at, b->where, b->v, b->op, b->oi, b->piv,
@@ -288,37 +274,65 @@ static double inverse_norm_small(const double *f, int k)
     return cols / fabs(f[0] * f[3]);
 }
 
-/* Hager's estimate of |B^-1|_1 (a lower bound, usually exact): climb the
- * convex function |B^-1 x|_1 over the unit 1-ball from its centre, moving
- * to the vertex its gradient points to, until that stops increasing it. */
-static double inverse_norm_hager(const double *a, int k, const int *piv, double *w)
+/* Hager's estimate of |A^-1|_1 for an n x n A given by its solves (a lower
+ * bound, usually exact): climb the convex function |A^-1 x|_1 over the unit
+ * 1-ball from its centre, moving to the vertex its gradient points to,
+ * until that stops increasing it, for at most `iterations` solves. w: 3n. */
+typedef struct solves {
+    void (*solve)(void *ctx, double *y);            /* y := A^-1 y */
+    void (*solve_transposed)(void *ctx, double *y); /* y := A^-T y */
+    void *ctx;
+} solves;
+
+static double inverse_norm_hager(const solves *s, int n, int iterations, double *w)
 {
-    double *x = w, *y = w + k, *z = w + 2 * k, est = 0.0;
-    for (int i = 0; i < k; i++)
-        x[i] = 1.0 / k;
-    for (int it = 0; it < HAGER_ITERATIONS; it++) {
-        memcpy(y, x, (size_t)k * sizeof *y);
-        block_solve(a, k, piv, y);
-        double ny = norm1(y, k);
+    double *x = w, *y = w + n, *z = w + 2 * n, est = 0.0;
+    for (int i = 0; i < n; i++)
+        x[i] = 1.0 / n;
+    for (int it = 0; it < iterations; it++) {
+        memcpy(y, x, (size_t)n * sizeof *y);
+        s->solve(s->ctx, y);
+        double ny = norm1(y, n);
         if (it > 0 && ny <= est)
             break;
         est = ny;
-        for (int i = 0; i < k; i++)
+        if (it == iterations - 1)
+            break;
+        for (int i = 0; i < n; i++)
             z[i] = y[i] >= 0.0 ? 1.0 : -1.0;
-        block_solve_transposed(a, k, piv, z);
+        s->solve_transposed(s->ctx, z);
         int j = 0;
         double ztx = 0.0;
-        for (int i = 0; i < k; i++) {
+        for (int i = 0; i < n; i++) {
             ztx += z[i] * x[i];
             if (fabs(z[i]) > fabs(z[j]))
                 j = i;
         }
         if (it > 0 && fabs(z[j]) <= ztx)
             break;
-        memset(x, 0, (size_t)k * sizeof *x);
+        memset(x, 0, (size_t)n * sizeof *x);
         x[j] = 1.0;
     }
     return est;
+}
+
+/* One block's factors, for inverse_norm_hager. */
+typedef struct block_ref {
+    const double *a;
+    int k;
+    const int *piv;
+} block_ref;
+
+static void block_ref_solve(void *c, double *y)
+{
+    const block_ref *r = c;
+    block_solve(r->a, r->k, r->piv, y);
+}
+
+static void block_ref_solve_transposed(void *c, double *y)
+{
+    const block_ref *r = c;
+    block_solve_transposed(r->a, r->k, r->piv, y);
 }
 
 /* ---- the whole matrix -------------------------------------------------- */
@@ -416,40 +430,16 @@ static double whole_norm1(const blocklu *b)
     return big;
 }
 
+static void whole_solve(void *c, double *y) { blocklu_solve(c, y); }
+static void whole_solve_transposed(void *c, double *y) { solve_transposed(c, y); }
+
 double blocklu_rcond_whole(blocklu *b)
 {
-    int n = b->n;
-    double *x = b->w + n, *y = b->w + 2 * n, *z = b->w + 3 * n, est = 0.0;
-    for (int i = 0; i < n; i++)
-        x[i] = 1.0 / n;
-    /* as inverse_norm_hager, but two iterations: the estimate only sets the
-       rounding floor of Newton's step, where a lower bound of the inverse's
-       norm errs on the safe side (a smaller floor, at worst one more
-       iteration); a third iteration rarely changes it by more than 2 */
-    for (int it = 0; it < WHOLE_HAGER_ITERATIONS; it++) {
-        memcpy(y, x, (size_t)n * sizeof *y);
-        blocklu_solve(b, y);
-        double ny = norm1(y, n);
-        if (it > 0 && ny <= est)
-            break;
-        est = ny;
-        if (it == WHOLE_HAGER_ITERATIONS - 1)
-            break;
-        for (int i = 0; i < n; i++)
-            z[i] = y[i] >= 0.0 ? 1.0 : -1.0;
-        solve_transposed(b, z);
-        int j = 0;
-        double ztx = 0.0;
-        for (int i = 0; i < n; i++) {
-            ztx += z[i] * x[i];
-            if (fabs(z[i]) > fabs(z[j]))
-                j = i;
-        }
-        if (it > 0 && fabs(z[j]) <= ztx)
-            break;
-        memset(x, 0, (size_t)n * sizeof *x);
-        x[j] = 1.0;
-    }
+    /* two iterations: the estimate only sets the rounding floor of Newton's
+       step, where a lower bound of the inverse's norm errs on the safe side
+       (a smaller floor, at worst one more iteration) */
+    solves s = {whole_solve, whole_solve_transposed, b};
+    double est = inverse_norm_hager(&s, b->n, WHOLE_HAGER_ITERATIONS, b->w + b->n);
     double anorm = whole_norm1(b), r = anorm > 0.0 && est > 0.0 ? 1.0 / (anorm * est) : 0.0;
     return r >= 0.0 ? r : 0.0;
 }
@@ -461,9 +451,11 @@ double blocklu_rcond(blocklu *b)
     for (int k = 0; k < b->nblocks; k++) {
         int k0 = b->R[k], size = b->R[k + 1] - k0;
         const double *a = b->v + b->at[k];
+        block_ref ref = {a, size, b->piv + k0};
+        solves sv = {block_ref_solve, block_ref_solve_transposed, &ref};
         double inv = size <= 2              ? inverse_norm_small(a, size)
                      : size <= EXACT_NORM_MAX ? inverse_norm_exact(a, size, b->piv + k0, w)
-                                              : inverse_norm_hager(a, size, b->piv + k0, w);
+                                              : inverse_norm_hager(&sv, size, HAGER_ITERATIONS, w);
         double r = b->anorm[k] > 0.0 && inv > 0.0 ? 1.0 / (b->anorm[k] * inv) : 0.0;
         if (!(r >= 0.0))  /* NaN: an overflowed inverse, singular */
             r = 0.0;

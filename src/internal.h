@@ -28,6 +28,9 @@ void *xcalloc(size_t n, size_t size);           /* NULL on overflow or failure *
 void *xrealloc_array(void *p, size_t n, size_t size);
 char *xstrdup(const char *s);
 int edit_distance(const char *a, const char *b); /* Levenshtein, capped at 99 */
+/* Parity of a permutation of 0..n-1 (0 even, 1 odd), by its cycles; seen:
+ * n bytes of work. */
+int permutation_parity(const int *perm, int n, unsigned char *seen);
 /* Nearest of `names` to `word` when close enough to be a likely typo, else NULL. */
 const char *nearest_name(const char *word, const char *const *names, size_t n);
 

@@ -7,20 +7,6 @@
 #include "internal.h"
 #include "linsys.h"
 
-static int parity(const int *perm, int n, unsigned char *seen)
-{
-    int odd = 0;
-    memset(seen, 0, (size_t)n);
-    for (int i = 0; i < n; i++) {
-        int len = 0;
-        for (int k = i; !seen[k]; k = perm[k], len++)
-            seen[k] = 1;
-        if (len > 0)
-            odd ^= (len - 1) & 1;
-    }
-    return odd;
-}
-
 static int klu_init(linsys *ls)
 {
     klu_defaults(&ls->common);
@@ -38,7 +24,7 @@ static int klu_init(linsys *ls)
     ls->sym = klu_analyze(ls->n, ls->Ap, ls->Ai, &ls->common);
     if (!ls->sym)
         return -1;
-    ls->q_parity = parity(ls->sym->Q, ls->n, ls->seen);
+    ls->q_parity = permutation_parity(ls->sym->Q, ls->n, ls->seen);
     return 0;
 }
 
@@ -80,7 +66,7 @@ static int klu_fresh_factor(linsys *ls, double *Ax)
     klu_rcond(ls->sym, ls->num, &ls->common);
     ls->pivot_ratio_factor = ls->common.rcond;
     /* refactoring keeps this pivot order: its parity holds until the next */
-    ls->perm_parity = parity(ls->num->Pnum, ls->n, ls->seen) ^ ls->q_parity;
+    ls->perm_parity = permutation_parity(ls->num->Pnum, ls->n, ls->seen) ^ ls->q_parity;
     return 0;
 }
 

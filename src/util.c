@@ -134,3 +134,17 @@ void name_map_free(name_map *nm)
     free(nm->values);
     memset(nm, 0, sizeof *nm);
 }
+
+int permutation_parity(const int *perm, int n, unsigned char *seen)
+{
+    int odd = 0;
+    memset(seen, 0, (size_t)n);
+    for (int i = 0; i < n; i++) {
+        int len = 0;
+        for (int k = i; !seen[k]; k = perm[k], len++)
+            seen[k] = 1;
+        if (len > 0)
+            odd ^= (len - 1) & 1;  /* a cycle of length L is L - 1 swaps */
+    }
+    return odd;
+}
