@@ -1,10 +1,13 @@
 /* tests/unit/helpers.h: what several test files need: load and check a
- * mechanism (from text or a path; the test fails if it does not load), and
- * the kind of a result column from its name. */
+ * mechanism (from text or a path; the test fails if it does not load), the
+ * kind of a result column from its name, and verbose notes. */
 #ifndef MECH_TEST_HELPERS_H
 #define MECH_TEST_HELPERS_H
 
 #include <criterion/criterion.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "mech.h"
@@ -30,6 +33,17 @@ static inline mech_model *test_load(const char *text, const char *path)
 
 static inline mech_model *load_text(const char *text) { return test_load(text, NULL); }
 static inline mech_model *load_path(const char *path) { return test_load(NULL, path); }
+
+/* A measured figure, printed with the tag when MECH_HARD_VERBOSE is set
+ * (the tests assert bounds; this shows how far inside them they are). */
+static inline void note_tagged(const char *tag, const char *fmt, va_list ap)
+{
+    if (!getenv("MECH_HARD_VERBOSE"))
+        return;
+    fprintf(stderr, "[%s] ", tag);
+    vfprintf(stderr, fmt, ap);
+    fprintf(stderr, "\n");
+}
 
 static inline int ends_with(const char *s, const char *suffix)
 {

@@ -60,13 +60,9 @@ static int sanitized(void)
 
 static void note(const char *fmt, ...)
 {
-    if (!getenv("MECH_HARD_VERBOSE"))
-        return;
     va_list ap;
     va_start(ap, fmt);
-    fprintf(stderr, "[hard] ");
-    vfprintf(stderr, fmt, ap);
-    fprintf(stderr, "\n");
+    note_tagged("hard", fmt, ap);
     va_end(ap);
 }
 

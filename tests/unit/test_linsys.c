@@ -21,13 +21,9 @@ enum { MAXN = 64 };
 /* The measured figures, with MECH_HARD_VERBOSE set (as test_hard.c). */
 static void note(const char *fmt, ...)
 {
-    if (!getenv("MECH_HARD_VERBOSE"))
-        return;
     va_list ap;
     va_start(ap, fmt);
-    fprintf(stderr, "[linsys] ");
-    vfprintf(stderr, fmt, ap);
-    fprintf(stderr, "\n");
+    note_tagged("linsys", fmt, ap);
     va_end(ap);
 }
 
