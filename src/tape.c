@@ -167,7 +167,8 @@ void tape_hoist(tape *t, int phase, const unsigned char *invariant)
         else
             t->ins[start + nfixed++] = in;  /* stable: order within each part kept */
     }
-    memcpy(t->ins + start + nfixed, moved, (size_t)nvar * sizeof *moved);
+    if (nvar > 0)  /* t->ins is NULL for an empty tape */
+        memcpy(t->ins + start + nfixed, moved, (size_t)nvar * sizeof *moved);
     t->phase_split[phase] = start + nfixed;
     free(variant);
     free(moved);
