@@ -303,7 +303,7 @@ void kin_update(const kin_tree *t, kin_state *st, const double *pos, const doubl
     for (int k = 0; k < t->norder; k++) {
         int l = t->order[k], var = t->angle_var[l];
         double th = var_value(pos, var);
-        if (th != st->th[l]) {  /* c, s always belong to th (solver_publish may set all three) */
+        if (th != st->th[l]) {  /* c, s belong to th: a link that did not turn keeps them */
             st->th[l] = th;
             st->c[l] = cos(th);  /* once per link and angle: on_link is hot */
             st->s[l] = sin(th);

@@ -249,45 +249,6 @@ done:
     return rc;
 }
 
-/* The loop equations hold cos and sin of most link angles; the link
- * frames need the same (solver_publish takes them from the tape). Nodes
- * first (interned: existing ones are found), registers after compiling. */
-static int trig_nodes(solver *sv)
-{
-    int nl = sv->m->nlinks;
-    sv->trig = xcalloc(3 * (size_t)nl + 1, sizeof *sv->trig);
-    if (!sv->trig)
-        return -1;
-    expr_ctx *c = &sv->sys->ex;
-    for (int l = 0; l < nl; l++) {
-        int var = sv->tree.angle_var[l];
-        sv->trig[3 * l] = -1;
-        if (var < 0)
-            continue;
-        ex v = expr_var(c, var), ce = v >= 0 ? expr_cos(c, v) : -1;
-        ex se = v >= 0 ? expr_sin(c, v) : -1;
-        if (ce < 0 || se < 0)
-            return -1;
-        sv->trig[3 * l] = var, sv->trig[3 * l + 1] = ce, sv->trig[3 * l + 2] = se;
-    }
-    return 0;
-}
-
-static void trig_registers(solver *sv)
-{
-    const tape *t = &sv->tp;
-    for (int l = 0; l < sv->m->nlinks; l++) {
-        int *g = sv->trig + 3 * l;
-        if (g[0] < 0)
-            continue;
-        g[0] = t->var_reg[g[0]];
-        g[1] = t->node_reg[g[1]];
-        g[2] = t->node_reg[g[2]];
-        if (g[0] < 0 || g[1] < 0 || g[2] < 0)
-            g[0] = -1;  /* not all in the tape: kin_update computes them */
-    }
-}
-
 /* Pattern of the solved rows and columns, and the tape computing them. */
 static int compile_subset(solver *sv, const unsigned char *row_on, const unsigned char *col_on)
 {
@@ -364,11 +325,8 @@ static int compile_subset(solver *sv, const unsigned char *row_on, const unsigne
     /* dx/dq and d2x/dq2 feed the predictor even for positions only: all three
        phases (two solves with factors already there cost less than the
        Newton iteration a second-order predictor needs) */
-    int nph = NPHASES;
-    if (trig_nodes(sv) < 0 ||
-        tape_compile(&sv->tp, &sv->sys->ex, SYS_NVARS(n), nph, roots, nroots) < 0)
+    if (tape_compile(&sv->tp, &sv->sys->ex, SYS_NVARS(n), NPHASES, roots, nroots) < 0)
         return -1;
-    trig_registers(sv);
     /* what depends on the driver alone (its sines and cosines, the crank's
        terms) is computed once per position, not per Newton iteration */
     unsigned char *invariant = xcalloc((size_t)SYS_NVARS(n), 1);
@@ -485,7 +443,7 @@ void solver_free(solver *sv)
     mech_system_free(&sv->sys);
     void *blocks[] = {sv->col, sv->row, sv->Ap, sv->Ai, sv->Ax, sv->Jv, sv->jpos, sv->rhs,
                       sv->cscale, sv->proot,
-                      sv->vroot, sv->aroot, sv->trig, sv->pos, sv->vel, sv->acc, sv->x, sv->xq,
+                      sv->vroot, sv->aroot, sv->pos, sv->vel, sv->acc, sv->x, sv->xq,
                       sv->xqq, sv->f, sv->dx, sv->xt, sv->ft};
     for (size_t i = 0; i < sizeof blocks / sizeof blocks[0]; i++)
         free(blocks[i]);
@@ -620,7 +578,7 @@ step_status solver_newton(solver *sv, double q)
         if (!(sv->rcond > 0.0))  /* the first factorisation: a condition for the floor */
             condition(sv);
         if (it == 0)
-            xtol = fmax(1e-2 * sv->opt.tol, 1.0 * DBL_EPSILON / fmax(sv->rcond_whole, 1e-300));
+            xtol = fmax(1e-2 * sv->opt.tol, DBL_EPSILON / fmax(sv->rcond_whole, 1e-300));
         linear_solve(sv, sv->f, sv->dx);
         double step = solver_step_size(sv, sv->dx);
         /* converged: residual small, and the step too, or no longer shrinking
@@ -707,16 +665,6 @@ void solver_publish(solver *sv, double q, double qd, double qdd)
         sv->pos[c] = sv->x[i];
         sv->vel[c] = sv->xq[i] * qd;
         sv->acc[c] = sv->xqq[i] * qd * qd + sv->xq[i] * qdd;
-    }
-    /* cos and sin of the angles the tape computed at these values */
-    const double *reg = sv->tp.reg;
-    for (int l = 1; l < sv->m->nlinks; l++) {
-        const int *g = sv->trig + 3 * l;
-        if (g[0] >= 0 && reg[g[0]] == sv->pos[sv->tree.angle_var[l]]) {
-            sv->ks.th[l] = reg[g[0]];
-            sv->ks.c[l] = reg[g[1]];
-            sv->ks.s[l] = reg[g[2]];
-        }
     }
     kin_update(&sv->tree, &sv->ks, sv->pos,
                sv->level & MECH_WANT_VELOCITY ? sv->vel : NULL,

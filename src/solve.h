@@ -43,8 +43,6 @@ typedef struct solver {
     double *cscale;            /* [ns] column scaling of the last factorisation */
     tape tp;                   /* evaluator of the solved rows only */
     double tape_q;             /* driver position of the tape's invariant part */
-    int *trig;                 /* [3 nlinks] registers of each link's angle, its cos and
-                                  sin in the tape (first -1: not there) */
     ex *proot, *vroot, *aroot; /* roots of the three phases */
 
     linsys ls;                 /* factors of the equilibrated Jacobian */
