@@ -92,16 +92,17 @@ int blocklu_analyze(blocklu *b, int n, const int *Ap, const int *Ai, int max_blo
         goto done;
     for (int k = 0; k < b->nblocks; k++) {
         int size = b->R[k + 1] - b->R[k];
+        if (size > max_block) {  /* before size * size can overflow */
+            b->largest = size;
+            rc = 2;
+            goto done;
+        }
         if (size > b->largest)
             b->largest = size;
         b->at[k] = b->ndense;
         b->ndense += size * size;
         for (int i = b->R[k]; i < b->R[k + 1]; i++)
             blk[i] = k;
-    }
-    if (b->largest > max_block) {
-        rc = 2;
-        goto done;
     }
     for (int k = 0; k < n; k++)
         pinv[b->P[k]] = k;

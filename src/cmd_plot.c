@@ -284,15 +284,25 @@ static int write_figures(const plot_args *a, const mech_model *m, const mech_tab
     return code;
 }
 
-int cmd_plot(int argc, char **argv)
+/* What both commands do first: default options, the arguments, the file
+ * loaded and checked. Returns -1 to go on, else the exit status. */
+static int begin(const char *cmd, int argc, char **argv, plot_args *a, mech_model **m)
 {
-    plot_args a = {.cmd = "plot", .friction = -1};
-    plot_anim_options_default(&a.anim);
-    int code = parse_args(argc, argv, &a);
+    *a = (plot_args){.cmd = cmd, .friction = -1};
+    plot_anim_options_default(&a->anim);
+    int code = parse_args(argc, argv, a);
     if (code >= 0)
         return code;
+    code = cmd_load_checked(a->file, m);
+    return code == MECH_EXIT_OK ? -1 : code;
+}
+
+int cmd_plot(int argc, char **argv)
+{
+    plot_args a;
     mech_model *m = NULL;
-    if ((code = cmd_load_checked(a.file, &m)) != MECH_EXIT_OK)
+    int code = begin("plot", argc, argv, &a, &m);
+    if (code >= 0)
         return code;
     char err[256];
     if (a.outputs && mech_select_outputs(m, a.outputs, err, sizeof err) != MECH_OK) {
@@ -350,13 +360,10 @@ static int select_everything(mech_model *m, int **trace, int *ntrace)
 
 int cmd_animate(int argc, char **argv)
 {
-    plot_args a = {.cmd = "animate", .friction = -1};
-    plot_anim_options_default(&a.anim);
-    int code = parse_args(argc, argv, &a);
-    if (code >= 0)
-        return code;
+    plot_args a;
     mech_model *m = NULL;
-    if ((code = cmd_load_checked(a.file, &m)) != MECH_EXIT_OK)
+    int code = begin("animate", argc, argv, &a, &m);
+    if (code >= 0)
         return code;
     int *trace = NULL, ntrace = 0;
     if (select_everything(m, &trace, &ntrace) != 0) {

@@ -544,7 +544,7 @@ static void friction_fixed_point(forces *fc, const solver *sv)
             return;
         }
         if (!(res < prev_res))
-            depth = 0;  /* not contracting: plain steps from here */
+            depth = 0;  /* not contracting: restart the history (a plain step) */
         prev_res = res;
         /* differences to the previous image and residual (slot newest) */
         if (it > 1) {

@@ -3,35 +3,7 @@
 # Run from the repository root:  MECH=build/mech sh tests/cli.sh
 # Prints one line per failure, then "cli: N passed, M failed"; exits 1 if
 # anything failed.
-MECH=${MECH:-build/mech}
-if [ ! -x "$MECH" ]; then
-    echo "cli: $MECH is not an executable (build it first, or set MECH)" >&2
-    exit 2
-fi
-
-tmp=${TMPDIR:-/tmp}/mech-cli.$$
-mkdir "$tmp" || exit 2
-trap 'rm -rf "$tmp"' EXIT
-trap 'exit 2' INT TERM HUP
-
-passed=0
-failed=0
-pass() { passed=$((passed + 1)); }
-fail() { failed=$((failed + 1)); echo "FAIL: $*"; }
-
-# run LABEL STATUS COMMAND...: run COMMAND with stdout in $tmp/out and stderr
-# in $tmp/err; 0 when it exits with STATUS, else report a failure and 1.
-run() {
-    label=$1 want=$2
-    shift 2
-    "$@" >"$tmp/out" 2>"$tmp/err"
-    status=$?
-    if [ "$status" -ne "$want" ]; then
-        fail "$label: exit status $status, expected $want (stderr: $(head -n 1 "$tmp/err"))"
-        return 1
-    fi
-    return 0
-}
+NAME=cli . tests/lib.sh
 
 # ---- usage ----------------------------------------------------------------
 
@@ -127,9 +99,6 @@ done
 # ---- mech solve ---------------------------------------------------------
 
 # has_line FILE PATTERN LABEL: pass when FILE has a line matching PATTERN
-has_line() {
-    if grep -q -- "$2" "$1"; then pass; else fail "$3: no line matching '$2' in $(head -c 300 "$1")"; fi
-}
 
 if run "mech solve --help" 0 "$MECH" solve --help; then
     has_line "$tmp/out" '^usage: mech solve' "mech solve --help"
@@ -256,5 +225,4 @@ if run "mech sweep unknown parameter" 2 "$MECH" sweep mechanisms/slider-crank.ya
 fi
 run "mech sweep bad range" 2 "$MECH" sweep mechanisms/slider-crank.yaml --vary r=30mm:60:4 && pass
 
-echo "cli: $passed passed, $failed failed"
-[ "$failed" -eq 0 ]
+summary

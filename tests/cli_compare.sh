@@ -4,35 +4,7 @@
 # Run from the repository root:  MECH=build/mech sh tests/cli_compare.sh
 # Prints one line per failure, then "cli-compare: N passed, M failed"; exits 1
 # if anything failed.
-MECH=${MECH:-build/mech}
-if [ ! -x "$MECH" ]; then
-    echo "cli-compare: $MECH is not an executable (build it first, or set MECH)" >&2
-    exit 2
-fi
-
-tmp=${TMPDIR:-/tmp}/mech-cli-compare.$$
-mkdir "$tmp" || exit 2
-trap 'rm -rf "$tmp"' EXIT
-trap 'exit 2' INT TERM HUP
-
-passed=0
-failed=0
-pass() { passed=$((passed + 1)); }
-fail() { failed=$((failed + 1)); echo "FAIL: $*"; }
-
-# run LABEL STATUS COMMAND...: run COMMAND with stdout in $tmp/out and stderr
-# in $tmp/err; 0 when it exits with STATUS, else report a failure and 1.
-run() {
-    label=$1 want=$2
-    shift 2
-    "$@" >"$tmp/out" 2>"$tmp/err"
-    status=$?
-    if [ "$status" -ne "$want" ]; then
-        fail "$label: exit status $status, expected $want (stderr: $(head -n 1 "$tmp/err"))"
-        return 1
-    fi
-    return 0
-}
+NAME=cli-compare . tests/lib.sh
 
 # expect LABEL FILE LINE: pass when FILE has the exact line LINE.
 expect() {
@@ -193,5 +165,4 @@ if "$MECH" solve --help >/dev/null 2>&1 && [ -f mechanisms/fourbar.yaml ]; then
     fi
 fi
 
-echo "cli-compare: $passed passed, $failed failed"
-[ "$failed" -eq 0 ]
+summary

@@ -4,15 +4,7 @@
 # tests/golden/README.md). Run from the repository root:
 #   MECH=build/mech sh tests/golden.sh
 # Regenerate the goldens with `make golden`, then review the diff by hand.
-MECH=${MECH:-build/mech}
-if [ ! -x "$MECH" ]; then
-    echo "golden: $MECH is not an executable (build it first, or set MECH)" >&2
-    exit 2
-fi
-tmp=${TMPDIR:-/tmp}/mech-golden.$$
-mkdir "$tmp" || exit 2
-trap 'rm -rf "$tmp"' EXIT
-trap 'exit 2' INT TERM HUP
+NAME=golden . tests/lib.sh
 
 "$MECH" batch -j 2 --golden tests/golden mechanisms/*.yaml >"$tmp/table" 2>"$tmp/err"
 status=$?
@@ -25,5 +17,4 @@ if [ "$status" -ne 0 ] || [ "$failed" -ne 0 ]; then
     sed 's/^/    /' "$tmp/err" | head -n 60
     [ "$failed" -gt 0 ] || failed=1
 fi
-echo "golden: $passed passed, $failed failed"
-[ "$failed" -eq 0 ]
+summary

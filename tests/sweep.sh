@@ -5,15 +5,7 @@
 # run as separate local processes in parallel (xargs -P, and GNU Parallel
 # when installed) and merged, equal to the unsharded run.
 # Run from the repository root:  MECH=build/mech sh tests/sweep.sh
-MECH=${MECH:-build/mech}
-tmp=${TMPDIR:-/tmp}/mech-sweep.$$
-mkdir "$tmp" || exit 2
-trap 'rm -rf "$tmp"' EXIT
-trap 'exit 2' INT TERM HUP
-passed=0
-failed=0
-pass() { passed=$((passed + 1)); }
-fail() { failed=$((failed + 1)); echo "FAIL: $*"; }
+NAME=sweep . tests/lib.sh
 
 n=100
 [ -n "$MECH_SANITIZE" ] && n=10
@@ -76,5 +68,4 @@ seq 0 $((m - 1)) | xargs -P $m -I K "$MECH" batch -q -j 1 --shard K/$m --out-dir
     mechanisms/*.yaml >/dev/null 2>&1
 diff -r "$tmp/b1" "$tmp/b2" >/dev/null && pass || fail "batch shards differ from one batch"
 
-echo "sweep: $passed passed, $failed failed"
-[ "$failed" -eq 0 ]
+summary
