@@ -2,9 +2,11 @@
  * interpreter (YAML file -> model -> loop equations -> solutions).
  *
  * Three kinds of data are kept apart (see docs/architecture.md):
- *   the model   (this header: what the file says, in SI units, fixed after load),
- *   the system  (equations, tape, sparsity pattern; built once),
- *   the state   (positions, velocities, ...; changes every crank step).
+ *   the model    (this header: what the file says, in SI units, fixed after load),
+ *   the analysis (equations, tape, sparsity pattern, columns; built once, then
+ *                 read only and shared by threads: mech_analysis below),
+ *   the state    (positions, velocities, factors...; changes every crank step,
+ *                 one per thread, inside mech_analysis_solve).
  *
  * Ownership: every mech_*_new / mech_load_* result is released by the matching
  * mech_*_free, which accepts NULL. */
@@ -342,6 +344,38 @@ typedef struct mech_solve_stats {
  * the rows solved before the failure. `stats` may be NULL. */
 int mech_solve(const mech_model *m, const mech_solve_options *o, mech_table *out,
                mech_solve_stats *stats, mech_diag *d);
+
+/* ---- The analysed system ----------------------------------------------
+ * mech_solve is three steps that callers may also take themselves:
+ *
+ *   mech_analysis_new    everything fixed for a model and options: the loop
+ *                        equations and derivatives, the unknowns the outputs
+ *                        need, the compiled tape, the linear solvers' pattern
+ *                        analysis, the force system's pattern, the columns;
+ *   mech_analysis_solve  a sweep: it allocates its own numeric state
+ *                        (unknowns, rates, tape registers, factors), solves
+ *                        the rows and frees the state;
+ *   mech_analysis_free.
+ *
+ * Thread safety: an analysis is read only after mech_analysis_new, so any
+ * number of threads may call mech_analysis_solve on the same analysis at
+ * once, each with its own table, stats and diag. The model must outlive
+ * the analysis and must not change meanwhile; options.log (if set) is
+ * written only by mech_analysis_new. */
+typedef struct mech_analysis mech_analysis;
+
+/* Analyse a checked model for the options (the driver positions are the
+ * file's, or the options' range). MECH_OK, or an error in d. */
+int mech_analysis_new(const mech_model *m, const mech_solve_options *o, mech_analysis **out,
+                      mech_diag *d);
+void mech_analysis_free(mech_analysis **a);
+/* Columns of the tables the analysis produces. */
+int mech_analysis_columns(const mech_analysis *a);
+/* Solve the driver positions q[0..nq-1] (in order: each row continues from
+ * the one before), or the analysis's own when q is NULL. Results, failures
+ * and stats as mech_solve. */
+int mech_analysis_solve(const mech_analysis *a, const double *q, int nq, mech_table *out,
+                        mech_solve_stats *stats, mech_diag *d);
 
 /* Parse a driver position from the command line: bare numbers are degrees
  * (is_angle) or millimetres, or give a unit ("2.0864 rad", "0.15 m"). */

@@ -18,10 +18,35 @@
 /* Exact inverse norm up to this block size; Hager's estimate above. */
 enum { EXACT_NORM_MAX = 8, HAGER_ITERATIONS = 5, WHOLE_HAGER_ITERATIONS = 2 };
 
+void blocklu_plan_free(blocklu_plan *b)
+{
+    void *blocks[] = {b->P, b->Q, b->R, b->at, b->where, b->op, b->oi};
+    for (size_t i = 0; i < sizeof blocks / sizeof blocks[0]; i++)
+        free(blocks[i]);
+    memset(b, 0, sizeof *b);
+}
+
+int blocklu_init(blocklu *b, const blocklu_plan *plan)
+{
+    memset(b, 0, sizeof *b);
+    int n = plan->n, nb = plan->nblocks;
+    b->plan = plan;
+    b->singular_col = -1;
+    b->v = xcalloc((size_t)plan->nv + 1, sizeof *b->v);
+    b->piv = xcalloc((size_t)n + 1, sizeof *b->piv);
+    b->anorm = xcalloc((size_t)nb + 1, sizeof *b->anorm);
+    b->colnorm = xcalloc((size_t)n + 1, sizeof *b->colnorm);
+    b->w = xcalloc(4 * (size_t)n + 3 * (size_t)plan->largest + 1, sizeof *b->w);
+    if (!b->v || !b->piv || !b->anorm || !b->colnorm || !b->w) {
+        blocklu_free(b);
+        return -1;
+    }
+    return 0;
+}
+
 void blocklu_free(blocklu *b)
 {
-    void *blocks[] = {b->P, b->Q, b->R, b->at, b->where, b->v, b->op, b->oi, b->piv,
-                      b->anorm, b->colnorm, b->w};
+    void *blocks[] = {b->v, b->piv, b->anorm, b->colnorm, b->w};
     for (size_t i = 0; i < sizeof blocks / sizeof blocks[0]; i++)
         free(blocks[i]);
     memset(b, 0, sizeof *b);
@@ -29,7 +54,7 @@ void blocklu_free(blocklu *b)
 
 /* Where each entry of A goes: its block's dense storage, or the list of
  * entries above the blocks (CSC by permuted column). */
-static int place_entries(blocklu *b, const int *Ap, const int *Ai, const int *pinv,
+static int place_entries(blocklu_plan *b, const int *Ap, const int *Ai, const int *pinv,
                          const int *blk)
 {
     int n = b->n, nnz = Ap[n], above = 0;
@@ -41,8 +66,8 @@ static int place_entries(blocklu *b, const int *Ap, const int *Ai, const int *pi
     b->op = xcalloc((size_t)n + 1, sizeof *b->op);
     b->oi = xcalloc((size_t)above + 1, sizeof *b->oi);
     b->where = xcalloc((size_t)nnz + 1, sizeof *b->where);
-    b->v = xcalloc((size_t)(b->ndense + above) + 1, sizeof *b->v);
-    if (!b->op || !b->oi || !b->where || !b->v)
+    b->nv = b->ndense + above;
+    if (!b->op || !b->oi || !b->where)
         return -1;
     int e = 0;
     for (int k = 0; k < n; k++) {
@@ -63,19 +88,17 @@ static int place_entries(blocklu *b, const int *Ap, const int *Ai, const int *pi
     return 0;
 }
 
-int blocklu_analyze(blocklu *b, int n, const int *Ap, const int *Ai, int max_block)
+int blocklu_analyze(blocklu_plan *b, int n, const int *Ap, const int *Ai, int max_block)
 {
     memset(b, 0, sizeof *b);
     b->n = n;
-    b->singular_col = -1;
     b->P = xcalloc((size_t)n + 1, sizeof *b->P);
     b->Q = xcalloc((size_t)n + 1, sizeof *b->Q);
     b->R = xcalloc((size_t)n + 2, sizeof *b->R);
-    b->piv = xcalloc((size_t)n + 1, sizeof *b->piv);
     int *work = xcalloc(5 * (size_t)n + 1, sizeof *work);
     int *pinv = xcalloc((size_t)n + 1, sizeof *pinv), *blk = xcalloc((size_t)n + 1, sizeof *blk);
     int rc = -1;
-    if (!b->P || !b->Q || !b->R || !b->piv || !work || !pinv || !blk)
+    if (!b->P || !b->Q || !b->R || !work || !pinv || !blk)
         goto done;
     double maxwork_done;
     int nmatch = 0;
@@ -87,8 +110,7 @@ int blocklu_analyze(blocklu *b, int n, const int *Ap, const int *Ai, int max_blo
         goto done;
     }
     b->at = xcalloc((size_t)b->nblocks + 1, sizeof *b->at);
-    b->anorm = xcalloc((size_t)b->nblocks + 1, sizeof *b->anorm);
-    if (!b->at || !b->anorm)
+    if (!b->at)
         goto done;
     for (int k = 0; k < b->nblocks; k++) {
         int size = b->R[k + 1] - b->R[k];
@@ -106,9 +128,7 @@ int blocklu_analyze(blocklu *b, int n, const int *Ap, const int *Ai, int max_blo
     }
     for (int k = 0; k < n; k++)
         pinv[b->P[k]] = k;
-    b->w = xcalloc(4 * (size_t)n + 3 * (size_t)b->largest + 1, sizeof *b->w);
-    b->colnorm = xcalloc((size_t)n + 1, sizeof *b->colnorm);
-    if (!b->w || !b->colnorm || place_entries(b, Ap, Ai, pinv, blk) < 0)
+    if (place_entries(b, Ap, Ai, pinv, blk) < 0)
         goto done;
     unsigned char *seen = (unsigned char *)work;  /* 5n ints: room for n bytes */
     b->pq_parity = permutation_parity(b->P, n, seen) ^ permutation_parity(b->Q, n, seen);
@@ -345,16 +365,17 @@ static void block_ref_solve_transposed(void *c, double *y)
  * zero next to the entries above it at a singular position. */
 static void column_norms(blocklu *b)
 {
-    const double *above = b->v + b->ndense;
-    for (int k = 0; k < b->nblocks; k++) {
-        int k0 = b->R[k], size = b->R[k + 1] - k0;
-        const double *a = b->v + b->at[k];
+    const blocklu_plan *pl = b->plan;
+    const double *above = b->v + pl->ndense;
+    for (int k = 0; k < pl->nblocks; k++) {
+        int k0 = pl->R[k], size = pl->R[k + 1] - k0;
+        const double *a = b->v + pl->at[k];
         double big = 0.0;
         for (int j = 0; j < size; j++) {
             double sum = 0.0;
             for (int i = 0; i < size; i++)
                 sum += fabs(a[i + j * size]);
-            for (int p = b->op[k0 + j]; p < b->op[k0 + j + 1]; p++)
+            for (int p = pl->op[k0 + j]; p < pl->op[k0 + j + 1]; p++)
                 sum += fabs(above[p]);
             b->colnorm[k0 + j] = sum;
             big = sum > big ? sum : big;
@@ -365,21 +386,22 @@ static void column_norms(blocklu *b)
 
 int blocklu_factor(blocklu *b, const double *Ax)
 {
-    memset(b->v, 0, (size_t)b->ndense * sizeof *b->v);
+    const blocklu_plan *pl = b->plan;
+    memset(b->v, 0, (size_t)pl->ndense * sizeof *b->v);
     b->singular_col = -1;
-    for (int p = 0; p < b->nnz; p++) {
+    for (int p = 0; p < pl->nnz; p++) {
         if (!isfinite(Ax[p]))
             return -1;
-        b->v[b->where[p]] = Ax[p];
+        b->v[pl->where[p]] = Ax[p];
     }
     column_norms(b);
     b->swap_parity = 0;
-    for (int k = 0; k < b->nblocks; k++) {
-        int k0 = b->R[k], size = b->R[k + 1] - k0;
-        double *a = b->v + b->at[k];
+    for (int k = 0; k < pl->nblocks; k++) {
+        int k0 = pl->R[k], size = pl->R[k + 1] - k0;
+        double *a = b->v + pl->at[k];
         int zero = block_factor(a, size, b->piv + k0, &b->swap_parity);
         if (zero >= 0) {
-            b->singular_col = b->Q[k0 + zero];
+            b->singular_col = pl->Q[k0 + zero];
             return -1;
         }
     }
@@ -390,43 +412,46 @@ int blocklu_factor(blocklu *b, const double *Ax)
  * block, then move its columns' entries above it to the right-hand side. */
 void blocklu_solve(blocklu *b, double *x)
 {
+    const blocklu_plan *pl = b->plan;
     double *y = b->w;
-    const double *above = b->v + b->ndense;
-    for (int k = 0; k < b->n; k++)
-        y[k] = x[b->P[k]];
-    for (int k = b->nblocks - 1; k >= 0; k--) {
-        int k0 = b->R[k], size = b->R[k + 1] - k0;
-        block_solve(b->v + b->at[k], size, b->piv + k0, y + k0);
+    const double *above = b->v + pl->ndense;
+    for (int k = 0; k < pl->n; k++)
+        y[k] = x[pl->P[k]];
+    for (int k = pl->nblocks - 1; k >= 0; k--) {
+        int k0 = pl->R[k], size = pl->R[k + 1] - k0;
+        block_solve(b->v + pl->at[k], size, b->piv + k0, y + k0);
         for (int j = k0; j < k0 + size; j++)
-            for (int p = b->op[j]; p < b->op[j + 1]; p++)
-                y[b->oi[p]] -= above[p] * y[j];
+            for (int p = pl->op[j]; p < pl->op[j + 1]; p++)
+                y[pl->oi[p]] -= above[p] * y[j];
     }
-    for (int k = 0; k < b->n; k++)
-        x[b->Q[k]] = y[k];
+    for (int k = 0; k < pl->n; k++)
+        x[pl->Q[k]] = y[k];
 }
 
 /* x := A^-T x: forward over the blocks (A^T is lower block triangular). */
 static void solve_transposed(blocklu *b, double *x)
 {
+    const blocklu_plan *pl = b->plan;
     double *y = b->w;
-    const double *above = b->v + b->ndense;
-    for (int k = 0; k < b->n; k++)
-        y[k] = x[b->Q[k]];
-    for (int k = 0; k < b->nblocks; k++) {
-        int k0 = b->R[k], size = b->R[k + 1] - k0;
+    const double *above = b->v + pl->ndense;
+    for (int k = 0; k < pl->n; k++)
+        y[k] = x[pl->Q[k]];
+    for (int k = 0; k < pl->nblocks; k++) {
+        int k0 = pl->R[k], size = pl->R[k + 1] - k0;
         for (int j = k0; j < k0 + size; j++)
-            for (int p = b->op[j]; p < b->op[j + 1]; p++)
-                y[j] -= above[p] * y[b->oi[p]];
-        block_solve_transposed(b->v + b->at[k], size, b->piv + k0, y + k0);
+            for (int p = pl->op[j]; p < pl->op[j + 1]; p++)
+                y[j] -= above[p] * y[pl->oi[p]];
+        block_solve_transposed(b->v + pl->at[k], size, b->piv + k0, y + k0);
     }
-    for (int k = 0; k < b->n; k++)
-        x[b->P[k]] = y[k];
+    for (int k = 0; k < pl->n; k++)
+        x[pl->P[k]] = y[k];
 }
 
 static double whole_norm1(const blocklu *b)
 {
+    const blocklu_plan *pl = b->plan;
     double big = 0.0;
-    for (int j = 0; j < b->n; j++)
+    for (int j = 0; j < pl->n; j++)
         big = fmax(big, b->colnorm[j]);
     return big;
 }
@@ -436,22 +461,24 @@ static void whole_solve_transposed(void *c, double *y) { solve_transposed(c, y);
 
 double blocklu_rcond_whole(blocklu *b)
 {
+    const blocklu_plan *pl = b->plan;
     /* two iterations: the estimate only sets the rounding floor of Newton's
        step, where a lower bound of the inverse's norm errs on the safe side
        (a smaller floor, at worst one more iteration) */
     solves s = {whole_solve, whole_solve_transposed, b};
-    double est = inverse_norm_hager(&s, b->n, WHOLE_HAGER_ITERATIONS, b->w + b->n);
+    double est = inverse_norm_hager(&s, pl->n, WHOLE_HAGER_ITERATIONS, b->w + pl->n);
     double anorm = whole_norm1(b), r = anorm > 0.0 && est > 0.0 ? 1.0 / (anorm * est) : 0.0;
     return r >= 0.0 ? r : 0.0;
 }
 
 double blocklu_rcond(blocklu *b)
 {
+    const blocklu_plan *pl = b->plan;
     double worst = 1.0;
-    double *w = b->w + 4 * b->n;
-    for (int k = 0; k < b->nblocks; k++) {
-        int k0 = b->R[k], size = b->R[k + 1] - k0;
-        const double *a = b->v + b->at[k];
+    double *w = b->w + 4 * pl->n;
+    for (int k = 0; k < pl->nblocks; k++) {
+        int k0 = pl->R[k], size = pl->R[k + 1] - k0;
+        const double *a = b->v + pl->at[k];
         block_ref ref = {a, size, b->piv + k0};
         solves sv = {block_ref_solve, block_ref_solve_transposed, &ref};
         double inv = size <= 2              ? inverse_norm_small(a, size)
@@ -467,10 +494,11 @@ double blocklu_rcond(blocklu *b)
 
 double blocklu_pivot_ratio(const blocklu *b)
 {
+    const blocklu_plan *pl = b->plan;
     double worst = 1.0;
-    for (int k = 0; k < b->nblocks; k++) {
-        int k0 = b->R[k], size = b->R[k + 1] - k0;
-        const double *a = b->v + b->at[k];
+    for (int k = 0; k < pl->nblocks; k++) {
+        int k0 = pl->R[k], size = pl->R[k + 1] - k0;
+        const double *a = b->v + pl->at[k];
         for (int j = 0; j < size; j++) {
             double r = b->anorm[k] > 0.0 ? fabs(a[j + j * size]) / b->anorm[k] : 0.0;
             worst = r < worst ? r : worst;
@@ -481,10 +509,11 @@ double blocklu_pivot_ratio(const blocklu *b)
 
 int blocklu_det_sign(const blocklu *b)
 {
-    int neg = b->pq_parity ^ b->swap_parity;
-    for (int k = 0; k < b->nblocks; k++) {
-        int k0 = b->R[k], size = b->R[k + 1] - k0;
-        const double *a = b->v + b->at[k];
+    const blocklu_plan *pl = b->plan;
+    int neg = pl->pq_parity ^ b->swap_parity;
+    for (int k = 0; k < pl->nblocks; k++) {
+        int k0 = pl->R[k], size = pl->R[k + 1] - k0;
+        const double *a = b->v + pl->at[k];
         for (int j = 0; j < size; j++) {
             double d = a[j + j * size];
             if (d == 0.0)

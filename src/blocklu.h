@@ -2,31 +2,41 @@
  * triangular form has only small diagonal blocks (docs/solver.md, section
  * "Linear solves"). Each diagonal block is stored dense and factored with
  * partial pivoting; the entries above the blocks stay sparse. Analysis
- * allocates once; factor, solve and the condition estimate do not. */
+ * (blocklu_plan) and the factors (blocklu) are apart, like KLU's symbolic
+ * and numeric objects; factor, solve and the condition estimate allocate
+ * nothing. */
 #ifndef MECH_BLOCKLU_H
 #define MECH_BLOCKLU_H
 
 /* Largest diagonal block factored dense: beyond it KLU is used (linsys.c). */
 enum { BLOCKLU_MAX_BLOCK = 16 };
 
-typedef struct blocklu {
+/* The analysis of a pattern: immutable once made, shared by every blocklu
+ * factoring values of that pattern (one per thread). */
+typedef struct blocklu_plan {
     int n, nblocks, largest;   /* order, number of blocks, largest block */
     int *P, *Q;                /* [n] A(P,Q) is upper block triangular (btf_order) */
     int *R;                    /* [nblocks+1] first row/column of each block */
     int *at;                   /* [nblocks] start of each block's dense storage in v */
     int nnz;
     int *where;                /* [nnz] slot in v of each entry of A (CSC order) */
-    int nv;                    /* dense storage, then one slot per entry above the blocks */
-    double *v;                 /* [nv + above] block k x k column major, then those entries */
+    int nv;                    /* values: the dense blocks (ndense), then one slot per entry
+                                  above the blocks */
     int *op, *oi;              /* [n+1], [above]: entries above the blocks, by permuted
                                   column: their permuted rows; values v[ndense + p] */
     int ndense;
+    int pq_parity;             /* parity of P and Q together */
+} blocklu_plan;
+
+/* Factors of one matrix with an analysed pattern (per thread). */
+typedef struct blocklu {
+    const blocklu_plan *plan;  /* borrowed */
+    double *v;                 /* [nv] block k x k column major, then the entries above */
     int *piv;                  /* [n] row swapped into each position within its block */
     double *anorm;             /* [nblocks] 1-norm of each block's columns (with the
                                   entries above the block) before factoring */
     double *colnorm;           /* [n] 1-norm of each column of A */
     double *w;                 /* [4 n + 3 largest] solve and estimator work */
-    int pq_parity;             /* parity of P and Q together */
     int swap_parity;           /* parity of the row swaps of the last factorisation */
     int singular_col;          /* column of A with a zero pivot, or -1 */
 } blocklu;
@@ -34,7 +44,10 @@ typedef struct blocklu {
 /* Block triangular form of the pattern (Ap, Ai: CSC, n columns). Returns 0,
  * 1 when the pattern is structurally singular, 2 when some diagonal block is
  * larger than max_block, -1 when out of memory. */
-int blocklu_analyze(blocklu *b, int n, const int *Ap, const int *Ai, int max_block);
+int blocklu_analyze(blocklu_plan *b, int n, const int *Ap, const int *Ai, int max_block);
+void blocklu_plan_free(blocklu_plan *b);
+/* Workspace and factors for values of the plan's pattern; -1 when out of memory. */
+int blocklu_init(blocklu *b, const blocklu_plan *plan);
 void blocklu_free(blocklu *b);
 
 /* Factor the values Ax (the analysed pattern). Returns 0, or -1 for a zero

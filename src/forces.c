@@ -44,7 +44,7 @@ static void joint_links(const mech_joint *jt, int *a, int *b)
 
 static void point_motion(const solver *sv, int l, int i, double *p, double *v, double *a)
 {
-    const mech_point *pt = &sv->m->links[l].points[i];
+    const mech_point *pt = &sv->p->m->links[l].points[i];
     double r[2] = {pt->x, pt->y};
     kin_on_link(&sv->ks, l, r, p, v, a);
 }
@@ -54,8 +54,9 @@ static void point_motion(const solver *sv, int l, int i, double *p, double *v, d
  * link needs them. */
 static void update_centres(forces *fc, const solver *sv)
 {
-    for (int l = 0; l < fc->m->nlinks; l++) {
-        const mech_link *k = &fc->m->links[l];
+    const mech_model *m = fc->p->m;
+    for (int l = 0; l < m->nlinks; l++) {
+        const mech_link *k = &m->links[l];
         double r[2] = {k->has_mass ? k->center[0] : 0.0, k->has_mass ? k->center[1] : 0.0};
         kin_on_link(&sv->ks, l, r, fc->g + 2 * l, fc->vg + 2 * l, fc->ag + 2 * l);
     }
@@ -85,12 +86,13 @@ typedef struct entry {
     double val;
 } entry;
 
-static int push_force(entry *e, int n, const forces *fc, int l, const double *p, const double *f,
-                      double sign)
+static int push_force(entry *e, int n, const double *centres, int l, const double *p,
+                      const double *f, double sign)
 {
     if (l == 0)
         return n;
-    const double *g = fc->g + 2 * l;
+    static const double origin[2] = {0.0, 0.0};  /* building the pattern: no centres */
+    const double *g = centres ? centres + 2 * l : origin;
     double r[2] = {p[0] - g[0], p[1] - g[1]};
     int row = moving_row(l);
     e[n++] = (entry){row, sign * f[0]};
@@ -106,32 +108,48 @@ static int push_moment(entry *e, int n, int l, double sign)
     return n;
 }
 
-/* Entries of column c at the current position, sorted by row. */
-static int column_entries(const forces *fc, const solver *sv, int c, entry *e)
+/* Contact point p and direction dir of the force of column c on joint jt
+ * at the published position of sv; with no position (sv NULL, the pattern
+ * is being built) any point and direction do: only the rows matter. */
+static void column_geometry(const solver *sv, const mech_joint *jt, fc_kind kind, double *p,
+                            double *dir)
 {
-    const mech_model *m = fc->m;
+    double v[2], u[2] = {1.0, 0.0};
+    p[0] = p[1] = 0.0;
+    if (sv)
+        contact(sv, jt, p, v);
+    if (sv && (kind == FC_NORMAL || kind == FC_DRIVE))
+        guide_dir(sv, jt, u);
+    switch (kind) {
+    case FC_FX: dir[0] = 1.0; dir[1] = 0.0; break;
+    case FC_FY: dir[0] = 0.0; dir[1] = 1.0; break;
+    case FC_NORMAL: dir[0] = -u[1]; dir[1] = u[0]; break;
+    case FC_DRIVE: dir[0] = u[0]; dir[1] = u[1]; break;
+    case FC_MOMENT: dir[0] = dir[1] = 0.0; break;
+    }
+}
+
+/* Entries of column c, sorted by row: at the published position of sv
+ * with the centres of mass g, or (sv NULL) just their rows. */
+static int column_entries(const forces_plan *fp, const solver *sv, const double *g, int c,
+                          entry *e)
+{
+    const mech_model *m = fp->m;
     int n = 0;
-    if (fc->joint[c] < 0 && m->driver.kind == MECH_DRIVE_ANGLE) {
+    if (fp->joint[c] < 0 && m->driver.kind == MECH_DRIVE_ANGLE) {
         n = push_moment(e, n, m->driver.index, 1.0);
     } else {
-        const mech_joint *jt = &m->joints[fc->joint[c] >= 0 ? fc->joint[c] : m->driver.index];
+        const mech_joint *jt = &m->joints[fp->joint[c] >= 0 ? fp->joint[c] : m->driver.index];
         int a, b;
         joint_links(jt, &a, &b);
-        double p[2], v[2], u[2], dir[2];
-        contact(sv, jt, p, v);
-        switch (fc->kind[c]) {
-        case FC_FX: dir[0] = 1.0; dir[1] = 0.0; break;
-        case FC_FY: dir[0] = 0.0; dir[1] = 1.0; break;
-        case FC_NORMAL: guide_dir(sv, jt, u); dir[0] = -u[1]; dir[1] = u[0]; break;
-        case FC_DRIVE: guide_dir(sv, jt, dir); break;
-        case FC_MOMENT: dir[0] = dir[1] = 0.0; break;
-        }
-        if (fc->kind[c] == FC_MOMENT) {
+        double p[2], dir[2];
+        column_geometry(sv, jt, fp->kind[c], p, dir);
+        if (fp->kind[c] == FC_MOMENT) {
             n = push_moment(e, n, a, 1.0);
             n = push_moment(e, n, b, -1.0);
         } else {
-            n = push_force(e, n, fc, a, p, dir, 1.0);
-            n = push_force(e, n, fc, b, p, dir, -1.0);
+            n = push_force(e, n, g, a, p, dir, 1.0);
+            n = push_force(e, n, g, b, p, dir, -1.0);
         }
     }
     for (int i = 1; i < n; i++)  /* insertion sort: at most 6 entries */
@@ -143,101 +161,90 @@ static int column_entries(const forces *fc, const solver *sv, int c, entry *e)
     return n;
 }
 
-static int add_column(forces *fc, fc_kind kind, int joint)
+static int add_column(forces_plan *fp, fc_kind kind, int joint)
 {
-    fc->kind[fc->ncols] = kind;
-    fc->joint[fc->ncols] = joint;
-    return fc->ncols++;
+    fp->kind[fp->ncols] = kind;
+    fp->joint[fp->ncols] = joint;
+    return fp->ncols++;
 }
 
-static void make_columns(forces *fc)
+static void make_columns(forces_plan *fp)
 {
-    const mech_model *m = fc->m;
+    const mech_model *m = fp->m;
     for (int j = 0; j < m->njoints; j++) {
         const mech_joint *jt = &m->joints[j];
-        fc->jcol[j] = fc->ncols;
+        fp->jcol[j] = fp->ncols;
         if (jt->kind == MECH_JOINT_REVOLUTE) {
-            add_column(fc, FC_FX, j);
-            add_column(fc, FC_FY, j);
+            add_column(fp, FC_FX, j);
+            add_column(fp, FC_FY, j);
         } else {
-            add_column(fc, FC_NORMAL, j);
+            add_column(fp, FC_NORMAL, j);
             if (jt->locked)
-                add_column(fc, FC_MOMENT, j);
+                add_column(fp, FC_MOMENT, j);
         }
         if (jt->friction > 0.0)
-            fc->has_friction = 1;
+            fp->has_friction = 1;
     }
-    add_column(fc, FC_DRIVE, -1);
+    add_column(fp, FC_DRIVE, -1);
 }
 
-static int build_pattern(forces *fc, const solver *sv)
+static int build_pattern(forces_plan *fp)
 {
     entry e[MAX_ENTRIES];
     int cap = 0;
-    for (int c = 0; c < fc->ncols; c++)
-        cap += column_entries(fc, sv, c, e);
-    fc->Ai = xcalloc((size_t)cap + 1, sizeof *fc->Ai);
-    fc->Ax = xcalloc((size_t)cap + 1, sizeof *fc->Ax);
-    if (!fc->Ai || !fc->Ax)
+    for (int c = 0; c < fp->ncols; c++)
+        cap += column_entries(fp, NULL, NULL, c, e);
+    fp->Ai = xcalloc((size_t)cap + 1, sizeof *fp->Ai);
+    if (!fp->Ai)
         return -1;
     int at = 0;
-    for (int c = 0; c < fc->ncols; c++) {
-        fc->Ap[c] = at;
-        int n = column_entries(fc, sv, c, e);
+    for (int c = 0; c < fp->ncols; c++) {
+        fp->Ap[c] = at;
+        int n = column_entries(fp, NULL, NULL, c, e);
         for (int k = 0; k < n; k++)
-            fc->Ai[at++] = e[k].row;
+            fp->Ai[at++] = e[k].row;
     }
-    fc->Ap[fc->ncols] = at;
-    fc->nnz = at;
+    fp->Ap[fp->ncols] = at;
+    fp->nnz = at;
     return 0;
 }
 
-int forces_init(forces *fc, const solver *sv, int friction, mech_diag *d)
+static int no_memory(const mech_model *m, mech_diag *d)
 {
-    const mech_model *m = sv->m;
-    memset(fc, 0, sizeof *fc);
-    fc->m = m;
-    fc->nrows = 3 * (m->nlinks - 1);
-    int maxcols = 2 * m->njoints + 1;
-    size_t nr = (size_t)fc->nrows + 1, nc = (size_t)maxcols + 1;
-    fc->kind = xcalloc(nc, sizeof *fc->kind);
-    fc->joint = xcalloc(nc, sizeof *fc->joint);
-    fc->jcol = xcalloc((size_t)m->njoints + 1, sizeof *fc->jcol);
-    fc->Ap = xcalloc(nc + 1, sizeof *fc->Ap);
-    fc->cscale = xcalloc(nc, sizeof *fc->cscale);
-    fc->b = xcalloc(nr + nc, sizeof *fc->b);
-    fc->y = xcalloc(nr + nc, sizeof *fc->y);
-    fc->y0 = xcalloc(nr + nc, sizeof *fc->y0);
-    fc->ynext = xcalloc(nr + nc, sizeof *fc->ynext);
-    fc->aa_g = xcalloc(nr, sizeof *fc->aa_g);
-    fc->aa_r = xcalloc(nr, sizeof *fc->aa_r);
-    fc->aa_dg = xcalloc(ANDERSON_DEPTH * nr, sizeof *fc->aa_dg);
-    fc->aa_dr = xcalloc(ANDERSON_DEPTH * nr, sizeof *fc->aa_dr);
-    fc->fric = xcalloc(nr, sizeof *fc->fric);
-    fc->g = xcalloc(2 * (size_t)m->nlinks, sizeof *fc->g);
-    fc->vg = xcalloc(2 * (size_t)m->nlinks, sizeof *fc->vg);
-    fc->ag = xcalloc(2 * (size_t)m->nlinks, sizeof *fc->ag);
-    if (!fc->kind || !fc->joint || !fc->jcol || !fc->Ap || !fc->cscale || !fc->b || !fc->y ||
-        !fc->y0 || !fc->ynext || !fc->fric || !fc->g || !fc->vg || !fc->ag || !fc->aa_g ||
-        !fc->aa_r || !fc->aa_dg || !fc->aa_dr)
-        return diag_error(d, m->file, (mech_mark){0, 0}, "out of memory"), MECH_ENOMEM;
-    make_columns(fc);
-    fc->friction = friction && fc->has_friction;
-    if (fc->ncols != fc->nrows)
+    return diag_error(d, m->file, (mech_mark){0, 0}, "out of memory"), MECH_ENOMEM;
+}
+
+int forces_plan_init(forces_plan *fp, const solver_plan *sp, int friction, mech_diag *d)
+{
+    const mech_model *m = sp->m;
+    memset(fp, 0, sizeof *fp);
+    fp->m = m;
+    fp->nrows = 3 * (m->nlinks - 1);
+    size_t nc = 2 * (size_t)m->njoints + 2;
+    fp->kind = xcalloc(nc, sizeof *fp->kind);
+    fp->joint = xcalloc(nc, sizeof *fp->joint);
+    fp->jcol = xcalloc((size_t)m->njoints + 1, sizeof *fp->jcol);
+    fp->Ap = xcalloc(nc + 1, sizeof *fp->Ap);
+    if (!fp->kind || !fp->joint || !fp->jcol || !fp->Ap)
+        return no_memory(m, d);
+    make_columns(fp);
+    fp->friction = friction != MECH_FRICTION_OFF && fp->has_friction;
+    fp->want_frictionless = friction == MECH_FRICTION_BOTH;
+    if (fp->ncols != fp->nrows)
         return diag_error(d, m->file, m->driver.mark,
                           "the force analysis has %d unknown reactions for %d equilibrium "
-                          "equations: the mechanism is %s", fc->ncols, fc->nrows,
-                          fc->ncols > fc->nrows ? "over-constrained (reactions not unique)"
+                          "equations: the mechanism is %s", fp->ncols, fp->nrows,
+                          fp->ncols > fp->nrows ? "over-constrained (reactions not unique)"
                                                 : "under-constrained"), MECH_EINPUT;
-    if (build_pattern(fc, sv) < 0)
-        return diag_error(d, m->file, (mech_mark){0, 0}, "out of memory"), MECH_ENOMEM;
+    if (build_pattern(fp) < 0)
+        return no_memory(m, d);
     double qd = fabs(m->driver.speed);
     if (m->driver.kind == MECH_DRIVE_SLIDER)
-        qd /= sv->lref;
-    fc->speed_eps = 1e-6 * (qd > 0.0 ? qd : 1.0);
-    int rc = linsys_init(&fc->ls, fc->ncols, fc->Ap, fc->Ai, sv->opt.linear_solver);
+        qd /= sp->lref;
+    fp->speed_eps = 1e-6 * (qd > 0.0 ? qd : 1.0);
+    int rc = linsys_plan_init(&fp->lp, fp->ncols, fp->Ap, fp->Ai, sp->opt.linear_solver);
     if (rc < 0)
-        return diag_error(d, m->file, (mech_mark){0, 0}, "out of memory"), MECH_ENOMEM;
+        return no_memory(m, d);
     if (rc > 0)
         return diag_error(d, m->file, m->driver.mark,
                           "the force analysis is structurally singular: some reaction appears in "
@@ -245,14 +252,39 @@ int forces_init(forces *fc, const solver *sv, int friction, mech_diag *d)
     return MECH_OK;
 }
 
+void forces_plan_free(forces_plan *fp)
+{
+    linsys_plan_free(&fp->lp);
+    void *blocks[] = {fp->kind, fp->joint, fp->jcol, fp->Ap, fp->Ai};
+    for (size_t i = 0; i < sizeof blocks / sizeof blocks[0]; i++)
+        free(blocks[i]);
+    memset(fp, 0, sizeof *fp);
+}
+
+int forces_init(forces *fc, const forces_plan *fp)
+{
+    memset(fc, 0, sizeof *fc);
+    fc->p = fp;
+    size_t nr = (size_t)fp->nrows + 1, nc = (size_t)fp->ncols + 1;
+    size_t nl2 = 2 * (size_t)fp->m->nlinks, depth = ANDERSON_DEPTH;
+    double **arrays[] = {&fc->Ax, &fc->cscale, &fc->b, &fc->y, &fc->y0, &fc->ynext,
+                         &fc->aa_g, &fc->aa_r, &fc->aa_dg, &fc->aa_dr, &fc->fric,
+                         &fc->g, &fc->vg, &fc->ag};
+    size_t sizes[] = {(size_t)fp->nnz + 1, nc, nr + nc, nr + nc, nr + nc, nr + nc,
+                      nr, nr, depth * nr, depth * nr, nr, nl2, nl2, nl2};
+    for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
+        if (!(*arrays[i] = xcalloc(sizes[i], sizeof(double))))
+            return -1;
+    return linsys_init(&fc->ls, &fp->lp);
+}
+
 void forces_free(forces *fc)
 {
     linsys_free(&fc->ls);
-    void *blocks[] = {fc->kind, fc->joint, fc->jcol, fc->Ap, fc->Ai, fc->Ax, fc->b, fc->y,
-                      fc->y0, fc->ynext, fc->fric, fc->cscale, fc->g, fc->vg, fc->ag,
-                      fc->aa_g, fc->aa_r, fc->aa_dg, fc->aa_dr};
-    for (size_t i = 0; i < sizeof blocks / sizeof blocks[0]; i++)
-        free(blocks[i]);
+    double *arrays[] = {fc->Ax, fc->b, fc->y, fc->y0, fc->ynext, fc->fric, fc->cscale,
+                        fc->g, fc->vg, fc->ag, fc->aa_g, fc->aa_r, fc->aa_dg, fc->aa_dr};
+    for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
+        free(arrays[i]);
     memset(fc, 0, sizeof *fc);
 }
 
@@ -304,7 +336,8 @@ static void load_resultant(const solver *sv, const mech_load *ld, double *f, dou
 /* Inertia, gravity and external loads. */
 static void known_loads(const forces *fc, const solver *sv, double *rhs)
 {
-    const mech_model *m = fc->m;
+    const forces_plan *fp = fc->p;
+    const mech_model *m = fp->m;
     for (int l = 1; l < m->nlinks; l++) {
         const mech_link *k = &m->links[l];
         int row = moving_row(l);
@@ -337,9 +370,10 @@ static double smooth_sign(double v, double eps) { return v / sqrt(v * v + eps * 
  * or sliding (slider, along the guide). */
 static double relative_speed(const forces *fc, const solver *sv, int j)
 {
-    const mech_joint *jt = &fc->m->joints[j];
+    const forces_plan *fp = fc->p;
+    const mech_joint *jt = &fp->m->joints[j];
     if (jt->kind == MECH_JOINT_SLIDER) {
-        int var = sv->tree.slide_var[j];
+        int var = sv->p->tree.slide_var[j];
         return var >= 0 ? sv->vel[var] : 0.0;
     }
     int a, b;
@@ -351,25 +385,26 @@ static double relative_speed(const forces *fc, const solver *sv, int j)
  * dissipate. */
 static double friction_loads(forces *fc, const solver *sv, const double *y)
 {
-    const mech_model *m = fc->m;
+    const forces_plan *fp = fc->p;
+    const mech_model *m = fp->m;
     double power = 0.0;
-    memset(fc->fric, 0, (size_t)fc->nrows * sizeof *fc->fric);
+    memset(fc->fric, 0, (size_t)fp->nrows * sizeof *fc->fric);
     for (int j = 0; j < m->njoints; j++) {
         const mech_joint *jt = &m->joints[j];
         if (!(jt->friction > 0.0))
             continue;
-        int a, b, c = fc->jcol[j];
+        int a, b, c = fp->jcol[j];
         joint_links(jt, &a, &b);
         double rel = relative_speed(fc, sv, j);
         if (jt->kind == MECH_JOINT_REVOLUTE) {
-            double eps = fc->speed_eps;
+            double eps = fp->speed_eps;
             double mf = jt->friction * jt->pin_radius * sqrt(y[c] * y[c] + y[c + 1] * y[c + 1]) *
                         smooth_sign(rel, eps);
             load_moment(fc->fric, a, -mf);
             load_moment(fc->fric, b, mf);
             power += mf * rel;
         } else {
-            double eps = fc->speed_eps * sv->lref, u[2], p[2], v[2];
+            double eps = fp->speed_eps * sv->p->lref, u[2], p[2], v[2];
             double ff = jt->friction * fabs(y[c]) * smooth_sign(rel, eps);
             guide_dir(sv, jt, u);
             contact(sv, jt, p, v);
@@ -386,9 +421,10 @@ static double friction_loads(forces *fc, const solver *sv, const double *y)
 
 static int factor(forces *fc, const solver *sv)
 {
+    const forces_plan *fp = fc->p;
     entry e[MAX_ENTRIES];
-    for (int c = 0; c < fc->ncols; c++) {
-        int n = column_entries(fc, sv, c, e), at = fc->Ap[c];
+    for (int c = 0; c < fp->ncols; c++) {
+        int n = column_entries(fp, sv, fc->g, c, e), at = fp->Ap[c];
         double big = 0.0;
         for (int k = 0; k < n; k++)
             big = fmax(big, fabs(e[k].val));
@@ -415,9 +451,10 @@ static int factor(forces *fc, const solver *sv)
 
 static void solve_rhs(forces *fc, const double *rhs, double *y)
 {
-    memcpy(y, rhs, (size_t)fc->nrows * sizeof *y);
+    const forces_plan *fp = fc->p;
+    memcpy(y, rhs, (size_t)fp->nrows * sizeof *y);
     linsys_solve(&fc->ls, y);
-    for (int c = 0; c < fc->ncols; c++)
+    for (int c = 0; c < fp->ncols; c++)
         y[c] *= fc->cscale[c];
 }
 
@@ -425,7 +462,8 @@ static void solve_rhs(forces *fc, const double *rhs, double *y)
  * largest of those terms. */
 static double power_residual(const forces *fc, const solver *sv, double drive, double pfric)
 {
-    const mech_model *m = fc->m;
+    const forces_plan *fp = fc->p;
+    const mech_model *m = fp->m;
     double pd = drive * m->driver.speed, kin = 0.0, ext = 0.0, scale = fabs(pd) + fabs(pfric);
     for (int l = 1; l < m->nlinks; l++) {
         const mech_link *k = &m->links[l];
@@ -517,7 +555,8 @@ static int anderson_weights(const double *dr, int n, int depth, int newest, cons
  * Converged when |G(y) - y| <= 1e-12 |G(y)|; y = G(y) then. */
 static void friction_fixed_point(forces *fc, const solver *sv)
 {
-    int n = fc->nrows, depth = 0, newest = 0;
+    const forces_plan *fp = fc->p;
+    int n = fp->nrows, depth = 0, newest = 0;
     double *g = fc->ynext, *r = fc->aa_r, *dg = fc->aa_dg, *dr = fc->aa_dr;
     double prev_res = INFINITY;
     for (int it = 1;; it++) {
@@ -573,7 +612,8 @@ static void friction_fixed_point(forces *fc, const solver *sv)
 
 int forces_solve(forces *fc, const solver *sv)
 {
-    int n = fc->nrows, drive = fc->ncols - 1;
+    const forces_plan *fp = fc->p;
+    int n = fp->nrows, drive = fp->ncols - 1;
     update_centres(fc, sv);
     known_loads(fc, sv, fc->b);
     if (factor(fc, sv) < 0)
@@ -583,7 +623,7 @@ int forces_solve(forces *fc, const solver *sv)
        steps start from the last step's reactions (one solve fewer, and
        closer) */
     fc->residual0 = 0.0;
-    if (!fc->friction || fc->want_frictionless || !fc->have_previous) {
+    if (!fp->friction || fp->want_frictionless || !fc->have_previous) {
         solve_rhs(fc, fc->b, fc->y0);
         fc->residual0 = power_residual(fc, sv, fc->y0[drive], 0.0);
         memcpy(fc->y, fc->y0, (size_t)n * sizeof *fc->y);
@@ -591,9 +631,9 @@ int forces_solve(forces *fc, const solver *sv)
     fc->have_previous = 1;
     fc->iterations = 0;
     fc->friction_power = 0.0;
-    if (fc->friction)
+    if (fp->friction)
         friction_fixed_point(fc, sv);
-    fc->drive_power = fc->y[drive] * fc->m->driver.speed;
+    fc->drive_power = fc->y[drive] * fp->m->driver.speed;
     fc->residual = power_residual(fc, sv, fc->y[drive], fc->friction_power);
     return fc->iterations < 0 ? -2 : 0;
 }
@@ -603,24 +643,25 @@ int forces_solve(forces *fc, const solver *sv)
  * when the factorisation itself failed, KLU's first singular column. */
 void forces_singular_joints(forces *fc, char *buf, size_t size)
 {
-    const mech_model *m = fc->m;
+    const forces_plan *fp = fc->p;
+    const mech_model *m = fp->m;
     size_t at = 0;
     buf[0] = '\0';
-    int ncols = fc->ncols, count = 0;
+    int ncols = fp->ncols, count = 0;
     unsigned char *mark = xcalloc((size_t)m->njoints + 2, 1);
     if (!mark)
         return;
     if (fc->ls.factored) {
-        for (int r = 0; r < fc->nrows; r++)
+        for (int r = 0; r < fp->nrows; r++)
             fc->ynext[r] = 1.0 + 0.1 * r;  /* a generic right-hand side */
         solve_rhs(fc, fc->ynext, fc->ynext);
         double big = vec_norm_inf(fc->ynext, ncols);
         for (int c = 0; c < ncols; c++)
             if (isfinite(big) && fabs(fc->ynext[c]) > 0.1 * big)
-                mark[fc->joint[c] >= 0 ? fc->joint[c] : m->njoints] = 1;
+                mark[fp->joint[c] >= 0 ? fp->joint[c] : m->njoints] = 1;
     } else if (linsys_singular_col(&fc->ls) >= 0) {
         int c = linsys_singular_col(&fc->ls);
-        mark[fc->joint[c] >= 0 ? fc->joint[c] : m->njoints] = 1;
+        mark[fp->joint[c] >= 0 ? fp->joint[c] : m->njoints] = 1;
     }
     for (int j = 0; j <= m->njoints && at < size; j++)
         if (mark[j])
@@ -632,9 +673,10 @@ void forces_singular_joints(forces *fc, char *buf, size_t size)
 void forces_joint(const forces *fc, const solver *sv, int j, int with_friction, double *fx,
                   double *fy, double *n, double *mo)
 {
+    const forces_plan *fp = fc->p;
     const double *y = with_friction ? fc->y : fc->y0;
-    const mech_joint *jt = &fc->m->joints[j];
-    int c = fc->jcol[j];
+    const mech_joint *jt = &fp->m->joints[j];
+    int c = fp->jcol[j];
     *n = *mo = 0.0;
     if (jt->kind == MECH_JOINT_REVOLUTE) {
         *fx = y[c];
@@ -652,5 +694,6 @@ void forces_joint(const forces *fc, const solver *sv, int j, int with_friction, 
 
 double forces_drive(const forces *fc, int with_friction)
 {
-    return (with_friction ? fc->y : fc->y0)[fc->ncols - 1];
+    const forces_plan *fp = fc->p;
+    return (with_friction ? fc->y : fc->y0)[fp->ncols - 1];
 }

@@ -10,20 +10,28 @@
 /* What one column of the force system is. */
 typedef enum { FC_FX, FC_FY, FC_NORMAL, FC_MOMENT, FC_DRIVE } fc_kind;
 
-typedef struct forces {
+/* The force system of a mechanism (fixed: built once, read only, shared). */
+typedef struct forces_plan {
     const mech_model *m;
     int friction;           /* 1: Coulomb friction of the joints is applied */
     int has_friction;       /* some joint has a friction coefficient */
     int want_frictionless;  /* the frictionless reactions are output too (y0) */
-    int have_previous;      /* y holds the last step's reactions (friction start) */
     int nrows;              /* 3 per moving link */
     int ncols;
     fc_kind *kind;          /* [ncols] */
     int *joint;             /* [ncols] joint of a reaction column (-1: the driver) */
     int *jcol;              /* [njoints] first column of each joint */
     int *Ap, *Ai;           /* [ncols+1], [nnz] */
-    double *Ax;             /* [nnz] */
     int nnz;
+    double speed_eps;       /* smoothing of sign(relative speed), rad/s */
+    linsys_plan lp;         /* analysis of the pattern */
+} forces_plan;
+
+/* One thread's force solve: values, factors, the friction iteration. */
+typedef struct forces {
+    const forces_plan *p;   /* borrowed */
+    int have_previous;      /* y holds the last step's reactions (friction start) */
+    double *Ax;             /* [nnz] */
     double *b, *y, *y0;     /* [nrows] right-hand side; solution; frictionless solution */
     double *ynext;          /* [nrows] friction iterate */
     double *aa_g, *aa_r;    /* [nrows] Anderson: the last image G(y) and residual */
@@ -41,10 +49,13 @@ typedef struct forces {
     double drive_power;     /* W supplied by the driver */
     double rcond;           /* reciprocal condition at the first step, or when last checked */
     int condition_known;    /* rcond computed (forces_solve, at the first step) */
-    double speed_eps;       /* smoothing of sign(relative speed), rad/s */
 } forces;
 
-int forces_init(forces *fc, const solver *sv, int friction, mech_diag *d);
+/* The force system of the mechanism the solver plan solves (every link's
+ * motion: the plan must solve all blocks). friction: MECH_FRICTION_*. */
+int forces_plan_init(forces_plan *fp, const solver_plan *sp, int friction, mech_diag *d);
+void forces_plan_free(forces_plan *fp);
+int forces_init(forces *fc, const forces_plan *fp);  /* 0, or -1 out of memory */
 void forces_free(forces *fc);
 
 /* Forces at the published position of sv (positions, velocities and

@@ -3,7 +3,8 @@
  * factors new values, estimates the condition and solves. When every
  * diagonal block of the block triangular form is small (planar mechanisms:
  * one or two loops per block) the blocks are factored dense (blocklu.c);
- * otherwise, or when asked, by SuiteSparse KLU. */
+ * otherwise, or when asked, by SuiteSparse KLU. As in KLU, the analysis
+ * (linsys_plan, shared) and the factors (linsys, per thread) are apart. */
 #ifndef MECH_LINSYS_H
 #define MECH_LINSYS_H
 
@@ -12,17 +13,25 @@
 #include "blocklu.h"
 #include "mech.h"
 
-typedef struct linsys {
+/* The analysis of one pattern (immutable once made; threads share it). */
+typedef struct linsys_plan {
     int n;
     int *Ap, *Ai;              /* the pattern (not owned) */
     int use_klu;               /* 0: dense blocks, 1: KLU */
+    blocklu_plan blu;
+    klu_common common;         /* the settings every factorisation copies */
+    klu_symbolic *sym;         /* read only after klu_analyze */
+    int q_parity;              /* parity of KLU's fixed column order */
+} linsys_plan;
+
+/* Factors of values of a plan's pattern: one per thread. */
+typedef struct linsys {
+    const linsys_plan *plan;   /* borrowed */
     blocklu blu;
-    klu_common common;
-    klu_symbolic *sym;
+    klu_common common;         /* KLU writes its status here: one per thread */
     klu_numeric *num;
     int factored;              /* the last factorisation succeeded */
     double pivot_ratio_factor; /* klu_rcond at the last full klu_factor */
-    int q_parity;              /* parity of KLU's fixed column order */
     int perm_parity;           /* of the row and column orders of KLU's factors */
     unsigned char *seen;       /* [n] permutation parity work */
     int factorizations;        /* full factorisations (every dense-block one) */
@@ -32,7 +41,10 @@ typedef struct linsys {
 /* Analyse the n x n pattern (CSC; kept by reference). method is
  * MECH_LINEAR_AUTO or MECH_LINEAR_KLU. Returns 0, 1 when the pattern is
  * structurally singular, -1 when out of memory or KLU fails. */
-int linsys_init(linsys *ls, int n, int *Ap, int *Ai, int method);
+int linsys_plan_init(linsys_plan *lp, int n, int *Ap, int *Ai, int method);
+void linsys_plan_free(linsys_plan *lp);
+/* Factors and workspace for the plan's pattern: 0, or -1 out of memory. */
+int linsys_init(linsys *ls, const linsys_plan *lp);
 void linsys_free(linsys *ls);
 
 /* Factor the values Ax. Returns 0, or -1 when singular or not finite. */
@@ -55,6 +67,6 @@ int linsys_det_sign(const linsys *ls);
 /* After a failed factorisation: a column with a zero pivot, or -1. */
 int linsys_singular_col(const linsys *ls);
 /* "dense blocks (largest 2x2)" or "KLU". */
-const char *linsys_method_name(const linsys *ls, char *buf, size_t size);
+const char *linsys_method_name(const linsys_plan *lp, char *buf, size_t size);
 
 #endif

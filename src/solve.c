@@ -56,44 +56,44 @@ static double largest_length(const mech_model *m)
 }
 
 /* Unknowns some output (or a branch condition) depends on. */
-static void needed_unknowns(solver *sv, unsigned char *need)
+static void needed_unknowns(solver_plan *sp, unsigned char *need)
 {
-    const mech_model *m = sv->m;
+    const mech_model *m = sp->m;
     const mech_outputs *o = &m->outputs;
-    if (sv->opt.all_blocks || o->forces) {
-        memset(need, 1, (size_t)sv->n);
+    if (sp->opt.all_blocks || o->forces) {
+        memset(need, 1, (size_t)sp->n);
         for (int l = 1; l < m->nlinks; l++)
-            sv->tree.active[l] = 1;
+            sp->tree.active[l] = 1;
         return;
     }
     for (int i = 0; i < o->npoints; i++)
-        kin_need_point(&sv->tree, o->points[i], need);
+        kin_need_point(&sp->tree, o->points[i], need);
     for (int i = 0; i < o->nlinks; i++)
-        kin_need_link(&sv->tree, o->links[i], need);
+        kin_need_link(&sp->tree, o->links[i], need);
     for (int i = 0; i < o->nsliders; i++) {
-        int var = sv->tree.slide_var[o->sliders[i]];
-        if (var >= 0 && var < sv->n)
+        int var = sp->tree.slide_var[o->sliders[i]];
+        if (var >= 0 && var < sp->n)
             need[var] = 1;
     }
     for (int b = 0; b < m->nbranches; b++)
         for (int k = 0; k < 3; k++)
-            kin_need_point(&sv->tree, m->branches[b].point[k], need);
+            kin_need_point(&sp->tree, m->branches[b].point[k], need);
 }
 
 /* Short name of an unknown for messages. */
-static const char *unknown_name(const solver *sv, int var) { return sv->sys->names[var]; }
+static const char *unknown_name(const solver_plan *sp, int var) { return sp->sys->names[var]; }
 
-static void log_blocks(const solver *sv, const int *P, const int *Q, const int *R,
+static void log_blocks(const solver_plan *sp, const int *P, const int *Q, const int *R,
                        const unsigned char *solve_block, const unsigned char *need)
 {
-    FILE *log = sv->opt.log;
+    FILE *log = sp->opt.log;
     fprintf(log, "blocks: %d unknowns in %d blocks of the block triangular form; solving %d\n",
-            sv->n, sv->nblocks, sv->nblocks_solved);
-    for (int b = sv->nblocks - 1; b >= 0; b--) {  /* solution order: last block first */
+            sp->n, sp->nblocks, sp->nblocks_solved);
+    for (int b = sp->nblocks - 1; b >= 0; b--) {  /* solution order: last block first */
         int wanted = 0;
         for (int k = R[b]; k < R[b + 1]; k++)
             wanted |= need[Q[k]];
-        fprintf(log, "  block %d (%d equation%s, loops", sv->nblocks - b, R[b + 1] - R[b],
+        fprintf(log, "  block %d (%d equation%s, loops", sp->nblocks - b, R[b + 1] - R[b],
                 R[b + 1] - R[b] == 1 ? "" : "s");
         int last = -1;
         for (int k = R[b]; k < R[b + 1]; k++)
@@ -101,7 +101,7 @@ static void log_blocks(const solver *sv, const int *P, const int *Q, const int *
                 fprintf(log, " %d", (last = P[k] / 2) + 1);
         fprintf(log, "):");
         for (int k = R[b]; k < R[b + 1]; k++)
-            fprintf(log, " %s", unknown_name(sv, Q[k]));
+            fprintf(log, " %s", unknown_name(sp, Q[k]));
         fprintf(log, " -- %s\n", !solve_block[b] ? "skipped, no output needs it"
                                  : wanted        ? "solved, outputs need it"
                                                  : "solved, a needed block depends on it");
@@ -133,11 +133,11 @@ static int transpose_pattern(const mech_system *s, int n, int **rp, int **rc)
 /* Blocks to solve: those holding a needed unknown, then (the form is upper
  * block triangular, rows of block b only reach columns of blocks >= b)
  * every block reached from a block already chosen. */
-static int choose_blocks(solver *sv, const unsigned char *need, unsigned char *row_on,
+static int choose_blocks(solver_plan *sp, const unsigned char *need, unsigned char *row_on,
                          unsigned char *col_on)
 {
-    const mech_system *s = sv->sys;
-    int n = sv->n, nmatch = 0;
+    const mech_system *s = sp->sys;
+    int n = sp->n, nmatch = 0;
     int *P = xcalloc((size_t)n, sizeof *P), *Q = xcalloc((size_t)n, sizeof *Q);
     int *R = xcalloc((size_t)n + 1, sizeof *R), *W = xcalloc(5 * (size_t)n, sizeof *W);
     int *blk = xcalloc((size_t)n, sizeof *blk);
@@ -146,12 +146,12 @@ static int choose_blocks(solver *sv, const unsigned char *need, unsigned char *r
     if (!P || !Q || !R || !W || !blk || !solve_block)
         goto done;
     double work;
-    sv->nblocks = btf_order(n, s->Jp, s->Ji, 0.0, &work, P, Q, R, &nmatch, W);
+    sp->nblocks = btf_order(n, s->Jp, s->Ji, 0.0, &work, P, Q, R, &nmatch, W);
     if (nmatch < n) {
         status = 1;  /* structurally singular: caller reports */
         goto done;
     }
-    for (int b = 0; b < sv->nblocks; b++)
+    for (int b = 0; b < sp->nblocks; b++)
         for (int k = R[b]; k < R[b + 1]; k++) {
             blk[Q[k]] = b;       /* block of each unknown */
         }
@@ -162,7 +162,7 @@ static int choose_blocks(solver *sv, const unsigned char *need, unsigned char *r
        reach, through the row-wise pattern (the transpose), in O(nnz) */
     if (transpose_pattern(s, n, &rp, &rc) < 0)
         goto done;
-    for (int b = 0; b < sv->nblocks; b++) {
+    for (int b = 0; b < sp->nblocks; b++) {
         if (!solve_block[b])
             continue;
         for (int k = R[b]; k < R[b + 1]; k++) {
@@ -171,15 +171,15 @@ static int choose_blocks(solver *sv, const unsigned char *need, unsigned char *r
                 solve_block[blk[rc[p]]] = 1;
         }
     }
-    sv->nblocks_solved = 0;
-    for (int b = 0; b < sv->nblocks; b++)
+    sp->nblocks_solved = 0;
+    for (int b = 0; b < sp->nblocks; b++)
         if (solve_block[b]) {
-            sv->nblocks_solved++;
+            sp->nblocks_solved++;
             for (int k = R[b]; k < R[b + 1]; k++)
                 col_on[Q[k]] = 1;
         }
-    if (sv->opt.log)
-        log_blocks(sv, P, Q, R, solve_block, need);
+    if (sp->opt.log)
+        log_blocks(sp, P, Q, R, solve_block, need);
     status = 0;
 done:
     free(rp);
@@ -196,18 +196,18 @@ done:
 /* The matrix of the least-squares mode: [I J; J^T 0] of size nr + ns,
  * whose solution [r; dx] minimises |J dx - f| (Gauss-Newton). jpos[2k] and
  * jpos[2k+1] are where J entry k goes (in J and in J^T). */
-static int augmented_pattern(solver *sv, const int *Jp, const int *Ji)
+static int augmented_pattern(solver_plan *sp, const int *Jp, const int *Ji)
 {
-    int nr = sv->nr, ns = sv->ns, nnz = sv->nnzJ, N = nr + ns;
+    int nr = sp->nr, ns = sp->ns, nnz = sp->nnzJ, N = nr + ns;
     int *rp = xcalloc((size_t)nr + 1, sizeof *rp), *fill = xcalloc((size_t)nr + 1, sizeof *fill);
     int *rk = xcalloc((size_t)nnz + 1, sizeof *rk);   /* J entries by row */
     int *colof = xcalloc((size_t)nnz + 1, sizeof *colof);
-    sv->Ap = xcalloc((size_t)N + 1, sizeof *sv->Ap);
-    sv->Ai = xcalloc((size_t)(nr + 2 * nnz) + 1, sizeof *sv->Ai);
-    sv->Ax = xcalloc((size_t)(nr + 2 * nnz) + 1, sizeof *sv->Ax);
-    sv->jpos = xcalloc(2 * (size_t)nnz + 1, sizeof *sv->jpos);
+    sp->Ap = xcalloc((size_t)N + 1, sizeof *sp->Ap);
+    sp->Ai = xcalloc((size_t)(nr + 2 * nnz) + 1, sizeof *sp->Ai);
+    sp->Ax0 = xcalloc((size_t)(nr + 2 * nnz) + 1, sizeof *sp->Ax0);
+    sp->jpos = xcalloc(2 * (size_t)nnz + 1, sizeof *sp->jpos);
     int rc = -1;
-    if (!rp || !fill || !rk || !colof || !sv->Ap || !sv->Ai || !sv->Ax || !sv->jpos)
+    if (!rp || !fill || !rk || !colof || !sp->Ap || !sp->Ai || !sp->Ax0 || !sp->jpos)
         goto done;
     for (int c = 0; c < ns; c++)
         for (int k = Jp[c]; k < Jp[c + 1]; k++)
@@ -221,25 +221,25 @@ static int augmented_pattern(solver *sv, const int *Jp, const int *Ji)
             rk[rp[Ji[k]] + fill[Ji[k]]++] = k;
     int at = 0;
     for (int r = 0; r < nr; r++) {  /* columns of the residual block: I, then J^T */
-        sv->Ap[r] = at;
-        sv->Ai[at] = r;
-        sv->Ax[at++] = 1.0;
+        sp->Ap[r] = at;
+        sp->Ai[at] = r;
+        sp->Ax0[at++] = 1.0;
         for (int p = rp[r]; p < rp[r + 1]; p++) {
             int k = rk[p];
-            sv->jpos[2 * k + 1] = at;
-            sv->Ai[at++] = nr + colof[k];
+            sp->jpos[2 * k + 1] = at;
+            sp->Ai[at++] = nr + colof[k];
         }
     }
     for (int c = 0; c < ns; c++) {  /* columns of the unknowns: J */
-        sv->Ap[nr + c] = at;
+        sp->Ap[nr + c] = at;
         for (int k = Jp[c]; k < Jp[c + 1]; k++) {
-            sv->jpos[2 * k] = at;
-            sv->Ai[at++] = Ji[k];
+            sp->jpos[2 * k] = at;
+            sp->Ai[at++] = Ji[k];
         }
     }
-    sv->Ap[N] = at;
-    sv->N = N;
-    sv->nnz = at;
+    sp->Ap[N] = at;
+    sp->N = N;
+    sp->nnz = at;
     rc = 0;
 done:
     free(rp);
@@ -250,15 +250,15 @@ done:
 }
 
 /* Pattern of the solved rows and columns, and the tape computing them. */
-static int compile_subset(solver *sv, const unsigned char *row_on, const unsigned char *col_on)
+static int compile_subset(solver_plan *sp, const unsigned char *row_on, const unsigned char *col_on)
 {
-    const mech_system *s = sv->sys;
-    int n = sv->n, rows = s->m, ns = 0, nr = 0;
+    const mech_system *s = sp->sys;
+    int n = sp->n, rows = s->m, ns = 0, nr = 0;
     int *rowmap = xcalloc((size_t)rows + 1, sizeof *rowmap);
-    sv->col = xcalloc((size_t)n + 1, sizeof *sv->col);
-    sv->row = xcalloc((size_t)rows + 1, sizeof *sv->row);
+    sp->col = xcalloc((size_t)n + 1, sizeof *sp->col);
+    sp->row = xcalloc((size_t)rows + 1, sizeof *sp->row);
     int *Jp = xcalloc((size_t)n + 1, sizeof *Jp);
-    if (!rowmap || !sv->col || !sv->row || !Jp) {
+    if (!rowmap || !sp->col || !sp->row || !Jp) {
         free(rowmap);
         free(Jp);
         return -1;
@@ -266,66 +266,65 @@ static int compile_subset(solver *sv, const unsigned char *row_on, const unsigne
     for (int r = 0; r < rows; r++) {
         rowmap[r] = row_on[r] ? nr : -1;
         if (row_on[r])
-            sv->row[nr++] = r;
+            sp->row[nr++] = r;
     }
     for (int c = 0; c < n; c++)
         if (col_on[c])
-            sv->col[ns++] = c;
-    sv->ns = ns;
-    sv->nr = nr;
+            sp->col[ns++] = c;
+    sp->ns = ns;
+    sp->nr = nr;
     int nnz = 0;
     for (int k = 0; k < ns; k++)
-        for (int p = s->Jp[sv->col[k]]; p < s->Jp[sv->col[k] + 1]; p++)
+        for (int p = s->Jp[sp->col[k]]; p < s->Jp[sp->col[k] + 1]; p++)
             nnz += rowmap[s->Ji[p]] >= 0;
-    sv->nnzJ = nnz;
+    sp->nnzJ = nnz;
     int *Ji = xcalloc((size_t)nnz + 1, sizeof *Ji);
-    sv->Jv = xcalloc((size_t)nnz + 1, sizeof *sv->Jv);
-    sv->proot = xcalloc((size_t)(nr + nnz) + 1, sizeof *sv->proot);
-    sv->vroot = xcalloc((size_t)nr + 1, sizeof *sv->vroot);
-    sv->aroot = xcalloc((size_t)nr + 1, sizeof *sv->aroot);
-    if (!Ji || !sv->Jv || !sv->proot || !sv->vroot || !sv->aroot) {
+    sp->proot = xcalloc((size_t)(nr + nnz) + 1, sizeof *sp->proot);
+    sp->vroot = xcalloc((size_t)nr + 1, sizeof *sp->vroot);
+    sp->aroot = xcalloc((size_t)nr + 1, sizeof *sp->aroot);
+    if (!Ji || !sp->proot || !sp->vroot || !sp->aroot) {
         free(rowmap);
         free(Jp);
         free(Ji);
         return -1;
     }
     for (int i = 0; i < nr; i++) {
-        sv->proot[i] = s->f[sv->row[i]];
-        sv->vroot[i] = s->vel[sv->row[i]];
-        sv->aroot[i] = s->acc[sv->row[i]];
+        sp->proot[i] = s->f[sp->row[i]];
+        sp->vroot[i] = s->vel[sp->row[i]];
+        sp->aroot[i] = s->acc[sp->row[i]];
     }
     int at = 0;
     for (int k = 0; k < ns; k++) {
         Jp[k] = at;
-        for (int p = s->Jp[sv->col[k]]; p < s->Jp[sv->col[k] + 1]; p++)
+        for (int p = s->Jp[sp->col[k]]; p < s->Jp[sp->col[k] + 1]; p++)
             if (rowmap[s->Ji[p]] >= 0) {
                 Ji[at] = rowmap[s->Ji[p]];
-                sv->proot[nr + at++] = s->Jx[p];
+                sp->proot[nr + at++] = s->Jx[p];
             }
     }
     Jp[ns] = at;
     free(rowmap);
     int rc = 0;
-    if (sv->aug) {
-        rc = augmented_pattern(sv, Jp, Ji);
+    if (sp->aug) {
+        rc = augmented_pattern(sp, Jp, Ji);
         free(Jp);
         free(Ji);
     } else {  /* square: J itself is factored */
-        sv->Ap = Jp;
-        sv->Ai = Ji;
-        sv->Ax = xcalloc((size_t)nnz + 1, sizeof *sv->Ax);
-        sv->N = ns;
-        sv->nnz = nnz;
-        rc = sv->Ax ? 0 : -1;
+        sp->Ap = Jp;
+        sp->Ai = Ji;
+        sp->Ax0 = xcalloc((size_t)nnz + 1, sizeof *sp->Ax0);
+        sp->N = ns;
+        sp->nnz = nnz;
+        rc = sp->Ax0 ? 0 : -1;
     }
     if (rc < 0)
         return -1;
-    const ex *roots[NPHASES] = {sv->proot, sv->vroot, sv->aroot};
+    const ex *roots[NPHASES] = {sp->proot, sp->vroot, sp->aroot};
     int nroots[NPHASES] = {nr + nnz, nr, nr};
     /* dx/dq and d2x/dq2 feed the predictor even for positions only: all three
        phases (two solves with factors already there cost less than the
        Newton iteration a second-order predictor needs) */
-    if (tape_compile(&sv->tp, &sv->sys->ex, SYS_NVARS(n), NPHASES, roots, nroots) < 0)
+    if (tape_compile(&sp->tp, &sp->sys->ex, SYS_NVARS(n), NPHASES, roots, nroots) < 0)
         return -1;
     /* what depends on the driver alone (its sines and cosines, the crank's
        terms) is computed once per position, not per Newton iteration */
@@ -333,31 +332,9 @@ static int compile_subset(solver *sv, const unsigned char *row_on, const unsigne
     if (!invariant)
         return -1;
     invariant[SYS_VAR_Q(n)] = 1;
-    tape_hoist(&sv->tp, PHASE_POSITION, invariant);
+    tape_hoist(&sp->tp, PHASE_POSITION, invariant);
     free(invariant);
-    sv->tape_q = NAN;
     return 0;
-}
-
-static int alloc_state(solver *sv)
-{
-    size_t n1 = (size_t)sv->n + 1, ns = (size_t)sv->ns + 1, nr = (size_t)sv->nr + 1;
-    sv->pos = xcalloc(n1, sizeof *sv->pos);
-    sv->vel = xcalloc(n1, sizeof *sv->vel);
-    sv->acc = xcalloc(n1, sizeof *sv->acc);
-    sv->x = xcalloc(ns, sizeof *sv->x);
-    sv->xq = xcalloc(ns, sizeof *sv->xq);
-    sv->xqq = xcalloc(ns, sizeof *sv->xqq);
-    sv->f = xcalloc(nr, sizeof *sv->f);
-    sv->dx = xcalloc(ns, sizeof *sv->dx);
-    sv->xt = xcalloc(ns, sizeof *sv->xt);
-    sv->ft = xcalloc(nr, sizeof *sv->ft);
-    sv->rhs = xcalloc(nr + ns, sizeof *sv->rhs);
-    sv->cscale = xcalloc(ns, sizeof *sv->cscale);
-    if (!sv->pos || !sv->vel || !sv->acc || !sv->x || !sv->xq || !sv->xqq || !sv->f ||
-        !sv->dx || !sv->xt || !sv->ft || !sv->rhs || !sv->cscale)
-        return -1;
-    return kin_state_init(&sv->ks, sv->m) == MECH_OK ? 0 : -1;
 }
 
 static int level_of(int want)
@@ -369,51 +346,51 @@ static int level_of(int want)
     return MECH_WANT_POSITION;
 }
 
-int solver_init(solver *sv, const mech_model *m, const mech_solve_options *o, mech_diag *d)
+int solver_plan_init(solver_plan *sp, const mech_model *m, const mech_solve_options *o,
+                     mech_diag *d)
 {
-    memset(sv, 0, sizeof *sv);
-    sv->published = -1;
-    sv->m = m;
-    sv->opt = *o;
-    sv->level = level_of(o->want ? o->want : MECH_WANT_ALL);
-    int rc = mech_system_new(m, &sv->sys, d);
+    memset(sp, 0, sizeof *sp);
+    sp->m = m;
+    sp->opt = *o;
+    sp->level = level_of(o->want ? o->want : MECH_WANT_ALL);
+    int rc = mech_system_new(m, &sp->sys, d);
     if (rc != MECH_OK)
         return rc;
-    sv->n = sv->sys->n;
-    sv->lref = largest_length(m);
-    if (!(sv->opt.tol > 0.0))
-        sv->opt.tol = 1e-12;
-    if (!(sv->opt.min_rcond > 0.0))
-        sv->opt.min_rcond = 1e-6;
-    sv->ftol = sv->opt.tol * sv->lref;
-    if (kin_tree_build(&sv->tree, sv->sys) != MECH_OK)
+    sp->n = sp->sys->n;
+    sp->lref = largest_length(m);
+    if (!(sp->opt.tol > 0.0))
+        sp->opt.tol = 1e-12;
+    if (!(sp->opt.min_rcond > 0.0))
+        sp->opt.min_rcond = 1e-6;
+    sp->ftol = sp->opt.tol * sp->lref;
+    if (kin_tree_build(&sp->tree, sp->sys) != MECH_OK)
         return diag_error(d, m->file, (mech_mark){0, 0}, "out of memory"), MECH_ENOMEM;
-    int rows = sv->sys->m;
-    unsigned char *need = xcalloc((size_t)sv->n + 1, 1), *row_on = xcalloc((size_t)rows + 1, 1),
-                  *col_on = xcalloc((size_t)sv->n + 1, 1);
+    int rows = sp->sys->m;
+    unsigned char *need = xcalloc((size_t)sp->n + 1, 1), *row_on = xcalloc((size_t)rows + 1, 1),
+                  *col_on = xcalloc((size_t)sp->n + 1, 1);
     rc = MECH_ENOMEM;
-    sv->aug = rows > sv->n;
+    sp->aug = rows > sp->n;
     if (need && row_on && col_on) {
-        needed_unknowns(sv, need);
+        needed_unknowns(sp, need);
         int b = 0;
-        if (sv->aug) {  /* redundant equations: no square block form; solve everything */
+        if (sp->aug) {  /* redundant equations: no square block form; solve everything */
             memset(row_on, 1, (size_t)rows);
-            memset(col_on, 1, (size_t)sv->n);
+            memset(col_on, 1, (size_t)sp->n);
             for (int l = 1; l < m->nlinks; l++)
-                sv->tree.active[l] = 1;
-            sv->nblocks = sv->nblocks_solved = 1;
-            if (sv->opt.log)
-                fprintf(sv->opt.log, "blocks: %d equations for %d unknowns (redundant "
+                sp->tree.active[l] = 1;
+            sp->nblocks = sp->nblocks_solved = 1;
+            if (sp->opt.log)
+                fprintf(sp->opt.log, "blocks: %d equations for %d unknowns (redundant "
                         "constraints): all solved together, in the least-squares sense\n",
-                        rows, sv->n);
+                        rows, sp->n);
         } else {
-            b = choose_blocks(sv, need, row_on, col_on);
+            b = choose_blocks(sp, need, row_on, col_on);
         }
         if (b > 0)
             rc = diag_error(d, m->file, m->driver.mark,
                             "the loop equations are structurally singular: some unknown "
                             "appears in no equation that could determine it (see 'mech equations')");
-        else if (b == 0 && compile_subset(sv, row_on, col_on) == 0 && alloc_state(sv) == 0)
+        else if (b == 0 && compile_subset(sp, row_on, col_on) == 0)
             rc = MECH_OK;
     }
     free(need);
@@ -423,30 +400,62 @@ int solver_init(solver *sv, const mech_model *m, const mech_solve_options *o, me
         return diag_error(d, m->file, (mech_mark){0, 0}, "out of memory"), MECH_ENOMEM;
     if (rc != MECH_OK)
         return rc;
-    if (sv->ns > 0 && linsys_init(&sv->ls, sv->N, sv->Ap, sv->Ai, sv->opt.linear_solver) != 0)
+    if (sp->ns > 0 && linsys_plan_init(&sp->lp, sp->N, sp->Ap, sp->Ai, sp->opt.linear_solver) != 0)
         return diag_error(d, m->file, (mech_mark){0, 0}, "cannot analyse the Jacobian "
                           "(out of memory)"), MECH_ENOMEM;
-    if (sv->opt.log) {
+    if (sp->opt.log) {
         char method[96];
-        fprintf(sv->opt.log, "linear solves: %s\n",
-                sv->ns > 0 ? linsys_method_name(&sv->ls, method, sizeof method) : "none");
+        fprintf(sp->opt.log, "linear solves: %s\n",
+                sp->ns > 0 ? linsys_method_name(&sp->lp, method, sizeof method) : "none");
     }
     return MECH_OK;
+}
+
+void solver_plan_free(solver_plan *sp)
+{
+    linsys_plan_free(&sp->lp);
+    tape_free(&sp->tp);
+    kin_tree_free(&sp->tree);
+    mech_system_free(&sp->sys);
+    void *blocks[] = {sp->col, sp->row, sp->Ap, sp->Ai, sp->Ax0, sp->jpos, sp->proot,
+                      sp->vroot, sp->aroot};
+    for (size_t i = 0; i < sizeof blocks / sizeof blocks[0]; i++)
+        free(blocks[i]);
+    memset(sp, 0, sizeof *sp);
+}
+
+/* ---- the numeric state ------------------------------------------------- */
+
+int solver_init(solver *sv, const solver_plan *sp)
+{
+    memset(sv, 0, sizeof *sv);
+    sv->p = sp;
+    sv->published = -1;
+    sv->tape_q = NAN;
+    size_t n1 = (size_t)sp->n + 1, ns = (size_t)sp->ns + 1, nr = (size_t)sp->nr + 1;
+    double **arrays[] = {&sv->pos, &sv->vel, &sv->acc, &sv->x, &sv->xq, &sv->xqq, &sv->f,
+                         &sv->ft, &sv->dx, &sv->xt, &sv->rhs, &sv->cscale, &sv->Jv, &sv->Ax};
+    size_t sizes[] = {n1, n1, n1, ns, ns, ns, nr, nr, ns, ns, nr + ns, ns,
+                      (size_t)sp->nnzJ + 1, (size_t)sp->nnz + 1};
+    for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
+        if (!(*arrays[i] = xcalloc(sizes[i], sizeof(double))))
+            return -1;
+    memcpy(sv->Ax, sp->Ax0, (size_t)sp->nnz * sizeof *sv->Ax);
+    if (!(sv->reg = tape_registers_new(&sp->tp)))
+        return -1;
+    if (sp->ns > 0 && linsys_init(&sv->ls, &sp->lp) != 0)
+        return -1;
+    return kin_state_init(&sv->ks, sp->m) == MECH_OK ? 0 : -1;
 }
 
 void solver_free(solver *sv)
 {
     linsys_free(&sv->ls);
-    tape_free(&sv->tp);
     kin_state_free(&sv->ks);
-    kin_tree_free(&sv->tree);
-    mech_system_free(&sv->sys);
-    void *blocks[] = {sv->col, sv->row, sv->Ap, sv->Ai, sv->Ax, sv->Jv, sv->jpos, sv->rhs,
-                      sv->cscale, sv->proot,
-                      sv->vroot, sv->aroot, sv->pos, sv->vel, sv->acc, sv->x, sv->xq,
-                      sv->xqq, sv->f, sv->dx, sv->xt, sv->ft};
-    for (size_t i = 0; i < sizeof blocks / sizeof blocks[0]; i++)
-        free(blocks[i]);
+    double *arrays[] = {sv->reg, sv->pos, sv->vel, sv->acc, sv->x, sv->xq, sv->xqq, sv->f,
+                        sv->ft, sv->dx, sv->xt, sv->rhs, sv->cscale, sv->Jv, sv->Ax};
+    for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
+        free(arrays[i]);
     memset(sv, 0, sizeof *sv);
 }
 
@@ -465,13 +474,13 @@ double vec_norm_inf(const double *v, int n)
 }
 
 /* Size of a change of the unknowns: angles in rad, slides in units of lref. */
-double solver_step_size(const solver *sv, const double *dx)
+double solver_step_size(const solver_plan *sp, const double *dx)
 {
     double r = 0.0;
-    for (int i = 0; i < sv->ns; i++) {
+    for (int i = 0; i < sp->ns; i++) {
         double v = fabs(dx[i]);
-        if (sv->sys->unk_kind[sv->col[i]] == UNK_SLIDE)
-            v /= sv->lref;
+        if (sp->sys->unk_kind[sp->col[i]] == UNK_SLIDE)
+            v /= sp->lref;
         r = v > r || v != v ? v : r;
     }
     return r;
@@ -480,30 +489,33 @@ double solver_step_size(const solver *sv, const double *dx)
 /* f (and the raw Jacobian in Ax) at x, q; returns |f|inf. */
 static double evaluate(solver *sv, const double *x, double q, double *f)
 {
-    tape *t = &sv->tp;
+    const solver_plan *sp = sv->p;
+    const tape *t = &sp->tp;
+    double *reg = sv->reg;
     if (!(q == sv->tape_q)) {
-        tape_set_var(t, SYS_VAR_Q(sv->n), q);
-        tape_run_invariant(t, PHASE_POSITION);
+        tape_set_var(t, reg, SYS_VAR_Q(sp->n), q);
+        tape_run_invariant(t, reg, PHASE_POSITION);
         sv->tape_q = q;
     }
-    for (int i = 0; i < sv->ns; i++)
-        tape_set_var(t, sv->col[i], x[i]);
-    tape_run_variant(t, PHASE_POSITION);
-    for (int i = 0; i < sv->nr; i++)
-        f[i] = tape_value(t, sv->proot[i]);
-    for (int k = 0; k < sv->nnzJ; k++)
-        sv->Jv[k] = tape_value(t, sv->proot[sv->nr + k]);
-    return vec_norm_inf(f, sv->nr);
+    for (int i = 0; i < sp->ns; i++)
+        tape_set_var(t, reg, sp->col[i], x[i]);
+    tape_run_variant(t, reg, PHASE_POSITION);
+    for (int i = 0; i < sp->nr; i++)
+        f[i] = tape_value(t, reg, sp->proot[i]);
+    for (int k = 0; k < sp->nnzJ; k++)
+        sv->Jv[k] = tape_value(t, reg, sp->proot[sp->nr + k]);
+    return vec_norm_inf(f, sp->nr);
 }
 
 /* Scale every column of J to unit largest entry (J C), remembering C, and
  * place the values in the factored matrix (J itself, or [I JC; (JC)^T 0]). */
 static void equilibrate(solver *sv)
 {
-    const int *Jp = sv->aug ? sv->Ap + sv->nr : sv->Ap;  /* column starts of J's entries */
+    const solver_plan *sp = sv->p;
+    const int *Jp = sp->aug ? sp->Ap + sp->nr : sp->Ap;  /* column starts of J's entries */
     int k = 0;
-    for (int c = 0; c < sv->ns; c++) {
-        int len = sv->aug ? Jp[c + 1] - Jp[c] : sv->Ap[c + 1] - sv->Ap[c];
+    for (int c = 0; c < sp->ns; c++) {
+        int len = sp->aug ? Jp[c + 1] - Jp[c] : sp->Ap[c + 1] - sp->Ap[c];
         double big = 0.0;
         for (int p = 0; p < len; p++)
             big = fabs(sv->Jv[k + p]) > big ? fabs(sv->Jv[k + p]) : big;
@@ -511,9 +523,9 @@ static void equilibrate(solver *sv)
         sv->cscale[c] = cs;
         for (int p = 0; p < len; p++, k++) {
             double v = sv->Jv[k] * cs;
-            if (sv->aug) {
-                sv->Ax[sv->jpos[2 * k]] = v;
-                sv->Ax[sv->jpos[2 * k + 1]] = v;
+            if (sp->aug) {
+                sv->Ax[sp->jpos[2 * k]] = v;
+                sv->Ax[sp->jpos[2 * k + 1]] = v;
             } else {
                 sv->Ax[k] = v;
             }
@@ -541,20 +553,22 @@ static double condition(solver *sv)
  * scaling is undone. */
 static void linear_solve(solver *sv, const double *b, double *dx)
 {
+    const solver_plan *sp = sv->p;
     double *w = sv->rhs;
-    memcpy(w, b, (size_t)sv->nr * sizeof *w);
-    for (int i = sv->nr; i < sv->N; i++)
+    memcpy(w, b, (size_t)sp->nr * sizeof *w);
+    for (int i = sp->nr; i < sp->N; i++)
         w[i] = 0.0;
     linsys_solve(&sv->ls, w);
-    const double *y = sv->aug ? w + sv->nr : w;
-    for (int i = 0; i < sv->ns; i++)
+    const double *y = sp->aug ? w + sp->nr : w;
+    for (int i = 0; i < sp->ns; i++)
         dx[i] = y[i] * sv->cscale[i];
 }
 
 step_status solver_newton(solver *sv, double q)
 {
+    const solver_plan *sp = sv->p;
     sv->generation++;  /* x changes: what was published is stale */
-    int ns = sv->ns;
+    int ns = sp->ns;
     sv->iters = 0;
     if (ns == 0) {
         sv->resid = 0.0;
@@ -562,14 +576,14 @@ step_status solver_newton(solver *sv, double q)
         return STEP_OK;
     }
     double r = evaluate(sv, sv->x, q, sv->f), prev_step = INFINITY;
-    int max_iter = sv->opt.max_iter > 0 ? sv->opt.max_iter : 50;
+    int max_iter = sp->opt.max_iter > 0 ? sp->opt.max_iter : 50;
     /* Converged when the correction is below tol/100, or below its
        rounding floor, eps over the whole Jacobian's condition (from the
        previous position). The correction is applied to x (its error is then
        of the order of its square), but the factors, and so the rates, stay
        those of x before it: less than tol/100 away, which moves the rates
        by about that relative to the condition (docs/solver.md, section 2). */
-    double xtol = 1e-2 * sv->opt.tol;
+    double xtol = 1e-2 * sp->opt.tol;
     for (int it = 0;; it++) {
         if (!isfinite(r))
             return STEP_NO_ASSEMBLY;
@@ -578,18 +592,18 @@ step_status solver_newton(solver *sv, double q)
         if (!(sv->rcond > 0.0))  /* the first factorisation: a condition for the floor */
             condition(sv);
         if (it == 0)
-            xtol = fmax(1e-2 * sv->opt.tol, DBL_EPSILON / fmax(sv->rcond_whole, 1e-300));
+            xtol = fmax(1e-2 * sp->opt.tol, DBL_EPSILON / fmax(sv->rcond_whole, 1e-300));
         linear_solve(sv, sv->f, sv->dx);
-        double step = solver_step_size(sv, sv->dx);
+        double step = solver_step_size(sv->p, sv->dx);
         /* converged: residual small, and the step too, or no longer shrinking
            (the rounding floor of an ill-conditioned position) */
-        if (r <= sv->ftol && (step <= xtol || step >= 0.9 * prev_step)) {
+        if (r <= sp->ftol && (step <= xtol || step >= 0.9 * prev_step)) {
             sv->resid = r;
             sv->iters = it;
             if (step <= xtol)  /* a real (not noise) correction: take it */
                 for (int i = 0; i < ns; i++)
                     sv->x[i] -= sv->dx[i];
-            return condition(sv) < sv->opt.min_rcond ? STEP_SINGULAR : STEP_OK;
+            return condition(sv) < sp->opt.min_rcond ? STEP_SINGULAR : STEP_OK;
         }
         if (it == max_iter) {
             sv->resid = r;
@@ -601,12 +615,12 @@ step_status solver_newton(solver *sv, double q)
             for (int i = 0; i < ns; i++)
                 sv->xt[i] = sv->x[i] - lambda * sv->dx[i];
             rt = evaluate(sv, sv->xt, q, sv->ft);
-            if (rt <= r || rt <= sv->ftol || lambda < 1.0 / 1024)
+            if (rt <= r || rt <= sp->ftol || lambda < 1.0 / 1024)
                 break;
             lambda *= 0.5;
         }
         memcpy(sv->x, sv->xt, (size_t)ns * sizeof *sv->x);
-        memcpy(sv->f, sv->ft, (size_t)sv->nr * sizeof *sv->f);
+        memcpy(sv->f, sv->ft, (size_t)sp->nr * sizeof *sv->f);
         r = rt;
         prev_step = lambda == 1.0 ? step : INFINITY;
         sv->iters = it + 1;
@@ -615,34 +629,39 @@ step_status solver_newton(solver *sv, double q)
 
 int solver_det_sign(solver *sv)
 {
+    const solver_plan *sp = sv->p;
     /* the column scaling is positive: the sign is that of the factors */
-    return sv->N == 0 ? 1 : linsys_det_sign(&sv->ls);
+    return sp->N == 0 ? 1 : linsys_det_sign(&sv->ls);
 }
 
 void solver_velocity_rhs(solver *sv, double *out)
 {
-    tape *t = &sv->tp;
-    tape_set_var(t, SYS_VAR_QDOT(sv->n), 1.0);
-    tape_run(t, PHASE_VELOCITY);
-    for (int i = 0; i < sv->nr; i++)
-        out[i] = tape_value(t, sv->vroot[i]);
+    const solver_plan *sp = sv->p;
+    const tape *t = &sp->tp;
+    double *reg = sv->reg;
+    tape_set_var(t, reg, SYS_VAR_QDOT(sp->n), 1.0);
+    tape_run(t, reg, PHASE_VELOCITY);
+    for (int i = 0; i < sp->nr; i++)
+        out[i] = tape_value(t, reg, sp->vroot[i]);
 }
 
 void solver_rates(solver *sv)
 {
+    const solver_plan *sp = sv->p;
     sv->generation++;
-    if (sv->ns == 0)
+    if (sp->ns == 0)
         return;
-    tape *t = &sv->tp;
+    const tape *t = &sp->tp;
+    double *reg = sv->reg;
     /* geometric rates (qdot = 1, qddot = 0); solver_publish scales them */
     solver_velocity_rhs(sv, sv->ft);
     linear_solve(sv, sv->ft, sv->xq);
-    for (int i = 0; i < sv->ns; i++)
-        tape_set_var(t, SYS_VAR_XDOT(sv->n, sv->col[i]), sv->xq[i]);
-    tape_set_var(t, SYS_VAR_QDDOT(sv->n), 0.0);
-    tape_run(t, PHASE_ACCELERATION);
-    for (int i = 0; i < sv->nr; i++)
-        sv->ft[i] = tape_value(t, sv->aroot[i]);
+    for (int i = 0; i < sp->ns; i++)
+        tape_set_var(t, reg, SYS_VAR_XDOT(sp->n, sp->col[i]), sv->xq[i]);
+    tape_set_var(t, reg, SYS_VAR_QDDOT(sp->n), 0.0);
+    tape_run(t, reg, PHASE_ACCELERATION);
+    for (int i = 0; i < sp->nr; i++)
+        sv->ft[i] = tape_value(t, reg, sp->aroot[i]);
     linear_solve(sv, sv->ft, sv->xqq);
 }
 
@@ -650,25 +669,26 @@ void solver_rates(solver *sv)
  * depend on time explicitly). */
 void solver_publish(solver *sv, double q, double qd, double qdd)
 {
+    const solver_plan *sp = sv->p;
     /* the same state published again (the branch check, then the row) */
     if (sv->published == sv->generation && q == sv->pub_q && qd == sv->pub_qd &&
         qdd == sv->pub_qdd)
         return;
     sv->published = sv->generation;
     sv->pub_q = q, sv->pub_qd = qd, sv->pub_qdd = qdd;
-    int n = sv->n;
+    int n = sp->n;
     sv->pos[n] = q;
     sv->vel[n] = qd;
     sv->acc[n] = qdd;
-    for (int i = 0; i < sv->ns; i++) {
-        int c = sv->col[i];
+    for (int i = 0; i < sp->ns; i++) {
+        int c = sp->col[i];
         sv->pos[c] = sv->x[i];
         sv->vel[c] = sv->xq[i] * qd;
         sv->acc[c] = sv->xqq[i] * qd * qd + sv->xq[i] * qdd;
     }
-    kin_update(&sv->tree, &sv->ks, sv->pos,
-               sv->level & MECH_WANT_VELOCITY ? sv->vel : NULL,
-               sv->level & MECH_WANT_ACCELERATION ? sv->acc : NULL);
+    kin_update(&sp->tree, &sv->ks, sv->pos,
+               sp->level & MECH_WANT_VELOCITY ? sv->vel : NULL,
+               sp->level & MECH_WANT_ACCELERATION ? sv->acc : NULL);
 }
 
 

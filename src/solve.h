@@ -1,6 +1,7 @@
-/* src/solve.h: the numerical core shared by the sweep and (later) forces:
- * the subset of unknowns to solve, its KLU factors, and one driver
- * position's Newton solve with velocity and acceleration solves. */
+/* src/solve.h: the numerical core of the sweep and the forces: the plan
+ * (the subset of unknowns to solve, its tape and pattern analysis; built
+ * once, shared) and the state (x, rates, registers, factors; per thread),
+ * with one driver position's Newton solve and its rate solves. */
 #ifndef MECH_SOLVE_H
 #define MECH_SOLVE_H
 
@@ -16,7 +17,9 @@ typedef enum {
     STEP_BRANCH        /* converged on the other side of a declared branch */
 } step_status;
 
-typedef struct solver {
+/* What is fixed for a mechanism and a choice of outputs (built once by
+ * solver_plan_init, then read only: threads share it). */
+typedef struct solver_plan {
     mech_system *sys;          /* owned */
     const mech_model *m;
     mech_solve_options opt;
@@ -34,17 +37,26 @@ typedef struct solver {
     int nblocks, nblocks_solved;
     int N;                     /* order of the factored matrix: ns, or nr + ns */
     int *Ap, *Ai;              /* [N+1], [nnz] pattern of the factored matrix */
-    double *Ax;                /* [nnz] values, columns equilibrated */
+    double *Ax0;               /* [nnz] its constant values (least squares: the identity
+                                  block), the image every state starts from */
     int nnz;
-    double *Jv;                /* [nnzJ] the Jacobian's values, in J's CSC order */
-    int nnzJ;
+    int nnzJ;                  /* nonzeros of the solved part of the Jacobian */
     int *jpos;                 /* [2 nnzJ] least squares: where each J value goes in Ax */
+    tape tp;                   /* evaluator of the solved rows only (no registers) */
+    ex *proot, *vroot, *aroot; /* roots of the three phases */
+    linsys_plan lp;            /* analysis of the factored matrix's pattern */
+    kin_tree tree;             /* link frames: the spanning tree, active links */
+} solver_plan;
+
+/* What changes from one driver position to the next: one per thread. */
+typedef struct solver {
+    const solver_plan *p;      /* borrowed: must outlive the state */
+    double *reg;               /* [p->tp.nreg] the tape's registers */
+    double tape_q;             /* driver position of the registers' invariant part */
+    double *Ax;                /* [nnz] values, columns equilibrated */
+    double *Jv;                /* [nnzJ] the Jacobian's values, in J's CSC order */
     double *rhs;               /* [N] solve work */
     double *cscale;            /* [ns] column scaling of the last factorisation */
-    tape tp;                   /* evaluator of the solved rows only */
-    double tape_q;             /* driver position of the tape's invariant part */
-    ex *proot, *vroot, *aroot; /* roots of the three phases */
-
     linsys ls;                 /* factors of the equilibrated Jacobian */
     double rcond;              /* reciprocal condition at the last converged position
                                   (the worst diagonal block's) */
@@ -62,12 +74,19 @@ typedef struct solver {
     int generation;            /* counts changes of x and its rates */
     int published;             /* generation of the last full publish (-1: none) */
     double pub_q, pub_qd, pub_qdd; /* and its driver state */
-    kin_tree tree;
-    kin_state ks;
+    kin_state ks;              /* link frames at the published position */
 } solver;
 
-int solver_init(solver *sv, const mech_model *m, const mech_solve_options *o, mech_diag *d);
+/* Build the system of a checked model, choose the blocks the outputs need,
+ * compile their tape and analyse their pattern. */
+int solver_plan_init(solver_plan *sp, const mech_model *m, const mech_solve_options *o,
+                     mech_diag *d);
+void solver_plan_free(solver_plan *sp);
+
+/* A numeric state for the plan (allocates everything a step needs). */
+int solver_init(solver *sv, const solver_plan *sp);
 void solver_free(solver *sv);
+
 
 /* Newton from sv->x at driver position q; on STEP_OK the factors are those
  * of the converged Jacobian. */
@@ -89,6 +108,6 @@ void solver_velocity_rhs(solver *sv, double *out);
 /* |v|inf, and the size of a change of the solved unknowns (angles in rad,
  * slides in units of lref). */
 double vec_norm_inf(const double *v, int n);
-double solver_step_size(const solver *sv, const double *dx);
+double solver_step_size(const solver_plan *sp, const double *dx);
 
 #endif

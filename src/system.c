@@ -440,6 +440,8 @@ static int compile(mech_system *s)
     nroots[PHASE_ACCELERATION] = rows;
     int rc = tape_compile(&s->tp, &s->ex, SYS_NVARS(n), NPHASES, roots, nroots);
     free(pos);
+    if (rc == 0 && !(s->reg = tape_registers_new(&s->tp)))
+        rc = -1;
     return rc;
 }
 
@@ -473,6 +475,7 @@ void mech_system_free(mech_system **ps)
     free(s->vel);
     free(s->acc);
     tape_free(&s->tp);
+    free(s->reg);
     free(s);
     *ps = NULL;
 }
@@ -527,35 +530,38 @@ int mech_system_size(const mech_system *s) { return s->n; }
 
 void sys_eval_position(mech_system *s, const double *x, double q, double *f, double *Jx)
 {
-    tape *t = &s->tp;
+    const tape *t = &s->tp;
+    double *reg = s->reg;
     for (int i = 0; i < s->n; i++)
-        tape_set_var(t, i, x[i]);
-    tape_set_var(t, SYS_VAR_Q(s->n), q);
-    tape_run(t, PHASE_POSITION);
+        tape_set_var(t, reg, i, x[i]);
+    tape_set_var(t, reg, SYS_VAR_Q(s->n), q);
+    tape_run(t, reg, PHASE_POSITION);
     for (int r = 0; r < s->m; r++)
-        f[r] = tape_value(t, s->f[r]);
+        f[r] = tape_value(t, reg, s->f[r]);
     if (Jx)
         for (int k = 0; k < s->nnz; k++)
-            Jx[k] = tape_value(t, s->Jx[k]);
+            Jx[k] = tape_value(t, reg, s->Jx[k]);
 }
 
 void sys_eval_velocity_rhs(mech_system *s, double qdot, double *rhs)
 {
-    tape *t = &s->tp;
-    tape_set_var(t, SYS_VAR_QDOT(s->n), qdot);
-    tape_run(t, PHASE_VELOCITY);
+    const tape *t = &s->tp;
+    double *reg = s->reg;
+    tape_set_var(t, reg, SYS_VAR_QDOT(s->n), qdot);
+    tape_run(t, reg, PHASE_VELOCITY);
     for (int r = 0; r < s->m; r++)
-        rhs[r] = tape_value(t, s->vel[r]);
+        rhs[r] = tape_value(t, reg, s->vel[r]);
 }
 
 void sys_eval_accel_rhs(mech_system *s, const double *xdot, double qdot, double qddot, double *rhs)
 {
-    tape *t = &s->tp;
+    const tape *t = &s->tp;
+    double *reg = s->reg;
     for (int i = 0; i < s->n; i++)
-        tape_set_var(t, SYS_VAR_XDOT(s->n, i), xdot[i]);
-    tape_set_var(t, SYS_VAR_QDOT(s->n), qdot);
-    tape_set_var(t, SYS_VAR_QDDOT(s->n), qddot);
-    tape_run(t, PHASE_ACCELERATION);
+        tape_set_var(t, reg, SYS_VAR_XDOT(s->n, i), xdot[i]);
+    tape_set_var(t, reg, SYS_VAR_QDOT(s->n), qdot);
+    tape_set_var(t, reg, SYS_VAR_QDDOT(s->n), qddot);
+    tape_run(t, reg, PHASE_ACCELERATION);
     for (int r = 0; r < s->m; r++)
-        rhs[r] = tape_value(t, s->acc[r]);
+        rhs[r] = tape_value(t, reg, s->acc[r]);
 }

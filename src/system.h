@@ -59,7 +59,10 @@ struct mech_system {
     ex *fq;                    /* [m] df/dq */
     ex *vel;                   /* [m] velocity right-hand side  -df/dq qdot */
     ex *acc;                   /* [m] acceleration right-hand side */
-    tape tp;                   /* compiled evaluator */
+    tape tp;                   /* compiled evaluator of every row */
+    double *reg;               /* [tp.nreg] its registers, for sys_eval_* (so those
+                                  are not for threads sharing the system; the solver
+                                  compiles its own tape and keeps registers per state) */
 };
 
 /* Evaluation through the tape (no allocation). The velocity and

@@ -8,7 +8,7 @@
 
 void tape_free(tape *t)
 {
-    free(t->reg);
+    free(t->reg0);
     free(t->ins);
     free(t->var_reg);
     free(t->node_reg);
@@ -62,7 +62,7 @@ static int emit(tape *t, const expr_ctx *c, ex root, work_stack *st, size_t *cap
         if (n->op == EX_CONST || n->op == EX_VAR) {
             t->node_reg[e] = t->nreg++;
             if (n->op == EX_CONST)
-                t->reg[t->node_reg[e]] = n->value;
+                t->reg0[t->node_reg[e]] = n->value;
             else
                 t->var_reg[n->var] = t->node_reg[e];
             st->n--;
@@ -180,10 +180,10 @@ int tape_compile(tape *t, expr_ctx *c, int nvars, int nphases, const ex *const *
     memset(t, 0, sizeof *t);
     size_t nodes = c->count, cap_ins = 0;
     t->node_reg = xcalloc(nodes, sizeof *t->node_reg);
-    t->reg = xcalloc(nodes, sizeof *t->reg);        /* at most one register per node */
+    t->reg0 = xcalloc(nodes, sizeof *t->reg0);      /* at most one register per node */
     t->var_reg = xcalloc((size_t)nvars, sizeof *t->var_reg);
     work_stack stack = {0};
-    if (!t->node_reg || !t->reg || !t->var_reg || nphases > TAPE_MAX_PHASES)
+    if (!t->node_reg || !t->reg0 || !t->var_reg || nphases > TAPE_MAX_PHASES)
         goto fail;
     for (size_t i = 0; i < nodes; i++)
         t->node_reg[i] = -1;
@@ -210,9 +210,8 @@ fail:
     return -1;
 }
 
-static void run_range(tape *t, int from, int to)
+static void run_range(const tape *t, double *r, int from, int to)
 {
-    double *r = t->reg;
     const tape_ins *ins = t->ins;
     for (int i = from; i < to; i++) {
         const tape_ins *p = &ins[i];
@@ -232,14 +231,25 @@ static void run_range(tape *t, int from, int to)
     }
 }
 
-void tape_run(tape *t, int phase) { run_range(t, t->phase_start[phase], t->phase_start[phase + 1]); }
-
-void tape_run_invariant(tape *t, int phase)
+void tape_run(const tape *t, double *reg, int phase)
 {
-    run_range(t, t->phase_start[phase], t->phase_split[phase]);
+    run_range(t, reg, t->phase_start[phase], t->phase_start[phase + 1]);
 }
 
-void tape_run_variant(tape *t, int phase)
+void tape_run_invariant(const tape *t, double *reg, int phase)
 {
-    run_range(t, t->phase_split[phase], t->phase_start[phase + 1]);
+    run_range(t, reg, t->phase_start[phase], t->phase_split[phase]);
+}
+
+void tape_run_variant(const tape *t, double *reg, int phase)
+{
+    run_range(t, reg, t->phase_split[phase], t->phase_start[phase + 1]);
+}
+
+double *tape_registers_new(const tape *t)
+{
+    double *reg = xcalloc((size_t)t->nreg + 1, sizeof *reg);
+    if (reg && t->nreg > 0)
+        memcpy(reg, t->reg0, (size_t)t->nreg * sizeof *reg);
+    return reg;
 }

@@ -1,7 +1,11 @@
 /* src/tape.h: a flat register program compiled from the expression DAG.
  * Every DAG node needed gets one register; constants are loaded once at
- * compile time, variables are written by the caller, and each instruction
- * computes one node from registers. Evaluation allocates nothing. */
+ * compile time into the register image, variables are written by the
+ * caller, and each instruction computes one node from registers.
+ *
+ * The program is immutable after compilation (and tape_hoist), so threads
+ * share it; each thread runs it on its own register file, a copy of the
+ * image made by tape_registers_new. Evaluation allocates nothing. */
 #ifndef MECH_TAPE_H
 #define MECH_TAPE_H
 
@@ -25,7 +29,7 @@ typedef struct tape_ins {
 enum { TAPE_MAX_PHASES = 4 };
 
 typedef struct tape {
-    double *reg;        /* [nreg] registers */
+    double *reg0;       /* [nreg] register image: the constants, zero elsewhere */
     int nreg;
     tape_ins *ins;      /* [nins] instructions, grouped by phase */
     int nins;
@@ -49,14 +53,19 @@ void tape_free(tape *t);
 void tape_hoist(tape *t, int phase, const unsigned char *invariant);
 /* Run the instructions of one phase; or only its invariant part, or only
  * the rest (valid while the invariant variables have not changed). */
-void tape_run(tape *t, int phase);
-void tape_run_invariant(tape *t, int phase);
-void tape_run_variant(tape *t, int phase);
-static inline double tape_value(const tape *t, ex e) { return t->reg[t->node_reg[e]]; }
-static inline void tape_set_var(tape *t, int var, double v)
+void tape_run(const tape *t, double *reg, int phase);
+void tape_run_invariant(const tape *t, double *reg, int phase);
+void tape_run_variant(const tape *t, double *reg, int phase);
+/* A register file for this tape (the image's copy; free() it), or NULL. */
+double *tape_registers_new(const tape *t);
+static inline double tape_value(const tape *t, const double *reg, ex e)
+{
+    return reg[t->node_reg[e]];
+}
+static inline void tape_set_var(const tape *t, double *reg, int var, double v)
 {
     if (t->var_reg[var] >= 0)
-        t->reg[t->var_reg[var]] = v;
+        reg[t->var_reg[var]] = v;
 }
 
 #endif

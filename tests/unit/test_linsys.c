@@ -191,8 +191,10 @@ static double whole_rcond(const sparse *s)
 
 static void check_method(sparse *s, int method, const char *what)
 {
+    linsys_plan lp;
     linsys ls;
-    cr_assert_eq(linsys_init(&ls, s->n, s->Ap, s->Ai, method), 0, "%s: analysis", what);
+    cr_assert_eq(linsys_plan_init(&lp, s->n, s->Ap, s->Ai, method), 0, "%s: analysis", what);
+    cr_assert_eq(linsys_init(&ls, &lp), 0, "%s: workspace", what);
     cr_assert_eq(linsys_factor(&ls, s->Ax), 0, "%s: factor", what);
     double x[MAXN], b[MAXN], ref[MAXN];
     for (int i = 0; i < s->n; i++)
@@ -215,7 +217,7 @@ static void check_method(sparse *s, int method, const char *what)
     cr_assert_geq(rw, exact_w * (1 - 1e-12), "%s: whole rcond %g below exact %g", what, rw,
                   exact_w);
     cr_assert_leq(rw, 10.0 * exact_w, "%s: whole rcond %g, exact %g", what, rw, exact_w);
-    if (!ls.use_klu) {
+    if (!lp.use_klu) {
         int largest = 0;
         for (int k = 0; k < s->nblocks; k++)
             largest = s->R[k + 1] - s->R[k] > largest ? s->R[k + 1] - s->R[k] : largest;
@@ -225,10 +227,11 @@ static void check_method(sparse *s, int method, const char *what)
         else
             cr_assert(rb >= exact_b * (1 - 1e-12) && rb <= 10.0 * exact_b,
                       "%s: blocks rcond %g, exact %g", what, rb, exact_b);
-        cr_assert_eq(ls.blu.nblocks, s->nblocks, "%s: %d blocks found, %d made", what,
-                     ls.blu.nblocks, s->nblocks);
+        cr_assert_eq(lp.blu.nblocks, s->nblocks, "%s: %d blocks found, %d made", what,
+                     lp.blu.nblocks, s->nblocks);
     }
     linsys_free(&ls);
+    linsys_plan_free(&lp);
 }
 
 Test(linsys, random_block_triangular_matrices)
@@ -254,15 +257,15 @@ Test(linsys, large_block_goes_to_klu)
     static const int sizes[] = {2, BLOCKLU_MAX_BLOCK + 1, 3};
     sparse s;
     make_matrix(&s, sizes, 3);
-    linsys ls;
-    cr_assert_eq(linsys_init(&ls, s.n, s.Ap, s.Ai, MECH_LINEAR_AUTO), 0);
-    cr_assert_eq(ls.use_klu, 1, "a %dx%d block is factored by KLU", BLOCKLU_MAX_BLOCK + 1,
+    linsys_plan lp;
+    cr_assert_eq(linsys_plan_init(&lp, s.n, s.Ap, s.Ai, MECH_LINEAR_AUTO), 0);
+    cr_assert_eq(lp.use_klu, 1, "a %dx%d block is factored by KLU", BLOCKLU_MAX_BLOCK + 1,
                  BLOCKLU_MAX_BLOCK + 1);
-    linsys_free(&ls);
+    linsys_plan_free(&lp);
     check_method(&s, MECH_LINEAR_AUTO, "a large block");
-    blocklu b;
-    cr_assert_eq(blocklu_analyze(&b, s.n, s.Ap, s.Ai, BLOCKLU_MAX_BLOCK), 2);
-    blocklu_free(&b);
+    blocklu_plan bp;
+    cr_assert_eq(blocklu_analyze(&bp, s.n, s.Ap, s.Ai, BLOCKLU_MAX_BLOCK), 2);
+    blocklu_plan_free(&bp);
 }
 
 Test(linsys, singular_and_not_finite)
@@ -283,8 +286,10 @@ Test(linsys, singular_and_not_finite)
     for (int j = 0; j < n; j++)
         for (int p = s.Ap[j]; p < s.Ap[j + 1]; p++)
             s.Ax[p] = s.a[s.Ai[p] * n + j];
+    blocklu_plan bp;
     blocklu b;
-    cr_assert_eq(blocklu_analyze(&b, n, s.Ap, s.Ai, BLOCKLU_MAX_BLOCK), 0);
+    cr_assert_eq(blocklu_analyze(&bp, n, s.Ap, s.Ai, BLOCKLU_MAX_BLOCK), 0);
+    cr_assert_eq(blocklu_init(&b, &bp), 0);
     int rc = blocklu_factor(&b, s.Ax);
     double rb = rc == 0 ? blocklu_rcond(&b) : 0.0;
     note("singular 3x3 block: factor %d, singular column %d (made %d or %d), rcond %g", rc,
@@ -297,18 +302,19 @@ Test(linsys, singular_and_not_finite)
     s.Ax[0] = NAN;
     cr_assert_lt(blocklu_factor(&b, s.Ax), 0, "a NaN entry is refused");
     blocklu_free(&b);
+    blocklu_plan_free(&bp);
 }
 
 Test(linsys, structurally_singular)
 {
     /* 3x3, column 2 empty */
     int Ap[] = {0, 2, 3, 3}, Ai[] = {0, 1, 2};
-    blocklu b;
-    cr_assert_eq(blocklu_analyze(&b, 3, Ap, Ai, BLOCKLU_MAX_BLOCK), 1);
-    blocklu_free(&b);
-    linsys ls;
-    cr_assert_eq(linsys_init(&ls, 3, Ap, Ai, MECH_LINEAR_AUTO), 1);
-    linsys_free(&ls);
+    blocklu_plan bp;
+    cr_assert_eq(blocklu_analyze(&bp, 3, Ap, Ai, BLOCKLU_MAX_BLOCK), 1);
+    blocklu_plan_free(&bp);
+    linsys_plan lp;
+    cr_assert_eq(linsys_plan_init(&lp, 3, Ap, Ai, MECH_LINEAR_AUTO), 1);
+    linsys_plan_free(&lp);
 }
 
 /* Every mechanism gives the same table with dense blocks and with KLU (the

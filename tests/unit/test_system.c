@@ -212,6 +212,7 @@ static void check_hoisted(const char *path)
     mech_system *s = build(m);
     int n = s->n, nv = SYS_NVARS(n);
     tape *t = &s->tp;
+    double *reg = s->reg;
     double *vars = calloc((size_t)nv, sizeof *vars);
     double *whole = calloc((size_t)t->nreg + 1, sizeof *whole);
     unsigned char *inv = calloc((size_t)nv, 1);
@@ -224,20 +225,20 @@ static void check_hoisted(const char *path)
     for (int trial = 0; trial < 5; trial++) {
         random_state(s, mechanism_size(m), vars);
         for (int v = 0; v < nv; v++)
-            tape_set_var(t, v, vars[v]);
-        tape_run_invariant(t, 0);
+            tape_set_var(t, reg, v, vars[v]);
+        tape_run_invariant(t, reg, 0);
         for (int it = 0; it < 3; it++) {  /* Newton iterations: x changes, q does not */
             for (int v = 0; v < n; v++) {
                 vars[v] += 0.01 * (it + 1);
-                tape_set_var(t, v, vars[v]);
+                tape_set_var(t, reg, v, vars[v]);
             }
-            tape_run_variant(t, 0);
-            memcpy(whole, t->reg, (size_t)t->nreg * sizeof *whole);
-            tape_run(t, 0);
+            tape_run_variant(t, reg, 0);
+            memcpy(whole, reg, (size_t)t->nreg * sizeof *whole);
+            tape_run(t, reg, 0);
             for (int r = 0; r < t->nreg; r++)
-                cr_assert(whole[r] == t->reg[r] || (whole[r] != whole[r] && t->reg[r] != t->reg[r]),
+                cr_assert(whole[r] == reg[r] || (whole[r] != whole[r] && reg[r] != reg[r]),
                           "%s: register %d %.17g hoisted, %.17g whole", path, r, whole[r],
-                          t->reg[r]);
+                          reg[r]);
         }
     }
     free(vars);

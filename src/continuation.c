@@ -1,0 +1,306 @@
+/* src/continuation.c: from one driver position to the next
+ * (continuation.h, docs/solver.md): row 0 from the guesses, then predict,
+ * correct by Newton, check, accept or halve the step. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "diagnose.h"
+
+static const double PI = 3.14159265358979323846;
+
+/* Scattered starts tried for the unknowns without a guess at row 0. */
+enum { START_ATTEMPTS = 48 };
+
+/* The file's guess for each unknown (NAN: none), gathered once: looking
+ * the guesses up per unknown would cost O(unknowns x guesses). */
+static int gather_guesses(cont *c)
+{
+    const solver_plan *sp = c->sv.p;
+    const mech_model *m = c->m;
+    c->guess = xcalloc((size_t)sp->n + 1, sizeof *c->guess);
+    if (!c->guess)
+        return -1;
+    for (int i = 0; i < sp->n; i++)
+        c->guess[i] = NAN;
+    for (int g = 0; g < m->nguesses; g++) {
+        const mech_guess *gs = &m->guesses[g];
+        int var = gs->is_slider ? sp->sys->joint_var[gs->index] : sp->sys->link_var[gs->index];
+        if (var >= 0 && var < sp->n)
+            c->guess[var] = gs->value;
+    }
+    return 0;
+}
+
+int cont_init(cont *c, const solver_plan *sp, mech_diag *d, mech_solve_stats *st)
+{
+    memset(c, 0, sizeof *c);
+    c->m = sp->m;
+    c->d = d;
+    c->st = st;
+    c->qd = sp->m->driver.speed;
+    c->qdd = sp->m->driver.accel;
+    if (solver_init(&c->sv, sp) != 0)
+        return -1;
+    size_t ns = (size_t)sp->ns + 1;
+    double **arrays[] = {&c->xc, &c->xqc, &c->xqqc, &c->xqq_prev, &c->xpred,
+                         &c->x0, &c->xq0, &c->xqq0};
+    for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
+        if (!(*arrays[i] = xcalloc(ns, sizeof(double))))
+            return -1;
+    return gather_guesses(c);
+}
+
+void cont_free(cont *c)
+{
+    double *arrays[] = {c->xc, c->xqc, c->xqqc, c->xqq_prev, c->xpred, c->x0,
+                        c->xq0, c->xqq0, c->guess};
+    for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
+        free(arrays[i]);
+    solver_free(&c->sv);
+    memset(c, 0, sizeof *c);
+}
+
+
+/* Taylor: x + h x_q + h^2/2 x_qq + h^3/6 x_qqq, with x_qqq from the last two
+ * x_qq (x_q and x_qq are solved at every position, whatever the output
+ * level: solver_rates). The cubic term makes
+ * the error of a 1-degree step about 1e-8 instead of 1e-6, so that one
+ * Newton correction reaches rounding and the second iteration only
+ * confirms it: two evaluations and factorisations per step instead of three
+ * (docs/solver.md, section 4). */
+static void predict(cont *c, double qn)
+{
+    solver *sv = &c->sv;
+    double h = qn - c->qc, dq = c->qc - c->q_prev;
+    int prev = c->have_prev && dq != 0.0;
+    for (int i = 0; i < sv->p->ns; i++) {
+        double xqqq = prev ? (c->xqqc[i] - c->xqq_prev[i]) / dq : 0.0;
+        c->xpred[i] = c->xc[i] + h * (c->xqc[i] + h * (0.5 * c->xqqc[i] + h * xqqq / 6.0));
+    }
+    memcpy(sv->x, c->xpred, (size_t)sv->p->ns * sizeof *sv->x);
+}
+
+int cont_branches_hold(cont *c, int *which)
+{
+    const mech_model *m = c->m;
+    for (int b = 0; b < m->nbranches; b++) {
+        double p[3][2];
+        for (int k = 0; k < 3; k++)
+            kin_point(&c->sv.p->tree, &c->sv.ks, m->branches[b].point[k], p[k], NULL, NULL);
+        double cross = (p[1][0] - p[0][0]) * (p[2][1] - p[1][1]) -
+                       (p[1][1] - p[0][1]) * (p[2][0] - p[1][0]);
+        if (cross * m->branches[b].sign <= 0.0) {
+            *which = b;
+            return 0;
+        }
+    }
+    return 1;
+}
+
+/* det J changed sign between the base and qn: a singular position was
+ * crossed (a change point); the sweep may have passed to another assembly. */
+static void note_crossing(cont *c, double qn)
+{
+    int sign = solver_det_sign(&c->sv);
+    if (sign != 0 && c->det_sign != 0 && sign != c->det_sign && !c->searching &&
+        c->crossings++ < 10) {
+        char qa[64], qb[64];
+        diag_warning(c->d, c->m->file, c->m->driver.mark,
+                     "between %s = %s and %s the Jacobian's determinant changes sign: the "
+                     "sweep passed a change point, where assembly branches cross, and may "
+                     "continue on the other assembly; declare `branch:` to keep one",
+                     diagnose_driver_word(c->m), diagnose_q_text(c->m, fmin(c->qc, qn), qa, sizeof qa),
+                     diagnose_q_text(c->m, fmax(c->qc, qn), qb, sizeof qb));
+    }
+    if (sign != 0)
+        c->det_sign = sign;
+}
+
+/* Keep the converged x at qn as the new base of the continuation. */
+static void accept(cont *c, double qn)
+{
+    solver *sv = &c->sv;
+    note_crossing(c, qn);
+    size_t bytes = (size_t)sv->p->ns * sizeof(double);
+    memcpy(c->xqq_prev, c->xqqc, bytes);
+    c->q_prev = c->qc;
+    c->have_prev = 1;
+    c->qc = qn;
+    memcpy(c->xc, sv->x, bytes);
+    memcpy(c->xqc, sv->xq, bytes);
+    memcpy(c->xqqc, sv->xqq, bytes);
+}
+
+static void note_stats(cont *c, double q)
+{
+    solver *sv = &c->sv;
+    mech_solve_stats *st = c->st;
+    if (sv->resid > st->worst_residual)
+        st->worst_residual = sv->resid;
+    if (sv->rcond < st->min_rcond) {
+        st->min_rcond = sv->rcond;
+        st->worst_rcond_q = q;
+    }
+}
+
+/* Newton at qn from sv->x, then the checks that make a step acceptable. */
+step_status cont_try(cont *c, double qn, int continuing)
+{
+    solver *sv = &c->sv;
+    step_status s = solver_newton(sv, qn);
+    c->row_iters += sv->iters;
+    if (s != STEP_OK)
+        return s;
+    if (continuing) {
+        /* correction against predicted move: large means another solution */
+        for (int i = 0; i < sv->p->ns; i++)
+            sv->dx[i] = sv->x[i] - c->xpred[i];
+        double corr = solver_step_size(sv->p, sv->dx);
+        for (int i = 0; i < sv->p->ns; i++)
+            sv->dx[i] = c->xpred[i] - c->xc[i];
+        if (corr > 0.5 * solver_step_size(sv->p, sv->dx) + 0.05)
+            return STEP_JUMP;
+    }
+    solver_rates(sv);
+    int b;
+    if (c->m->nbranches) {  /* the branch test needs the point positions */
+        solver_publish(sv, qn, c->qd, c->qdd);  /* the row's own, unless rejected */
+        if (!cont_branches_hold(c, &b))
+            return STEP_BRANCH;
+    }
+    return STEP_OK;
+}
+
+/* From the base c->qc to q by continuation, halving rejected steps. */
+step_status cont_advance(cont *c, double q, double hmin)
+{
+    double h = q - c->qc;
+    step_status s = STEP_OK;
+    c->fail_status = STEP_OK;
+    while (c->qc != q) {
+        double remaining = q - c->qc;
+        double qn = fabs(remaining) <= fabs(h) * (1.0 + 1e-12) ? q : c->qc + h;
+        predict(c, qn);
+        s = cont_try(c, qn, 1);
+        if (s == STEP_OK) {
+            note_stats(c, qn);
+            accept(c, qn);
+            if (c->qc != q)
+                c->row_substeps++;
+            if (fabs(2.0 * h) <= fabs(q - c->qc))
+                h *= 2.0;  /* recover the step after a difficulty */
+            continue;
+        }
+        if (c->fail_status == STEP_OK) {
+            c->fail_resid = vec_norm_inf(c->sv.f, c->sv.p->nr);
+            c->fail_loop = diagnose_worst_loop(&c->sv);
+        }
+        c->fail_q = qn;
+        c->fail_status = s;
+        if (fabs(h) <= hmin)
+            return s;
+        h *= 0.5;
+    }
+    return STEP_OK;
+}
+
+/* ---- row 0 --------------------------------------------------------------- */
+
+static unsigned next_random(unsigned *state)
+{
+    *state = *state * 1664525u + 1013904223u;
+    return *state >> 8;
+}
+
+/* Starting values: the file's guesses; the others 0 on the first attempt,
+ * scattered over a turn (angles) or +-2 lref (slides) later. */
+void cont_start_values(cont *c, int attempt, unsigned *rng)
+{
+    solver *sv = &c->sv;
+    const solver_plan *sp = sv->p;
+    for (int i = 0; i < sp->ns; i++) {
+        int var = sp->col[i];
+        double u = attempt ? (double)(next_random(rng) & 0xffff) / 65536.0 - 0.5 : 0.0;
+        sv->x[i] = sp->sys->unk_kind[var] == UNK_ANGLE ? 2.0 * PI * u : 4.0 * sp->lref * u;
+        if (!isnan(c->guess[var]))
+            sv->x[i] = c->guess[var];
+    }
+}
+
+static int has_unguessed(const cont *c)
+{
+    for (int i = 0; i < c->sv.p->ns; i++)
+        if (isnan(c->guess[c->sv.p->col[i]]))
+            return 1;
+    return 0;
+}
+
+/* Row 0 also fixes the base of the continuation and row 0's copy (for the
+ * assembly search after a failure). */
+int cont_start(cont *c, double q)
+{
+    solver *sv = &c->sv;
+    unsigned rng = 20261121u;
+    int attempts = has_unguessed(c) ? START_ATTEMPTS : 1, branch = -1;
+    step_status s = STEP_NO_ASSEMBLY, first = STEP_OK;
+    double first_resid = 0.0;
+    int first_loop = 0;
+    for (int a = 0; a < attempts; a++) {
+        cont_start_values(c, a, &rng);
+        s = cont_try(c, q, 0);
+        if (a == 0) {
+            first = s;
+            first_resid = sv->resid;
+            first_loop = diagnose_worst_loop(sv);
+        }
+        if (s == STEP_OK)
+            break;
+        if (s == STEP_BRANCH)
+            cont_branches_hold(c, &branch);
+    }
+    if (s != STEP_OK) {
+        diagnose_start(c, q, first, first_resid, first_loop, branch, attempts);
+        return MECH_ESOLVE;
+    }
+    note_stats(c, q);
+    c->qc = q;
+    accept(c, q);
+    c->have_prev = 0;
+    diagnose_redundant(c, q);
+    c->q0 = q;
+    size_t bytes = (size_t)sv->p->ns * sizeof(double);
+    memcpy(c->x0, c->xc, bytes);
+    memcpy(c->xq0, c->xqc, bytes);
+    memcpy(c->xqq0, c->xqqc, bytes);
+    return MECH_OK;
+}
+
+/* Make (q, x, x_q, x_qq) the base of the continuation. */
+void cont_set_base(cont *c, double q, const double *x, const double *xq, const double *xqq)
+{
+    size_t bytes = (size_t)c->sv.p->ns * sizeof(double);
+    memcpy(c->xc, x, bytes);
+    memcpy(c->xqc, xq, bytes);
+    memcpy(c->xqqc, xqq, bytes);
+    c->qc = q;
+    c->have_prev = 0;
+}
+
+/* From the base, march in direction dir by steps h until assembly fails or
+ * `span` is covered; returns the last position reached (a limit when
+ * *found). */
+double cont_march(cont *c, double dir, double h, double span, int *found)
+{
+    double q0 = c->qc;
+    *found = 0;
+    for (double q = q0; fabs(q - q0) < span;) {
+        q += dir * h;
+        if (cont_advance(c, q, 1e-9 * fmax(h, 1e-12)) != STEP_OK) {
+            *found = c->fail_status == STEP_NO_ASSEMBLY || c->fail_status == STEP_SINGULAR;
+            return c->qc;
+        }
+    }
+    return c->qc;
+}
+

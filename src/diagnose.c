@@ -1,0 +1,384 @@
+/* src/diagnose.c: why a position or a sweep failed (diagnose.h): null
+ * vectors of the Jacobian at a singular position, the rank of redundant
+ * equations, and the assembly interval found by marching from row 0. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "diagnose.h"
+
+static const double PI = 3.14159265358979323846;
+
+static int is_angle_driver(const mech_model *m) { return m->driver.kind == MECH_DRIVE_ANGLE; }
+
+/* "123.4 deg" or "0.1834 m": the driver position as users think of it. */
+const char *diagnose_q_text(const mech_model *m, double q, char *buf, size_t size)
+{
+    if (is_angle_driver(m))
+        snprintf(buf, size, "%.6g deg", q * 180.0 / PI);
+    else
+        snprintf(buf, size, "%.6g mm", q * 1e3);
+    return buf;
+}
+
+const char *diagnose_driver_word(const mech_model *m)
+{
+    return is_angle_driver(m) ? "driver angle" : "driver displacement";
+}
+
+/* "loop 2 (A-B-C-D-A)" */
+const char *diagnose_loop_label(const solver *sv, int k, char *buf, size_t size)
+{
+    const mech_model *m = sv->p->m;
+    const loop_set *ls = &sv->p->sys->loops;
+    size_t at = (size_t)snprintf(buf, size, "loop %d (", k + 1);
+    if (ls->from_file && k < m->nloops) {
+        for (int i = 0; i < m->loops[k].npoints && at < size; i++)
+            at += (size_t)snprintf(buf + at, size - at, "%s%s", i ? "-" : "",
+                                   m->point_names[m->loops[k].points[i]]);
+    } else {
+        const char *first = NULL;  /* the point each term starts from */
+        for (int t = ls->start[k]; t < ls->start[k + 1] && at < size; t++) {
+            const loop_term *lt = &ls->terms[t];
+            const char *p;
+            if (lt->kind == TERM_BODY) {
+                p = m->links[lt->link].points[lt->p0].name;
+            } else {
+                const mech_joint *j = &m->joints[lt->joint];
+                int side = lt->sign > 0 ? 1 : 0;  /* + runs guide point -> mover */
+                p = m->links[j->link[side]].points[j->point[side]].name;
+            }
+            first = first ? first : p;
+            at += (size_t)snprintf(buf + at, size - at, "%s-", p);
+        }
+        if (at < size)
+            at += (size_t)snprintf(buf + at, size - at, "%s", first ? first : "?");
+    }
+    if (at < size)
+        snprintf(buf + at, size - at, ")");
+    return buf;
+}
+
+/* The loop that closes worst at the current iterate. */
+int diagnose_worst_loop(const solver *sv)
+{
+    int worst = 0;
+    double big = -1.0;
+    for (int i = 0; i < sv->p->nr; i++)
+        if (fabs(sv->f[i]) > big) {
+            big = fabs(sv->f[i]);
+            worst = sv->p->row[i] / 2;
+        }
+    return worst;
+}
+
+/* Null vectors of the (equilibrated) Jacobian by dense LU with full
+ * pivoting: which unknowns move freely, and which loop equations are
+ * dependent, at a singular position. Small systems only; diagnostics. */
+static int dense_null(const solver *sv, double *right, double *left)
+{
+    int n = sv->p->ns;
+    if (n == 0 || n > 300 || sv->p->aug)  /* the least-squares matrix is not J */
+        return -1;
+    double *a = xcalloc((size_t)n * (size_t)n, sizeof *a);
+    int *pr = xcalloc((size_t)n, sizeof *pr), *pc = xcalloc((size_t)n, sizeof *pc);
+    if (!a || !pr || !pc) {
+        free(a);
+        free(pr);
+        free(pc);
+        return -1;
+    }
+    for (int pass = 0; pass < 2; pass++) {  /* 0: J, 1: J^T */
+        double *out = pass == 0 ? right : left;
+        for (int c = 0; c < n; c++)
+            for (int p = sv->p->Ap[c]; p < sv->p->Ap[c + 1]; p++) {
+                int r = sv->p->Ai[p];
+                if (pass == 0)
+                    a[r * n + c] = sv->Ax[p];
+                else
+                    a[c * n + r] = sv->Ax[p];
+            }
+        for (int i = 0; i < n; i++)
+            pr[i] = pc[i] = i;
+        for (int k = 0; k < n; k++) {
+            int bi = k, bj = k;
+            for (int i = k; i < n; i++)
+                for (int j = k; j < n; j++)
+                    if (fabs(a[pr[i] * n + pc[j]]) > fabs(a[pr[bi] * n + pc[bj]]))
+                        bi = i, bj = j;
+            int t = pr[k]; pr[k] = pr[bi]; pr[bi] = t;
+            t = pc[k]; pc[k] = pc[bj]; pc[bj] = t;
+            double piv = a[pr[k] * n + pc[k]];
+            if (piv == 0.0)
+                continue;
+            for (int i = k + 1; i < n; i++) {
+                double l = a[pr[i] * n + pc[k]] / piv;
+                for (int j = k; j < n; j++)
+                    a[pr[i] * n + pc[j]] -= l * a[pr[k] * n + pc[j]];
+            }
+        }
+        /* U z = 0 with z_last = 1, back substitution, then undo the column order */
+        double *z = out;
+        for (int i = 0; i < n; i++)
+            z[i] = 0.0;
+        z[pc[n - 1]] = 1.0;
+        for (int k = n - 2; k >= 0; k--) {
+            double s = 0.0;
+            for (int j = k + 1; j < n; j++)
+                s += a[pr[k] * n + pc[j]] * z[pc[j]];
+            double piv = a[pr[k] * n + pc[k]];
+            z[pc[k]] = piv != 0.0 ? -s / piv : 0.0;
+        }
+        memset(a, 0, (size_t)n * (size_t)n * sizeof *a);
+    }
+    free(a);
+    free(pr);
+    free(pc);
+    return 0;
+}
+
+/* Append the names of the unknowns (or loops) with a large null-vector
+ * component to buf. */
+static void list_large(const solver *sv, const double *v, int loops, char *buf, size_t size)
+{
+    double big = vec_norm_inf(v, sv->p->ns);
+    size_t at = strlen(buf);
+    int count = 0, last_loop = -1;
+    char lb[256];
+    for (int i = 0; i < sv->p->ns && at < size; i++) {
+        if (!(fabs(v[i]) > 0.05 * big))
+            continue;
+        if (loops) {
+            int k = sv->p->row[i] / 2;
+            if (k == last_loop)
+                continue;
+            last_loop = k;
+            at += (size_t)snprintf(buf + at, size - at, "%s%s", count++ ? ", " : "",
+                                   diagnose_loop_label(sv, k, lb, sizeof lb));
+        } else {  /* the unknown, and where it is: "th_crank (at 0 deg)" */
+            int c = sv->p->col[i];
+            int angle = sv->p->sys->unk_kind[c] == UNK_ANGLE;
+            double val = angle ? remainder(sv->x[i], 2.0 * PI) * 180.0 / PI : sv->x[i] * 1e3;
+            if (fabs(val) < 5e-4)  /* known to about sqrt(eps) at a singular position */
+                val = 0.0;
+            at += (size_t)snprintf(buf + at, size - at, "%s%s (at %.3f %s)", count++ ? ", " : "",
+                                   sv->p->sys->names[c], val, angle ? "deg" : "mm");
+        }
+    }
+}
+
+/* At a singular position, is the driver's column -f_q in the range of J
+ * (w . f_q = 0 for the left null vector w)? Then the solution curve goes on
+ * through the position and another crosses it: a change point. Otherwise
+ * the driver cannot move on: a dead point or limit position. */
+static int is_change_point(solver *sv, const double *left)
+{
+    double *fq = xcalloc((size_t)sv->p->nr + 1, sizeof *fq);
+    if (!fq)
+        return 0;
+    solver_velocity_rhs(sv, fq);
+    double dot = 0.0, nw = 0.0, nf = 0.0;
+    for (int i = 0; i < sv->p->nr; i++) {
+        dot += left[i] * fq[i];
+        nw += left[i] * left[i];
+        nf += fq[i] * fq[i];
+    }
+    free(fq);
+    return nw > 0.0 && nf > 0.0 && fabs(dot) <= 1e-3 * sqrt(nw * nf);
+}
+
+void diagnose_singular(cont *c, double q)
+{
+    solver *sv = &c->sv;
+    char qb[64], what[700] = "";
+    const char *kind = "a dead point, toggle or limit position";
+    double *right = xcalloc((size_t)sv->p->ns + 1, sizeof *right);
+    double *left = xcalloc((size_t)sv->p->nr + 1, sizeof *left);
+    if (right && left && dense_null(sv, right, left) == 0) {
+        if (is_change_point(sv, left))
+            kind = "a change point, where two assembly branches cross";
+        snprintf(what, sizeof what, ": the unknowns ");
+        list_large(sv, right, 0, what, sizeof what);
+        size_t at = strlen(what);
+        snprintf(what + at, sizeof what - at, " are not determined by ");
+        list_large(sv, left, 1, what, sizeof what);
+    } else if (linsys_singular_col(&sv->ls) >= 0 && linsys_singular_col(&sv->ls) < sv->p->ns) {
+        snprintf(what, sizeof what, ": the unknown %s is not determined",
+                 sv->p->sys->names[sv->p->col[linsys_singular_col(&sv->ls)]]);
+    }
+    free(right);
+    free(left);
+    diag_error(c->d, c->m->file, c->m->driver.mark,
+               "singular position at %s = %s (reciprocal condition %.2g, limit %.2g): %s%s; "
+               "velocities there are not unique", diagnose_driver_word(c->m),
+               diagnose_q_text(c->m, q, qb, sizeof qb), sv->rcond, sv->p->opt.min_rcond, kind, what);
+}
+
+/* With redundant constraints (more loop equations than unknowns), say which
+ * equations are implied by the others at the first position: modified
+ * Gram-Schmidt over the rows of J, in order; a row left with less than 1e-8
+ * of its length is redundant. Small systems only (dense). */
+void diagnose_redundant(cont *c, double q)
+{
+    solver *sv = &c->sv;
+    int nr = sv->p->nr, ns = sv->p->ns;
+    if (!sv->p->aug || nr > 400)
+        return;
+    double *a = xcalloc((size_t)nr * (size_t)ns + 1, sizeof *a);
+    if (!a)
+        return;
+    for (int col = 0, k = 0; col < ns; col++)
+        for (int p = sv->p->Ap[nr + col]; p < sv->p->Ap[nr + col + 1]; p++, k++)
+            a[(size_t)sv->p->Ai[p] * ns + col] = sv->Jv[k];
+    char list[600] = "", lb[256], qb[64];
+    size_t at = 0;
+    int count = 0;
+    for (int i = 0; i < nr; i++) {
+        double *ri = a + (size_t)i * ns, len0 = 0.0, len = 0.0;
+        for (int col = 0; col < ns; col++)
+            len0 += ri[col] * ri[col];
+        for (int j = 0; j < i; j++) {
+            double *rj = a + (size_t)j * ns, dot = 0.0, nj = 0.0;
+            for (int col = 0; col < ns; col++)
+                dot += ri[col] * rj[col], nj += rj[col] * rj[col];
+            if (nj > 0.0)
+                for (int col = 0; col < ns; col++)
+                    ri[col] -= dot / nj * rj[col];
+        }
+        for (int col = 0; col < ns; col++)
+            len += ri[col] * ri[col];
+        if (len <= 1e-16 * len0) {
+            for (int col = 0; col < ns; col++)
+                ri[col] = 0.0;
+            if (at < sizeof list)
+                at += (size_t)snprintf(list + at, sizeof list - at, "%s%s equation of %s",
+                                       count++ ? ", " : "", sv->p->row[i] % 2 ? "y" : "x",
+                                       diagnose_loop_label(sv, sv->p->row[i] / 2, lb, sizeof lb));
+        }
+    }
+    free(a);
+    diag_warning(c->d, c->m->file, c->m->driver.mark,
+                 "redundant constraints: at %s = %s the %d loop equations have rank %d; "
+                 "implied by the others: the %s; the mechanism moves because "
+                 "they are consistent, and it is solved in the least-squares sense (joint "
+                 "reactions are not unique)", diagnose_driver_word(c->m),
+                 diagnose_q_text(c->m, q, qb, sizeof qb), nr, nr - count, count ? list : "(none found)");
+}
+
+void diagnose_start(cont *c, double q, step_status first, double resid, int loop, int branch,
+                    int attempts)
+{
+    const mech_model *m = c->m;
+    char qb[64], lb[256];
+    if (branch >= 0) {
+        const mech_branch *b = &m->branches[branch];
+        diag_error(c->d, m->file, b->mark,
+                   "at %s = %s the mechanism assembles, but not with %s-%s-%s turning %s "
+                   "(from the initial guesses%s); check the guesses or the branch",
+                   diagnose_driver_word(m), diagnose_q_text(m, q, qb, sizeof qb),
+                   m->point_names[b->point[0]], m->point_names[b->point[1]],
+                   m->point_names[b->point[2]], b->sign > 0 ? "counter-clockwise" : "clockwise",
+                   attempts > 1 ? " and other starts" : "");
+        return;
+    }
+    if (first == STEP_SINGULAR) {
+        diagnose_singular(c, q);
+        return;
+    }
+    diag_error(c->d, m->file, m->driver.mark,
+               "cannot assemble at %s = %s: %s does not close (residual %.3g m after "
+               "Newton from the initial guesses%s); check the dimensions, or give "
+               "`initial:` guesses near the intended assembly",
+               diagnose_driver_word(m), diagnose_q_text(m, q, qb, sizeof qb),
+               diagnose_loop_label(&c->sv, loop, lb, sizeof lb), resid,
+               attempts > 1 ? " and other starts" : "");
+}
+
+/* ---- failures in the sweep -------------------------------------------- */
+
+static double lower_limit(cont *c, double span, double hrow, int *found)
+{
+    cont_set_base(c, c->q0, c->x0, c->xq0, c->xqq0);
+    return cont_march(c, hrow > 0 ? -1.0 : 1.0, fabs(hrow), span, found);
+}
+
+/* Look for another interval where a crank assembles, in the gap (hi, lo +
+ * 2 pi) left by the one found: Newton from scattered starts every row
+ * spacing; at the first success, march both ways to its limits. Small
+ * systems only (it is a search). Returns 1 with the interval in lo2, hi2. */
+static int other_interval(cont *c, double lo, double hi, double h, double *lo2, double *hi2)
+{
+    solver *sv = &c->sv;
+    if (sv->p->ns > 50 || !(h > 0.0))
+        return 0;
+    unsigned rng = 12345u;
+    for (double q = hi + h; q < lo + 2.0 * PI - 0.5 * h; q += h)
+        for (int a = 1; a <= 8; a++) {
+            cont_start_values(c, a, &rng);
+            if (cont_try(c, q, 0) != STEP_OK)
+                continue;
+            /* save this point: both marches start from it */
+            size_t bytes = (size_t)sv->p->ns * sizeof(double);
+            memcpy(c->x0, sv->x, bytes);
+            memcpy(c->xq0, sv->xq, bytes);
+            memcpy(c->xqq0, sv->xqq, bytes);
+            int f1, f2;
+            cont_set_base(c, q, c->x0, c->xq0, c->xqq0);
+            *hi2 = cont_march(c, 1.0, h, 2.0 * PI, &f1);
+            cont_set_base(c, q, c->x0, c->xq0, c->xqq0);
+            *lo2 = cont_march(c, -1.0, h, 2.0 * PI, &f2);
+            return f1 && f2;
+        }
+    return 0;
+}
+
+void diagnose_failure(cont *c, double q_row, double hrow)
+{
+    const mech_model *m = c->m;
+    solver *sv = &c->sv;
+    char qa[64], qb[64], qc[64], lb[256];
+    double upper = c->qc, fq = c->fail_q;
+    step_status s = c->fail_status;
+    int loop = c->fail_loop;
+    double resid = c->fail_resid;
+    if (s == STEP_SINGULAR) {
+        diagnose_singular(c, fq);
+        return;
+    }
+    if (s == STEP_NO_ASSEMBLY) {
+        c->searching = 1;
+        double span = is_angle_driver(m) ? 2.0 * PI : fabs(q_row - c->q0) * 4.0 + sv->p->lref;
+        int found;
+        double lower = lower_limit(c, span, hrow, &found);
+        double lo = fmin(lower, upper), hi = fmax(lower, upper), lo2, hi2;
+        char more[200] = "", qd[64], qe[64];
+        if (found && is_angle_driver(m) && other_interval(c, lo, hi, fabs(hrow), &lo2, &hi2))
+            snprintf(more, sizeof more, " and from %s to %s", diagnose_q_text(m, lo2, qd, sizeof qd),
+                     diagnose_q_text(m, hi2, qe, sizeof qe));
+        diag_error(c->d, m->file, m->driver.mark,
+                   "cannot assemble at %s = %s: %s does not close (residual %.3g m); the "
+                   "mechanism assembles for %s from %s%s to %s%s (limit positions%s)",
+                   diagnose_driver_word(m), diagnose_q_text(m, q_row, qa, sizeof qa),
+                   diagnose_loop_label(sv, loop, lb, sizeof lb), resid, diagnose_driver_word(m),
+                   found || lo == lower ? "" : "at most ", diagnose_q_text(m, lo, qb, sizeof qb),
+                   diagnose_q_text(m, hi, qc, sizeof qc), more,
+                   found ? "" : "; the other side was not searched past one range");
+        return;
+    }
+    if (s == STEP_JUMP)
+        diag_error(c->d, m->file, m->driver.mark,
+                   "at %s = %s the solution jumps (to another assembly branch, or through a "
+                   "branch point) although the step was refined to %.3g of the row spacing; "
+                   "the sweep stops here rather than switch branches silently",
+                   diagnose_driver_word(m), diagnose_q_text(m, fq, qa, sizeof qa),
+                   fabs(fq - upper) / fmax(fabs(hrow), 1e-300));
+    else if (s == STEP_BRANCH)
+        diag_error(c->d, m->file, m->driver.mark,
+                   "at %s = %s the mechanism leaves the declared assembly branch (a change "
+                   "point, where the branches cross); the sweep stops on the declared branch "
+                   "at %s",
+                   diagnose_driver_word(m), diagnose_q_text(m, fq, qa, sizeof qa), diagnose_q_text(m, upper, qb, sizeof qb));
+    else
+        diag_error(c->d, m->file, (mech_mark){0, 0}, "out of memory");
+}
+
