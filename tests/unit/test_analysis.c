@@ -1,0 +1,117 @@
+/* tests/unit/test_analysis.c: the analysed system (mech_analysis) is read
+ * only once built: threads that solve on one analysis at the same time get
+ * the same tables, bit for bit, as one mech_solve; and a sub-range of the
+ * driver positions gives the rows of the whole sweep. */
+#include <math.h>
+#include <pthread.h>
+
+#include "helpers.h"
+
+enum { REPS = 40 };
+
+typedef struct job {
+    const mech_analysis *a;
+    const mech_table *ref;     /* what every sweep must give */
+    pthread_barrier_t *start;
+    int failed;                /* sweeps that failed or differ from ref */
+    int rc;
+} job;
+
+static int same_values(const mech_table *a, const mech_table *b)
+{
+    size_t n = (size_t)a->nrows * (size_t)a->ncolumns;
+    return a->nrows == b->nrows && a->ncolumns == b->ncolumns &&
+           memcmp(a->values, b->values, n * sizeof(double)) == 0;
+}
+
+/* Many sweeps in a row, started together, so the threads overlap. */
+static void *solve_job(void *arg)
+{
+    job *j = arg;
+    mech_diag d;
+    mech_diag_init(&d);
+    pthread_barrier_wait(j->start);
+    for (int rep = 0; rep < REPS; rep++) {
+        mech_table t = {0};
+        j->rc = mech_analysis_solve(j->a, NULL, 0, &t, NULL, &d);
+        j->failed += j->rc != MECH_OK || !same_values(&t, j->ref);
+        mech_table_free(&t);
+    }
+    mech_diag_free(&d);
+    return NULL;
+}
+
+static void two_threads(const char *path, int forces)
+{
+    mech_model *m = load_path(path);
+    mech_solve_options o;
+    mech_solve_options_default(&o);
+    o.forces = forces;
+    mech_diag d;
+    mech_diag_init(&d);
+    mech_table ref = {0};
+    cr_assert_eq(mech_solve(m, &o, &ref, NULL, &d), MECH_OK, "%s: mech_solve", path);
+    mech_analysis *a = NULL;
+    cr_assert_eq(mech_analysis_new(m, &o, &a, &d), MECH_OK, "%s: analysis", path);
+    cr_assert_eq(mech_analysis_columns(a), ref.ncolumns);
+    pthread_barrier_t start;
+    pthread_barrier_init(&start, NULL, 2);
+    job jobs[2] = {{a, &ref, &start, 0, -1}, {a, &ref, &start, 0, -1}};
+    pthread_t tid[2];
+    for (int k = 0; k < 2; k++)
+        cr_assert_eq(pthread_create(&tid[k], NULL, solve_job, &jobs[k]), 0);
+    for (int k = 0; k < 2; k++)
+        pthread_join(tid[k], NULL);
+    pthread_barrier_destroy(&start);
+    for (int k = 0; k < 2; k++) {
+        cr_assert_eq(jobs[k].rc, MECH_OK, "%s: thread %d", path, k);
+        cr_assert_eq(jobs[k].failed, 0, "%s: thread %d: %d of %d sweeps differ from mech_solve's "
+                     "table", path, k, jobs[k].failed, REPS);
+    }
+    mech_analysis_free(&a);
+    cr_assert_null(a, "mech_analysis_free clears the handle");
+    mech_table_free(&ref);
+    mech_diag_free(&d);
+    mech_model_free(&m);
+}
+
+Test(analysis, two_threads_one_analysis_fourbar) { two_threads("mechanisms/fourbar.yaml", 0); }
+Test(analysis, two_threads_one_analysis_stirling) { two_threads("mechanisms/stirling.yaml", 0); }
+Test(analysis, two_threads_one_analysis_conveyor_forces)
+{
+    two_threads("mechanisms/conveyor.yaml", 1);
+}
+
+/* Positions given by the caller: the second half of the sweep, started
+ * afresh from the guesses, reaches the same rows (to the Newton tolerance:
+ * the first row is found by a different start). */
+Test(analysis, caller_positions_match_the_sweep)
+{
+    mech_model *m = load_path("mechanisms/fourbar.yaml");
+    mech_solve_options o;
+    mech_solve_options_default(&o);
+    mech_diag d;
+    mech_diag_init(&d);
+    mech_analysis *a = NULL;
+    cr_assert_eq(mech_analysis_new(m, &o, &a, &d), MECH_OK);
+    mech_table all = {0}, part = {0};
+    cr_assert_eq(mech_analysis_solve(a, NULL, 0, &all, NULL, &d), MECH_OK);
+    int from = all.nrows / 2, nq = all.nrows - from;
+    double *q = calloc((size_t)nq, sizeof *q);
+    for (int i = 0; i < nq; i++)
+        q[i] = mech_table_get(&all, from + i, 0);
+    cr_assert_eq(mech_analysis_solve(a, q, nq, &part, NULL, &d), MECH_OK);
+    cr_assert_eq(part.nrows, nq);
+    for (int i = 0; i < nq; i++)
+        for (int c = 0; c < all.ncolumns; c++) {
+            double x = mech_table_get(&all, from + i, c), y = mech_table_get(&part, i, c);
+            cr_assert(fabs(x - y) <= 1e-9 * (1.0 + fabs(x)), "row %d column %s: %.17g vs %.17g",
+                      i, all.columns[c].name, x, y);
+        }
+    free(q);
+    mech_table_free(&all);
+    mech_table_free(&part);
+    mech_analysis_free(&a);
+    mech_diag_free(&d);
+    mech_model_free(&m);
+}
