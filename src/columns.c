@@ -11,6 +11,7 @@ void columns_free(column_layout *cl)
     for (int i = 0; i < cl->ncols; i++)
         free(cl->cols[i].name);
     free(cl->cols);
+    free(cl->groups);
     memset(cl, 0, sizeof *cl);
 }
 
@@ -149,6 +150,45 @@ static int dynamic_columns(column_layout *cl, const mech_model *m, const column_
     return rc;
 }
 
+static int same_object(const column_desc *a, const column_desc *b)
+{
+    return a->src == b->src && a->obj == b->obj && a->set == b->set;
+}
+
+/* Values a source gives: a point's motion 6, a link's or slider's 3, a
+ * reaction 4, anything else 1. */
+static int source_width(column_source src)
+{
+    switch (src) {
+    case SRC_POINT: return 6;
+    case SRC_LINK: case SRC_SLIDER: return 3;
+    case SRC_REACTION: return 4;
+    default: return 1;
+    }
+}
+
+/* Runs of columns of one source object, components 0, 1, ... in order. */
+static int make_groups(column_layout *cl)
+{
+    cl->groups = xcalloc((size_t)cl->ncols + 1, sizeof *cl->groups);
+    if (!cl->groups)
+        return -1;
+    column_group *g = NULL;
+    for (int c = 0; c < cl->ncols; c++) {
+        const column_desc *d = &cl->cols[c];
+        if (!g || !same_object(&cl->cols[g->first], d) || d->comp != g->n) {
+            g = &cl->groups[cl->ngroups++];
+            *g = (column_group){d->src, d->obj, d->set, c, 0, 0};
+        }
+        g->n++;
+        g->direct = g->n == source_width(g->src);
+    }
+    for (int k = 0; k < cl->ngroups; k++)
+        if (cl->cols[cl->groups[k].first].comp != 0)
+            return -1;  /* a layout this module did not make */
+    return 0;
+}
+
 int columns_build(column_layout *cl, const mech_model *m, const column_request *rq)
 {
     memset(cl, 0, sizeof *cl);
@@ -160,6 +200,8 @@ int columns_build(column_layout *cl, const mech_model *m, const column_request *
              add(cl, SRC_RESIDUAL, 0, 0, "residual", "", "m") |
              add(cl, SRC_RCOND, 0, 0, "rcond", "", "-") |
              add(cl, SRC_SUBSTEPS, 0, 0, "substeps", "", "-");
+    if (!rc)
+        rc = make_groups(cl);
     if (rc) {
         columns_free(cl);
         return MECH_ENOMEM;
@@ -188,64 +230,55 @@ int columns_make_table(const column_layout *cl, mech_table *t, int nrows)
 
 /* ---- filling a row -------------------------------------------------------- */
 
-static double slider_value(const solver *sv, int joint, int comp)
+static void slider_values(const solver *sv, int joint, double *v)
 {
     int var = sv->p->tree.slide_var[joint];
-    const double *v = comp == 0 ? sv->pos : comp == 1 ? sv->vel : sv->acc;
-    return var >= 0 ? v[var] : 0.0;
+    v[0] = var >= 0 ? sv->pos[var] : 0.0;
+    v[1] = var >= 0 ? sv->vel[var] : 0.0;
+    v[2] = var >= 0 ? sv->acc[var] : 0.0;
 }
 
-/* A joint's reaction (Fx, Fy, F or N, M) of one set, computed once for
- * its columns: the cache remembers the last joint and set. */
-typedef struct reaction_cache {
-    int joint, set;
-    double r[4];
-} reaction_cache;
-
-static double reaction(const row_sources *rs, reaction_cache *rc, int joint, int comp, int set)
+/* A joint's reaction: Fx, Fy, F (revolute: the magnitude) or N, M. */
+static void reaction_values(const row_sources *rs, int joint, int set, double *r)
 {
-    if (joint != rc->joint || set != rc->set) {
-        rc->joint = joint;
-        rc->set = set;
-        forces_joint(rs->fc, rs->sv, joint, set, &rc->r[0], &rc->r[1], &rc->r[2], &rc->r[3]);
-        if (rs->fc->p->m->joints[joint].kind != MECH_JOINT_SLIDER)
-            rc->r[2] = hypot(rc->r[0], rc->r[1]);
-    }
-    return rc->r[comp];
+    forces_joint(rs->fc, rs->sv, joint, set, &r[0], &r[1], &r[2], &r[3]);
+    if (rs->fc->p->m->joints[joint].kind != MECH_JOINT_SLIDER)
+        r[2] = hypot(r[0], r[1]);
 }
 
-/* A point's motion is computed once for its (up to six) columns. */
-void columns_fill(const column_layout *cl, const row_sources *rs, double *row)
+/* Every component of a group's source object into v[0 .. width - 1]. */
+static void source_values(const column_group *g, const row_sources *rs, double *v)
 {
     const solver *sv = rs->sv;
     const kin_state *ks = &sv->ks;
-    double pva[6] = {0};
-    int point = -1;
-    reaction_cache rcache = {-1, -1, {0}};
-    for (int c = 0; c < cl->ncols; c++) {
-        const column_desc *d = &cl->cols[c];
-        double v = 0.0;
-        switch (d->src) {
-        case SRC_DRIVER: v = sv->pos[sv->p->n]; break;
-        case SRC_POINT:
-            if (d->obj != point) {
-                point = d->obj;
-                kin_point(&sv->p->tree, ks, point, pva, pva + 2, pva + 4);
-            }
-            v = pva[d->comp];
-            break;
-        case SRC_LINK: v = (d->comp == 0 ? ks->th : d->comp == 1 ? ks->om : ks->al)[d->obj]; break;
-        case SRC_SLIDER: v = slider_value(sv, d->obj, d->comp); break;
-        case SRC_REACTION: v = reaction(rs, &rcache, d->obj, d->comp, d->set); break;
-        case SRC_DRIVE_LOAD: v = forces_drive(rs->fc, d->set); break;
-        case SRC_POWER_RESIDUAL: v = d->set ? rs->fc->residual : rs->fc->residual0; break;
-        case SRC_FRICTION_POWER: v = rs->fc->friction_power; break;
-        case SRC_FRICTION_ITERATIONS: v = rs->fc->iterations; break;
-        case SRC_ITERATIONS: v = rs->iterations; break;
-        case SRC_RESIDUAL: v = sv->resid; break;
-        case SRC_RCOND: v = sv->rcond; break;
-        case SRC_SUBSTEPS: v = rs->substeps; break;
-        }
-        row[c] = v;
+    switch (g->src) {
+    case SRC_DRIVER: v[0] = sv->pos[sv->p->n]; break;
+    case SRC_POINT: kin_point(&sv->p->tree, ks, g->obj, v, v + 2, v + 4); break;
+    case SRC_LINK:
+        v[0] = ks->th[g->obj];
+        v[1] = ks->om[g->obj];
+        v[2] = ks->al[g->obj];
+        break;
+    case SRC_SLIDER: slider_values(sv, g->obj, v); break;
+    case SRC_REACTION: reaction_values(rs, g->obj, g->set, v); break;
+    case SRC_DRIVE_LOAD: v[0] = forces_drive(rs->fc, g->set); break;
+    case SRC_POWER_RESIDUAL: v[0] = g->set ? rs->fc->residual : rs->fc->residual0; break;
+    case SRC_FRICTION_POWER: v[0] = rs->fc->friction_power; break;
+    case SRC_FRICTION_ITERATIONS: v[0] = rs->fc->iterations; break;
+    case SRC_ITERATIONS: v[0] = rs->iterations; break;
+    case SRC_RESIDUAL: v[0] = sv->resid; break;
+    case SRC_RCOND: v[0] = sv->rcond; break;
+    case SRC_SUBSTEPS: v[0] = rs->substeps; break;
+    }
+}
+
+void columns_fill(const column_layout *cl, const row_sources *rs, double *row)
+{
+    for (int k = 0; k < cl->ngroups; k++) {
+        const column_group *g = &cl->groups[k];
+        double v[6];  /* some components only (positions without rates): copied */
+        source_values(g, rs, g->direct ? row + g->first : v);
+        if (!g->direct)
+            memcpy(row + g->first, v, (size_t)g->n * sizeof *v);
     }
 }

@@ -37,10 +37,24 @@ typedef struct column_desc {
     const char *unit;    /* static */
 } column_desc;
 
+/* Consecutive columns of one source object, filled together: the source
+ * is evaluated once (a point's six motion values, a joint's reaction) and
+ * the wanted components copied. Derived from the descriptors. */
+typedef struct column_group {
+    column_source src;
+    int obj, set;
+    int first;           /* first column */
+    int n;               /* columns: components 0 .. n-1 of the source (the rates come
+                            after the positions, the levels are nested) */
+    int direct;          /* n is every component: the source writes into the row */
+} column_group;
+
 typedef struct column_layout {
     column_desc *cols;   /* [ncols] */
     int ncols;
     int cap;
+    column_group *groups; /* [ngroups] the columns in runs of one source object */
+    int ngroups;
 } column_layout;
 
 /* What a layout must hold. */
