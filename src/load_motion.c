@@ -146,6 +146,9 @@ void load_initial(loader *ld, const ynode *map)
             g->index = li;
             if (load_get_quantity(ld, v, Q_ANGLE, "initial angle", &g->value))
                 m->nguesses++;
+        } else if (ji >= 0 && m->joints[ji].kind == MECH_JOINT_SLIDER && m->has_driver &&
+                   m->driver.kind == MECH_DRIVE_SLIDER && m->driver.index == ji) {
+            load_err(ld, k, "'%s' is the driver; its displacement comes from 'driver'", name);
         } else if (ji >= 0 && m->joints[ji].kind == MECH_JOINT_SLIDER) {
             g->is_slider = 1;
             g->index = ji;

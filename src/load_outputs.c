@@ -34,6 +34,26 @@ static int load_target_link(loader *ld, const ynode *map, int point_id, const yn
     return found;
 }
 
+/* The keys of one kind of load (0 force, 1 torque, 2 distributed) that
+ * belong to another kind are errors, at the key: a torque 'at' a point
+ * would read as if the point mattered. */
+static int keys_apply(loader *ld, const ynode *map, int kind)
+{
+    static const char *const noun[] = {"force", "torque", "distributed load"};
+    static const char *const own[][4] = {{"at", NULL}, {NULL}, {"from", "to", "direction", NULL}};
+    static const char *const others[] = {"at", "from", "to", "direction"};
+    int ok = 1;
+    for (size_t i = 0; i < COUNT(others); i++) {
+        const ynode *k = load_key_of(map, others[i]);
+        int mine = 0;
+        for (int o = 0; own[kind][o]; o++)
+            mine |= strcmp(own[kind][o], others[i]) == 0;
+        if (k && !mine)
+            ok = 0, load_err(ld, k, "'%s' does not apply to a %s", others[i], noun[kind]);
+    }
+    return ok;
+}
+
 static void load_one_load(loader *ld, const ynode *map, mech_load *l)
 {
     static const char *const keys[] = {"force", "torque", "distributed", "link", "at",
@@ -45,6 +65,8 @@ static void load_one_load(loader *ld, const ynode *map, mech_load *l)
     if ((f != NULL) + (t != NULL) + (dl != NULL) != 1)
         return (void)load_err(ld, map, "a load is exactly one of 'force', 'torque' or 'distributed'");
     l->mark = map->mark;
+    if (!keys_apply(ld, map, f ? 0 : t ? 1 : 2))
+        return;
     int ok = 1;
     if (f) {
         l->kind = MECH_LOAD_FORCE;

@@ -872,26 +872,46 @@ Test(load_loads, kinds_and_defaults)
     mech_model_free(&m);
 }
 
-/* A key that belongs to another kind of load is accepted and ignored:
- * {torque: 5, link: crank, at: A} loads the whole crank with 5 N*m and the
- * 'at' says nothing (a reader may think the torque acts at A); a force with
- * 'direction' or 'from' is likewise silent. load.c checks the union of all
- * load keys. Disabled: loader bug (should be "'at' does not apply to a
- * torque"). */
-Test(load_loads, keys_of_another_kind_are_errors, .disabled = true)
+/* A key that belongs to another kind of load is an error, at the key:
+ * {torque: 5, link: crank, at: A} loads the whole crank with 5 N*m, and an
+ * 'at' would let a reader think the torque acts at A; a force with
+ * 'direction' or 'from' likewise. (It used to be accepted and ignored.) */
+Test(load_loads, keys_of_another_kind_are_errors)
 {
-    char yaml[1024];
-    snprintf(yaml, sizeof yaml, "%sloads:\n  - {torque: 5, link: crank, at: A}\n", FOURBAR);
-    mech_diag d;
-    mech_diag_init(&d);
-    load_fails("torque at", yaml, &d);
-    mech_diag_free(&d);
+    static const struct {
+        const char *load, *key, *message;  /* the error is at `key` in the load */
+    } cases[] = {
+        {"{torque: 5, link: crank, at: A}", " at:", "'at' does not apply to a torque"},
+        {"{force: [0, 1], at: A, direction: 90}", " direction:",
+         "'direction' does not apply to a force"},
+        {"{force: [0, 1], at: A, from: A}", " from:", "'from' does not apply to a force"},
+        {"{distributed: 5, link: coupler, from: A, to: B, at: A}", " at:",
+         "'at' does not apply to a distributed load"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        char yaml[1024];
+        snprintf(yaml, sizeof yaml, "%sloads:\n  - %s\n", FOURBAR, cases[i].load);
+        mech_diag d;
+        mech_diag_init(&d);
+        load_fails(cases[i].load, yaml, &d);
+        int k = diag_find(&d, cases[i].message);
+        cr_expect_geq(k, 0, "%s: want '%s', got:%s", cases[i].load, cases[i].message,
+                      diag_text(&d));
+        /* line 9, after the 7 of FOURBAR and 'loads:'; "  - " precedes the load */
+        int col = 4 + (int)(strstr(cases[i].load, cases[i].key) - cases[i].load) + 2;
+        if (k >= 0)
+            cr_expect(d.entries[k].mark.line == 9 && d.entries[k].mark.col == col,
+                      "%s: at %d:%d, want 9:%d", cases[i].load, d.entries[k].mark.line,
+                      d.entries[k].mark.col, col);
+        cr_expect_eq(d.nerrors, 1, "%s: one error:%s", cases[i].load, diag_text(&d));
+        mech_diag_free(&d);
+    }
 }
 
 /* `initial:` rejects a guess for the driving link ("its angle comes from
- * 'driver'") but accepts one for the driving slider, which is then ignored.
- * Disabled: loader bug (load_initial checks only MECH_DRIVE_ANGLE). */
-Test(load_initial, guess_for_the_driving_slider_is_an_error, .disabled = true)
+ * 'driver'") and likewise one for the driving slider (it used to be
+ * accepted and then ignored). */
+Test(load_initial, guess_for_the_driving_slider_is_an_error)
 {
     static const char yaml[] =
         "name: slider-driven\n"
@@ -908,6 +928,13 @@ Test(load_initial, guess_for_the_driving_slider_is_an_error, .disabled = true)
     mech_diag d;
     mech_diag_init(&d);
     load_fails("initial driver slider", yaml, &d);
+    int k = diag_find(&d, "'s_B' is the driver; its displacement comes from 'driver'");
+    cr_expect_geq(k, 0, "got:%s", diag_text(&d));
+    if (k >= 0)
+        cr_expect(d.entries[k].mark.line == 11 && d.entries[k].mark.col == 11,
+                  "at the key 's_B' (11:11), not %d:%d", d.entries[k].mark.line,
+                  d.entries[k].mark.col);
+    cr_expect_eq(d.nerrors, 1, "one error:%s", diag_text(&d));
     mech_diag_free(&d);
 }
 
