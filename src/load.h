@@ -46,6 +46,7 @@ typedef struct loader {
     const mech_override *ov; /* [nov] parameter definitions replaced (mech sweep) */
     int nov;
     unsigned char *ov_used;  /* [nov] the file defines it */
+    int angle_unit_given; /* 'units:' names the angle unit: bare driver angles are meant */
 } loader;
 
 /* Index of a point, link or joint name, or -1. */

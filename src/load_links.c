@@ -46,6 +46,8 @@ void load_units(loader *ld, const ynode *map)
             continue;
         }
         ld->units.scale[q] = scale;
+        if (q == Q_ANGLE)
+            ld->angle_unit_given = 1;
     }
 }
 

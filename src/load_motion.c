@@ -1,5 +1,6 @@
 /* src/load_motion.c: the loader's 'driver' (its link or slider and its
  * range), 'initial' guesses, 'branch' conditions and listed 'loops'. */
+#include <ctype.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -9,6 +10,74 @@
 
 /* ---- driver, guesses, branches, loops ------------------------------ */
 
+/* A driver angle written as bare numbers (no unit, no parameter that could
+ * carry one): radians, which a reader of 'to: 360' rarely means. */
+static int bare_angle(const loader *ld, const ynode *n, double value)
+{
+    if (ld->angle_unit_given || value == 0 || n->kind != YNODE_SCALAR)
+        return 0;  /* 0 is 0 in any unit */
+    for (const char *s = n->text; *s;) {
+        if (isdigit((unsigned char)*s) || *s == '.') {  /* a number: 1.5, 2e-3 */
+            while (isdigit((unsigned char)*s) || *s == '.')
+                s++;
+            if ((*s == 'e' || *s == 'E') &&
+                (isdigit((unsigned char)s[1]) ||
+                 ((s[1] == '+' || s[1] == '-') && isdigit((unsigned char)s[2]))))
+                for (s += 2; isdigit((unsigned char)*s); s++) {}
+            continue;
+        }
+        if (!(isalpha((unsigned char)*s) || *s == '_')) {
+            s++;
+            continue;
+        }
+        size_t len = 0;
+        while (isalnum((unsigned char)s[len]) || s[len] == '_')
+            len++;
+        char word[MAX_NAME + 1];
+        if (len > MAX_NAME)
+            return 0;
+        memcpy(word, s, len);
+        word[len] = '\0';
+        if (unit_is_name(s, len) || name_map_get(&ld->param_map, word) >= 0)
+            return 0;
+        s += len;
+    }
+    return 1;
+}
+
+/* Warn when bare driver angles (radians) span more than a revolution or
+ * step by more than 30 deg: 'to: 360' without 'units: {angle: deg}' is 57
+ * revolutions. `big` is the bare value to quote. */
+static void warn_radians(loader *ld, const ynode *range, const ynode *big, double span,
+                         double step)
+{
+    const double turn = 6.283185307179586, tol = 1 + 1e-4; /* 2 pi; 6.2832 is one turn */
+    if (span <= turn * tol && step <= turn / 12 * tol)
+        return;
+    diag_warning(ld->d, ld->file, range->mark,
+                 "driver angle numbers without a unit are radians: this range spans %.3g "
+                 "revolutions in steps of up to %.3g deg; for degrees write 'units: {angle: "
+                 "deg}' or '%s deg'", span / turn, step * 360 / turn, big->text);
+}
+
+/* The bare-angle check of a list of driver angles. */
+static void check_list_radians(loader *ld, const ynode *n, const mech_driver *dr)
+{
+    const ynode *big = NULL;
+    double lo = dr->values[0], hi = lo, step = 0, top = 0;
+    for (int i = 0; i < dr->nvalues; i++) {
+        const ynode *v = n->kind == YNODE_SCALAR ? n : n->items[i];
+        double x = dr->values[i];
+        if (bare_angle(ld, v, x) && fabs(x) > top)
+            big = v, top = fabs(x);
+        lo = fmin(lo, x);
+        hi = fmax(hi, x);
+        if (i > 0)
+            step = fmax(step, fabs(x - dr->values[i - 1]));
+    }
+    if (big)
+        warn_radians(ld, n, big, hi - lo, step);
+}
 
 static void load_range(loader *ld, const ynode *n, quantity q, mech_driver *dr)
 {
@@ -25,6 +94,8 @@ static void load_range(loader *ld, const ynode *n, quantity q, mech_driver *dr)
             if (load_get_quantity(ld, v, q, what, &dr->values[i]))
                 dr->nvalues++;
         }
+        if (q == Q_ANGLE && dr->nvalues == (int)count)
+            check_list_radians(ld, n, dr);
         return;
     }
     static const char *const keys[] = {"from", "to", "steps"};
@@ -42,6 +113,11 @@ static void load_range(loader *ld, const ynode *n, quantity q, mech_driver *dr)
         return;
     if (!isfinite(b - a))  /* from -1e308 to 1e308: the positions would be inf and NaN */
         return (void)load_err(ld, n, "%s range is too wide (from %g to %g)", what, a, b);
+    int bare_a = q == Q_ANGLE && bare_angle(ld, from, a);
+    int bare_b = q == Q_ANGLE && bare_angle(ld, to, b);
+    if (bare_a || bare_b)
+        warn_radians(ld, n, bare_b && (!bare_a || fabs(b) >= fabs(a)) ? to : from, fabs(b - a),
+                     fabs(b - a) / (double)s);
     dr->values = xcalloc((size_t)s + 1, sizeof *dr->values);
     if (!dr->values)
         return (void)load_err(ld, n, "out of memory");

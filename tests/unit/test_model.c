@@ -724,6 +724,69 @@ Test(load_driver, lists_single_values_and_defaults)
     mech_model_free(&m);
 }
 
+/* Bare driver angles are radians: 'to: 360' without 'units: {angle: deg}'
+ * is 57 revolutions. A warning (the file still loads) at the range when bare
+ * numbers span more than a revolution or step by more than 30 deg; none when
+ * the unit is written, in 'units:' or on the number. */
+Test(load_driver, bare_angles_in_radians_warn)
+{
+    static const char head[] =
+        "name: four-bar\n"
+        "%s"
+        "ground: {O: [0, 0], C: [0.07, 0]}\n"
+        "links:\n"
+        "  crank:   {points: {O: [0, 0], A: [0.02, 0]}}\n"
+        "  coupler: {points: {A: [0, 0], B: [0.06, 0]}}\n"
+        "  rocker:  {points: {C: [0, 0], B: [0.05, 0]}}\n"
+        "parameters: {full: 360 deg}\n"
+        "driver: {link: crank, angle: %s}\n";
+    static const struct {
+        const char *units, *angle, *message;  /* message NULL: no warning */
+    } cases[] = {
+        {"", "{from: 0, to: 360, steps: 360}",
+         "driver angle numbers without a unit are radians: this range spans 57.3 revolutions "
+         "in steps of up to 57.3 deg; for degrees write 'units: {angle: deg}' or '360 deg'"},
+        {"", "{from: 0 deg, to: 720, steps: 720}", "spans 115 revolutions"},
+        {"", "{from: 0, to: 6.2832, steps: 4}", "in steps of up to 90 deg"},
+        {"", "[0, 1, 2]", "this range spans 0.318 revolutions in steps of up to 57.3 deg"},
+        {"", "{from: 0, to: 6.283185307179586, steps: 360}", NULL},
+        {"", "{from: 0, to: 2*pi, steps: 12}", NULL},
+        {"", "{from: 0, to: 360 deg, steps: 360}", NULL},
+        {"", "{from: 0, to: 2*full, steps: 720}", NULL},
+        {"", "[0, 0.1, 0.2]", NULL},
+        {"units: {angle: deg}\n", "{from: 0, to: 360, steps: 360}", NULL},
+        {"units: {angle: rad}\n", "{from: 0, to: 60, steps: 10}", NULL},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        char yaml[1024];
+        snprintf(yaml, sizeof yaml, head, cases[i].units, cases[i].angle);
+        mech_diag d;
+        mech_diag_init(&d);
+        mech_model *m = NULL;
+        int rc = mech_load_string(yaml, strlen(yaml), "bare.yaml", &m, &d);
+        cr_expect_eq(rc, MECH_OK, "%s loads:%s", cases[i].angle, diag_text(&d));
+        if (cases[i].message) {
+            cr_expect_eq(d.count, 1, "%s: one warning:%s", cases[i].angle, diag_text(&d));
+            int k = diag_find(&d, cases[i].message);
+            cr_expect_geq(k, 0, "%s: want '%s':%s", cases[i].angle, cases[i].message,
+                          diag_text(&d));
+            int line = cases[i].units[0] ? 9 : 8;
+            int col = (int)strlen("driver: {link: crank, angle: ") + 1;
+            if (k >= 0)
+                cr_expect(d.entries[k].severity == MECH_SEV_WARNING &&
+                              d.entries[k].mark.line == line && d.entries[k].mark.col == col,
+                          "%s: a warning at %d:%d, got severity %d at %d:%d", cases[i].angle,
+                          line, col, (int)d.entries[k].severity, d.entries[k].mark.line,
+                          d.entries[k].mark.col);
+        } else {
+            cr_expect_eq(d.count, 0, "%s (%s): no warning:%s", cases[i].angle, cases[i].units,
+                         diag_text(&d));
+        }
+        mech_model_free(&m);
+        mech_diag_free(&d);
+    }
+}
+
 Test(load_driver, bad_steps)
 {
     static const char *const bad[] = {"0", "1.5", "1000001", "2*180", "many"};
