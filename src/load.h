@@ -21,6 +21,8 @@ enum {
     MAX_SUGGEST = 1000        /* names searched for a "did you mean" */
 };
 
+enum { LINK_FAILED = 1, LINK_UNPLACED = 2 };  /* bits of loader.link_failed */
+
 typedef struct loader {
     const char *file;
     mech_diag *d;
@@ -32,8 +34,10 @@ typedef struct loader {
     name_map link_map;    /* link name -> index */
     name_map joint_map;   /* joint name -> index */
     /* Follow-on errors are not reported: one mistake, one message. */
-    unsigned char *link_failed; /* [links allocated] errors were reported about the link's
-                                   points or joints: skip checks that would only echo them */
+    unsigned char *link_failed; /* [links allocated] LINK_FAILED: errors were reported about
+                                   the link's points or joints: skip checks that would only
+                                   echo them; LINK_UNPLACED: some point's coordinates could
+                                   not be read (an error elsewhere) and are taken as 0, 0 */
     int links_bad;        /* 'links' missing or unreadable: names of links are not known */
     int points_bad;       /* some link's points unreadable: names of points are not known */
     name_map bad_params;  /* parameters whose definition failed (keys borrowed from the tree) */

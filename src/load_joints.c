@@ -2,6 +2,7 @@
  * sliders), the index of the links carrying each point name, the implicit
  * revolutes of point names shared by links, and the checks that each link
  * has enough points and at most one locked slider. */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -223,7 +224,7 @@ static void load_slider(loader *ld, const ynode *map)
     int first, end;
     load_carriers_of(ld, id, &first, &end);
     for (int c = first; c < end; c++)
-        ld->link_failed[ld->carrier_link[c]] = 1;
+        ld->link_failed[ld->carrier_link[c]] |= LINK_FAILED;
 }
 
 /* Index the links that carry each point name (see load_carriers_of); points are
@@ -385,8 +386,22 @@ done:
     free(parent);
 }
 
-/* Links need two points, unless a slider carries them (a piston block); a
- * link is held by at most one locked slider. One pass over the joints, with
+/* Do all the points of link `l` coincide (within 1e-12 of the link's
+ * largest coordinate, the rounding of polar points)? Then its angle is
+ * undefined. */
+static int points_coincide(const mech_link *l)
+{
+    double scale = 0, spread = 0;
+    for (int i = 0; i < l->npoints; i++) {
+        scale = fmax(scale, fmax(fabs(l->points[i].x), fabs(l->points[i].y)));
+        spread = fmax(spread, fmax(fabs(l->points[i].x - l->points[0].x),
+                                   fabs(l->points[i].y - l->points[0].y)));
+    }
+    return spread <= 1e-12 * scale;
+}
+
+/* Links need two distinct points, unless a slider carries them (a piston
+ * block); a link is held by at most one locked slider. One pass over the joints, with
  * per-link marks, so that many links or sliders stay linear. */
 void load_check_link_points(loader *ld)
 {
@@ -402,7 +417,13 @@ void load_check_link_points(loader *ld)
             slides[m->joints[ji].link[0]] = 1;
     for (int li = 1; li < m->nlinks; li++) {
         const mech_link *l = &m->links[li];
-        if (l->npoints >= 2 || !l->name || ld->link_failed[li] || slides[li])
+        if (!l->name || (ld->link_failed[li] & LINK_FAILED) || slides[li])
+            continue;
+        if (l->npoints >= 2 && !(ld->link_failed[li] & LINK_UNPLACED) && points_coincide(l))
+            diag_error(ld->d, ld->file, l->mark,
+                       "link '%s': all its %d points are at the same place, so its angle is "
+                       "undefined (a link needs two distinct points)", l->name, l->npoints);
+        if (l->npoints >= 2)
             continue;
         diag_error(ld->d, ld->file, l->mark,
                    "link '%s' has %d point%s; a link needs at least two (only a slider "

@@ -251,8 +251,10 @@ static int load_points(loader *ld, mech_link *l, const ynode *map)
         char what[128];
         snprintf(what, sizeof what, "point '%s' of link '%s'", name, l->name);
         mech_point *p = &l->points[l->npoints];
-        if (!load_point_coords(ld, l, &index, v, what, &p->x, &p->y))
+        if (!load_point_coords(ld, l, &index, v, what, &p->x, &p->y)) {
             p->x = p->y = 0;
+            ld->link_failed[l - ld->m->links] |= LINK_UNPLACED;
+        }
         p->name = xstrdup(name);
         p->id = intern_point(ld, name);
         p->mark = k->mark;
@@ -331,7 +333,7 @@ void load_ground(loader *ld, const ynode *map)
     if (map) {
         g->mark = map->mark;
         if (!load_points(ld, g, map))
-            ld->link_failed[0] = 1;
+            ld->link_failed[0] |= LINK_FAILED;
     }
 }
 
@@ -345,7 +347,7 @@ static void load_link(loader *ld, mech_link *l, const ynode *k, const ynode *v)
     snprintf(where, sizeof where, "link '%s'", l->name);
     unsigned char *failed = &ld->link_failed[l - ld->m->links];
     if (v->kind != YNODE_MAP) {
-        *failed = 1;
+        *failed |= LINK_FAILED;
         return (void)load_err(ld, v, "link '%s' must be a mapping with its 'points' (and optionally "
                                      "'mass', 'center', 'inertia', 'symbol'), not %s", l->name,
                               ynode_kind_name(v->kind));
@@ -353,11 +355,11 @@ static void load_link(loader *ld, mech_link *l, const ynode *k, const ynode *v)
     load_check_keys(ld, v, link_keys, COUNT(link_keys), where);
     const ynode *points = ymap_get(v, "points"), *sym = ymap_get(v, "symbol");
     if (!points) {
-        *failed = 1;
+        *failed |= LINK_FAILED;
         if (!load_misspelt(v, "points", link_keys, COUNT(link_keys)))
             load_err(ld, k, "link '%s' has no 'points'", l->name);
     } else if (!load_points(ld, l, points)) {
-        *failed = 1;
+        *failed |= LINK_FAILED;
     }
     if (sym)
         l->symbol = load_get_string(ld, sym, "symbol", 32);
