@@ -246,6 +246,40 @@ void load_initial(loader *ld, const ynode *map)
     }
 }
 
+/* A branch condition whose turn A -> B -> C can never be strictly ccw or cw:
+ * a point named twice, or the three fixed on one link (or the ground) on
+ * one line, coincident points included (cross product 0 within 1e-12 of
+ * the link's size squared). Reported at the condition; returns 0. */
+static int branch_can_turn(loader *ld, const ynode *b, const mech_branch *br)
+{
+    const mech_model *m = ld->m;
+    const int *p = br->point;
+    const char *a = m->point_names[p[0]], *bb = m->point_names[p[1]], *c = m->point_names[p[2]];
+    int twice = p[0] == p[1] || p[0] == p[2] ? p[0] : p[1] == p[2] ? p[1] : -1;
+    if (twice >= 0)
+        return load_err(ld, b, "branch condition [%s, %s, %s] names point '%s' twice, so its "
+                               "turn is never strictly ccw or cw", a, bb, c,
+                        m->point_names[twice]), 0;
+    int first, end;
+    load_carriers_of(ld, p[0], &first, &end);
+    for (int k = first; k < end; k++) {
+        int li = ld->carrier_link[k], i1 = load_point_in_link(ld, li, p[1]),
+            i2 = load_point_in_link(ld, li, p[2]);
+        if (i1 < 0 || i2 < 0 || ld->link_failed[li])
+            continue;
+        const mech_link *l = &m->links[li];
+        const mech_point *q0 = &l->points[ld->carrier_point[k]], *q1 = &l->points[i1],
+                         *q2 = &l->points[i2];
+        double ux = q1->x - q0->x, uy = q1->y - q0->y, vx = q2->x - q1->x, vy = q2->y - q1->y;
+        double size = fmax(fmax(fabs(ux), fabs(uy)), fmax(fabs(vx), fabs(vy)));
+        if (fabs(ux * vy - uy * vx) <= 1e-12 * size * size)  /* (B - A) x (C - B) */
+            return load_err(ld, b, "branch condition [%s, %s, %s]: the three points are fixed "
+                                   "on one line on link '%s', so the turn is never strictly ccw "
+                                   "or cw", a, bb, c, l->name), 0;
+    }
+    return 1;
+}
+
 void load_branches(loader *ld, const ynode *seq)
 {
     mech_model *m = ld->m;
@@ -283,6 +317,8 @@ void load_branches(loader *ld, const ynode *seq)
             br->sign = -1;
         else
             ok = 0, load_err(ld, turn, "'turn' must be 'ccw' (counter-clockwise) or 'cw' (clockwise)");
+        if (ok)
+            ok = branch_can_turn(ld, b, br);
         if (ok)
             m->nbranches++;
     }
