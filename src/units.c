@@ -435,7 +435,7 @@ static qval call_function(qparser *p, const char *name, size_t n, const char *at
 }
 
 /* Index of the parameter named by the n bytes at `name`, or -1. Names are
- * at most 64 bytes (load.c), so a longer word is no parameter. */
+ * at most 64 bytes (load.h), so a longer word is no parameter. */
 static int find_param(const expr_env *env, const char *name, size_t n)
 {
     if (env->param_index) {

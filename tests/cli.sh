@@ -225,4 +225,29 @@ if run "mech sweep unknown parameter" 2 "$MECH" sweep mechanisms/slider-crank.ya
 fi
 run "mech sweep bad range" 2 "$MECH" sweep mechanisms/slider-crank.yaml --vary r=30mm:60:4 && pass
 
+# ---- bare driver angles are radians (issue 16 item 8) -----------------------
+
+cat >"$tmp/rad.yaml" <<'EOF2'
+name: four-bar in radians by mistake
+units: {length: mm}
+ground: {O: [0, 0], C: [70, 0]}
+links:
+  crank:   {points: {O: [0, 0], A: [20, 0]}}
+  coupler: {points: {A: [0, 0], B: [60, 0]}}
+  rocker:  {points: {C: [0, 0], B: [50, 0]}}
+driver: {link: crank, angle: {from: 0, to: 360, steps: 360}}
+EOF2
+rad_warning="rad.yaml:8:30: warning: driver angle numbers without a unit are radians: this range spans 57.3 revolutions in steps of up to 57.3 deg; for degrees write 'units: {angle: deg}' or '360 deg'"
+if run "mech check bare radians" 0 "$MECH" check "$tmp/rad.yaml"; then
+    has_line "$tmp/err" "$rad_warning" "check: bare driver angles warn"
+fi
+if run "mech solve bare radians" 0 "$MECH" solve "$tmp/rad.yaml" -o "$tmp/rad.csv"; then
+    has_line "$tmp/err" "$rad_warning" "solve: bare driver angles warn"
+fi
+for f in mechanisms/*.yaml; do
+    if run "mech check $f" 0 "$MECH" check "$f"; then
+        if grep -q 'warning' "$tmp/err"; then fail "$f: warns: $(head -n 1 "$tmp/err")"; else pass; fi
+    fi
+done
+
 summary

@@ -724,6 +724,69 @@ Test(load_driver, lists_single_values_and_defaults)
     mech_model_free(&m);
 }
 
+/* Bare driver angles are radians: 'to: 360' without 'units: {angle: deg}'
+ * is 57 revolutions. A warning (the file still loads) at the range when bare
+ * numbers span more than a revolution or step by more than 30 deg; none when
+ * the unit is written, in 'units:' or on the number. */
+Test(load_driver, bare_angles_in_radians_warn)
+{
+    static const char head[] =
+        "name: four-bar\n"
+        "%s"
+        "ground: {O: [0, 0], C: [0.07, 0]}\n"
+        "links:\n"
+        "  crank:   {points: {O: [0, 0], A: [0.02, 0]}}\n"
+        "  coupler: {points: {A: [0, 0], B: [0.06, 0]}}\n"
+        "  rocker:  {points: {C: [0, 0], B: [0.05, 0]}}\n"
+        "parameters: {full: 360 deg}\n"
+        "driver: {link: crank, angle: %s}\n";
+    static const struct {
+        const char *units, *angle, *message;  /* message NULL: no warning */
+    } cases[] = {
+        {"", "{from: 0, to: 360, steps: 360}",
+         "driver angle numbers without a unit are radians: this range spans 57.3 revolutions "
+         "in steps of up to 57.3 deg; for degrees write 'units: {angle: deg}' or '360 deg'"},
+        {"", "{from: 0 deg, to: 720, steps: 720}", "spans 115 revolutions"},
+        {"", "{from: 0, to: 6.2832, steps: 4}", "in steps of up to 90 deg"},
+        {"", "[0, 1, 2]", "this range spans 0.318 revolutions in steps of up to 57.3 deg"},
+        {"", "{from: 0, to: 6.283185307179586, steps: 360}", NULL},
+        {"", "{from: 0, to: 2*pi, steps: 12}", NULL},
+        {"", "{from: 0, to: 360 deg, steps: 360}", NULL},
+        {"", "{from: 0, to: 2*full, steps: 720}", NULL},
+        {"", "[0, 0.1, 0.2]", NULL},
+        {"units: {angle: deg}\n", "{from: 0, to: 360, steps: 360}", NULL},
+        {"units: {angle: rad}\n", "{from: 0, to: 60, steps: 10}", NULL},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        char yaml[1024];
+        snprintf(yaml, sizeof yaml, head, cases[i].units, cases[i].angle);
+        mech_diag d;
+        mech_diag_init(&d);
+        mech_model *m = NULL;
+        int rc = mech_load_string(yaml, strlen(yaml), "bare.yaml", &m, &d);
+        cr_expect_eq(rc, MECH_OK, "%s loads:%s", cases[i].angle, diag_text(&d));
+        if (cases[i].message) {
+            cr_expect_eq(d.count, 1, "%s: one warning:%s", cases[i].angle, diag_text(&d));
+            int k = diag_find(&d, cases[i].message);
+            cr_expect_geq(k, 0, "%s: want '%s':%s", cases[i].angle, cases[i].message,
+                          diag_text(&d));
+            int line = cases[i].units[0] ? 9 : 8;
+            int col = (int)strlen("driver: {link: crank, angle: ") + 1;
+            if (k >= 0)
+                cr_expect(d.entries[k].severity == MECH_SEV_WARNING &&
+                              d.entries[k].mark.line == line && d.entries[k].mark.col == col,
+                          "%s: a warning at %d:%d, got severity %d at %d:%d", cases[i].angle,
+                          line, col, (int)d.entries[k].severity, d.entries[k].mark.line,
+                          d.entries[k].mark.col);
+        } else {
+            cr_expect_eq(d.count, 0, "%s (%s): no warning:%s", cases[i].angle, cases[i].units,
+                         diag_text(&d));
+        }
+        mech_model_free(&m);
+        mech_diag_free(&d);
+    }
+}
+
 Test(load_driver, bad_steps)
 {
     static const char *const bad[] = {"0", "1.5", "1000001", "2*180", "many"};
@@ -872,26 +935,46 @@ Test(load_loads, kinds_and_defaults)
     mech_model_free(&m);
 }
 
-/* A key that belongs to another kind of load is accepted and ignored:
- * {torque: 5, link: crank, at: A} loads the whole crank with 5 N*m and the
- * 'at' says nothing (a reader may think the torque acts at A); a force with
- * 'direction' or 'from' is likewise silent. load.c checks the union of all
- * load keys. Disabled: loader bug (should be "'at' does not apply to a
- * torque"). */
-Test(load_loads, keys_of_another_kind_are_errors, .disabled = true)
+/* A key that belongs to another kind of load is an error, at the key:
+ * {torque: 5, link: crank, at: A} loads the whole crank with 5 N*m, and an
+ * 'at' would let a reader think the torque acts at A; a force with
+ * 'direction' or 'from' likewise. (It used to be accepted and ignored.) */
+Test(load_loads, keys_of_another_kind_are_errors)
 {
-    char yaml[1024];
-    snprintf(yaml, sizeof yaml, "%sloads:\n  - {torque: 5, link: crank, at: A}\n", FOURBAR);
-    mech_diag d;
-    mech_diag_init(&d);
-    load_fails("torque at", yaml, &d);
-    mech_diag_free(&d);
+    static const struct {
+        const char *load, *key, *message;  /* the error is at `key` in the load */
+    } cases[] = {
+        {"{torque: 5, link: crank, at: A}", " at:", "'at' does not apply to a torque"},
+        {"{force: [0, 1], at: A, direction: 90}", " direction:",
+         "'direction' does not apply to a force"},
+        {"{force: [0, 1], at: A, from: A}", " from:", "'from' does not apply to a force"},
+        {"{distributed: 5, link: coupler, from: A, to: B, at: A}", " at:",
+         "'at' does not apply to a distributed load"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        char yaml[1024];
+        snprintf(yaml, sizeof yaml, "%sloads:\n  - %s\n", FOURBAR, cases[i].load);
+        mech_diag d;
+        mech_diag_init(&d);
+        load_fails(cases[i].load, yaml, &d);
+        int k = diag_find(&d, cases[i].message);
+        cr_expect_geq(k, 0, "%s: want '%s', got:%s", cases[i].load, cases[i].message,
+                      diag_text(&d));
+        /* line 9, after the 7 of FOURBAR and 'loads:'; "  - " precedes the load */
+        int col = 4 + (int)(strstr(cases[i].load, cases[i].key) - cases[i].load) + 2;
+        if (k >= 0)
+            cr_expect(d.entries[k].mark.line == 9 && d.entries[k].mark.col == col,
+                      "%s: at %d:%d, want 9:%d", cases[i].load, d.entries[k].mark.line,
+                      d.entries[k].mark.col, col);
+        cr_expect_eq(d.nerrors, 1, "%s: one error:%s", cases[i].load, diag_text(&d));
+        mech_diag_free(&d);
+    }
 }
 
 /* `initial:` rejects a guess for the driving link ("its angle comes from
- * 'driver'") but accepts one for the driving slider, which is then ignored.
- * Disabled: loader bug (load_initial checks only MECH_DRIVE_ANGLE). */
-Test(load_initial, guess_for_the_driving_slider_is_an_error, .disabled = true)
+ * 'driver'") and likewise one for the driving slider (it used to be
+ * accepted and then ignored). */
+Test(load_initial, guess_for_the_driving_slider_is_an_error)
 {
     static const char yaml[] =
         "name: slider-driven\n"
@@ -908,6 +991,13 @@ Test(load_initial, guess_for_the_driving_slider_is_an_error, .disabled = true)
     mech_diag d;
     mech_diag_init(&d);
     load_fails("initial driver slider", yaml, &d);
+    int k = diag_find(&d, "'s_B' is the driver; its displacement comes from 'driver'");
+    cr_expect_geq(k, 0, "got:%s", diag_text(&d));
+    if (k >= 0)
+        cr_expect(d.entries[k].mark.line == 11 && d.entries[k].mark.col == 11,
+                  "at the key 's_B' (11:11), not %d:%d", d.entries[k].mark.line,
+                  d.entries[k].mark.col);
+    cr_expect_eq(d.nerrors, 1, "one error:%s", diag_text(&d));
     mech_diag_free(&d);
 }
 
