@@ -18,77 +18,17 @@ static int expr_variable(const expr_ctx *c, ex e)
     return nd->op == EX_VAR ? nd->var : -1;
 }
 
-/* Joints of each link as compressed lists: adj[start[l] .. start[l+1]-1]. */
-static int joint_lists(const mech_model *m, int **start, int **adj)
-{
-    *start = xcalloc((size_t)m->nlinks + 1, sizeof **start);
-    *adj = xcalloc(2 * (size_t)m->njoints + 1, sizeof **adj);
-    int *fill = xcalloc((size_t)m->nlinks + 1, sizeof *fill);
-    if (!*start || !*adj || !fill) {
-        free(fill);
-        return -1;
-    }
-    for (int j = 0; j < m->njoints; j++)
-        for (int side = 0; side < 2; side++)
-            (*start)[m->joints[j].link[side] + 1]++;
-    for (int l = 0; l < m->nlinks; l++)
-        (*start)[l + 1] += (*start)[l];
-    for (int j = 0; j < m->njoints; j++)
-        for (int side = 0; side < 2; side++) {
-            int l = m->joints[j].link[side];
-            (*adj)[(*start)[l] + fill[l]++] = j;
-        }
-    free(fill);
-    return 0;
-}
-
-static int breadth_first(kin_tree *t)
-{
-    const mech_model *m = t->model;
-    int *start, *adj;
-    if (joint_lists(m, &start, &adj) < 0) {
-        free(start);
-        free(adj);
-        return -1;
-    }
-    for (int l = 0; l < m->nlinks; l++) {
-        t->parent_joint[l] = -1;
-        t->parent_link[l] = -1;
-        t->depth[l] = l == 0 ? 0 : -1;
-    }
-    int head = 0, tail = 0, here = 0;  /* t->order is the queue */
-    for (;;) {
-        for (int k = start[here]; k < start[here + 1]; k++) {
-            const mech_joint *jt = &m->joints[adj[k]];
-            int there = jt->link[0] == here ? jt->link[1] : jt->link[0];
-            if (t->depth[there] >= 0)
-                continue;
-            t->depth[there] = t->depth[here] + 1;
-            t->parent_joint[there] = adj[k];
-            t->parent_link[there] = here;
-            t->order[tail++] = there;
-        }
-        if (head == tail)
-            break;
-        here = t->order[head++];
-    }
-    t->norder = tail;
-    free(start);
-    free(adj);
-    return 0;
-}
-
 static void nearest_carriers(kin_tree *t)
 {
     const mech_model *m = t->model;
     for (int p = 0; p < m->npoint_names; p++)
         t->point_link[p] = -1;
     for (int l = 0; l < m->nlinks; l++) {
-        if (t->depth[l] < 0)
+        if (t->span->depth[l] < 0)
             continue;
         for (int i = 0; i < m->links[l].npoints; i++) {
             int id = m->links[l].points[i].id, cur = t->point_link[id];
-            if (cur < 0 || t->depth[l] < t->depth[cur]) {
+            if (cur < 0 || t->span->depth[l] < t->span->depth[cur]) {
                 t->point_link[id] = l;
                 t->point_index[id] = i;
             }
@@ -101,18 +41,15 @@ int kin_tree_build(kin_tree *t, const mech_system *s)
     const mech_model *m = s->model;
     memset(t, 0, sizeof *t);
     t->model = m;
+    t->span = &s->span;
     t->n = s->n;
     size_t nl = (size_t)m->nlinks, nj = (size_t)m->njoints + 1, np = (size_t)m->npoint_names + 1;
-    t->order = xcalloc(nl, sizeof *t->order);
-    t->parent_joint = xcalloc(nl, sizeof *t->parent_joint);
-    t->parent_link = xcalloc(nl, sizeof *t->parent_link);
-    t->depth = xcalloc(nl, sizeof *t->depth);
     t->angle_var = xcalloc(nl, sizeof *t->angle_var);
     t->slide_var = xcalloc(nj, sizeof *t->slide_var);
     t->point_link = xcalloc(np, sizeof *t->point_link);
     t->point_index = xcalloc(np, sizeof *t->point_index);
     t->active = xcalloc(nl, sizeof *t->active);
-    if (!t->order || !t->parent_joint || !t->parent_link || !t->depth || !t->angle_var ||
+    if (!t->angle_var ||
         !t->slide_var || !t->point_link || !t->point_index || !t->active) {
         kin_tree_free(t);
         return MECH_ENOMEM;
@@ -122,20 +59,12 @@ int kin_tree_build(kin_tree *t, const mech_system *s)
     for (int j = 0; j < m->njoints; j++)
         t->slide_var[j] = m->joints[j].kind == MECH_JOINT_SLIDER
                               ? expr_variable(&s->ex, s->slide[j]) : -1;
-    if (breadth_first(t) < 0) {
-        kin_tree_free(t);
-        return MECH_ENOMEM;
-    }
     nearest_carriers(t);
     return MECH_OK;
 }
 
 void kin_tree_free(kin_tree *t)
 {
-    free(t->order);
-    free(t->parent_joint);
-    free(t->parent_link);
-    free(t->depth);
     free(t->angle_var);
     free(t->slide_var);
     free(t->point_link);
@@ -159,14 +88,14 @@ void kin_need_link(kin_tree *t, int link, unsigned char *need)
  * ground and the displacements of the sliders along it. */
 static void need_frame(kin_tree *t, int link, unsigned char *need)
 {
-    for (int l = link; l > 0 && l < t->model->nlinks; l = t->parent_link[l]) {
+    for (int l = link; l > 0 && l < t->model->nlinks; l = t->span->parent_link[l]) {
         t->active[l] = 1;
         need_var(t, t->angle_var[l], need);
-        int j = t->parent_joint[l];
+        int j = t->span->parent_joint[l];
         if (j < 0)
             break;
         need_var(t, t->slide_var[j], need);
-        need_var(t, t->angle_var[t->parent_link[l]], need);
+        need_var(t, t->angle_var[t->span->parent_link[l]], need);
     }
 }
 
@@ -274,7 +203,7 @@ static void place_link(const kin_tree *t, kin_state *st, int l, const double *po
                        const double *vel, const double *acc)
 {
     const mech_model *m = t->model;
-    int j = t->parent_joint[l], pl = t->parent_link[l];
+    int j = t->span->parent_joint[l], pl = t->span->parent_link[l];
     const mech_joint *jt = &m->joints[j];
     double rbuf[2], p[2], v[2], a[2];
     if (jt->kind == MECH_JOINT_REVOLUTE) {
@@ -300,8 +229,8 @@ void kin_update(const kin_tree *t, kin_state *st, const double *pos, const doubl
                 const double *acc)
 {
     /* angles first: a guide's angle may be needed before its frame */
-    for (int k = 0; k < t->norder; k++) {
-        int l = t->order[k], var = t->angle_var[l];
+    for (int k = 0; k < t->span->norder; k++) {
+        int l = t->span->order[k], var = t->angle_var[l];
         double th = var_value(pos, var);
         if (th != st->th[l]) {  /* c, s belong to th: a link that did not turn keeps them */
             st->th[l] = th;
@@ -311,9 +240,9 @@ void kin_update(const kin_tree *t, kin_state *st, const double *pos, const doubl
         st->om[l] = var_value(vel, var);
         st->al[l] = var_value(acc, var);
     }
-    for (int k = 0; k < t->norder; k++)
-        if (t->active[t->order[k]])
-            place_link(t, st, t->order[k], pos, vel, acc);
+    for (int k = 0; k < t->span->norder; k++)
+        if (t->active[t->span->order[k]])
+            place_link(t, st, t->span->order[k], pos, vel, acc);
 }
 
 void kin_point(const kin_tree *t, const kin_state *st, int name_id, double *p, double *v,

@@ -2,8 +2,8 @@
  *
  * The loop equations give link angles and slider displacements; the frame
  * origin of every link follows by walking a spanning tree of the joints
- * from the ground (breadth first, so each point is reached by the shortest
- * chain of links). Velocities and accelerations use the rigid-body and
+ * from the ground (the system's span_tree, breadth first, so each point is
+ * reached by the shortest chain of links). Velocities and accelerations use the rigid-body and
  * sliding-point formulas, exact for the solved rates. */
 #ifndef MECH_KINEMATICS_H
 #define MECH_KINEMATICS_H
@@ -13,11 +13,8 @@
 typedef struct kin_tree {
     const mech_model *model;
     int n;              /* unknowns of the system; variable n is the driver q */
-    int *order;         /* [norder] links in breadth-first order, ground excluded */
-    int norder;
-    int *parent_joint;  /* [nlinks] joint to the parent link (-1: ground, unreachable) */
-    int *parent_link;   /* [nlinks] */
-    int *depth;         /* [nlinks] joints from the ground */
+    const span_tree *span; /* the system's spanning tree (borrowed): frames are placed
+                              in its order, each from its parent */
     int *angle_var;     /* [nlinks] variable of the link angle: -1 zero (ground), 0..n */
     int *slide_var;     /* [njoints] variable of a slider's displacement, else -1 */
     int *point_link;    /* [npoint_names] the carrier link of a point name nearest the ground */

@@ -52,83 +52,12 @@ static int push_crossing(term_buf *b, const mech_joint *j, int ji, int from)
     return push(b, (loop_term){TERM_SLIDE, -1, -1, -1, ji, from == j->link[1] ? +1 : -1});
 }
 
-/* ---- automatic: cycle basis from a BFS spanning tree ---------------- */
-
-typedef struct graph {
-    int *adj_start;  /* [nlinks+1] */
-    int *adj;        /* [2 njoints] joint indices incident to each link */
-    int *parent;     /* [nlinks] link's parent in the tree, -1 at the root */
-    int *pjoint;     /* [nlinks] joint to the parent */
-    int *depth;      /* [nlinks] */
-    char *tree;      /* [njoints] 1 if the joint is a tree edge */
-} graph;
-
-static void graph_free(graph *g)
-{
-    free(g->adj_start);
-    free(g->adj);
-    free(g->parent);
-    free(g->pjoint);
-    free(g->depth);
-    free(g->tree);
-}
-
-static int graph_build(const mech_model *m, graph *g)
-{
-    int nl = m->nlinks, nj = m->njoints;
-    g->adj_start = xcalloc((size_t)nl + 1, sizeof *g->adj_start);
-    g->adj = xcalloc(2 * (size_t)nj, sizeof *g->adj);
-    g->parent = xcalloc((size_t)nl, sizeof *g->parent);
-    g->pjoint = xcalloc((size_t)nl, sizeof *g->pjoint);
-    g->depth = xcalloc((size_t)nl, sizeof *g->depth);
-    g->tree = xcalloc((size_t)nj, 1);
-    int *queue = xcalloc((size_t)nl, sizeof *queue), *fill = xcalloc((size_t)nl, sizeof *fill);
-    if (!g->adj_start || !g->adj || !g->parent || !g->pjoint || !g->depth || !g->tree || !queue ||
-        !fill) {
-        free(queue);
-        free(fill);
-        return -1;
-    }
-    for (int j = 0; j < nj; j++) {
-        g->adj_start[m->joints[j].link[0] + 1]++;
-        g->adj_start[m->joints[j].link[1] + 1]++;
-    }
-    for (int l = 0; l < nl; l++)
-        g->adj_start[l + 1] += g->adj_start[l];
-    for (int j = 0; j < nj; j++)
-        for (int k = 0; k < 2; k++) {
-            int l = m->joints[j].link[k];
-            g->adj[g->adj_start[l] + fill[l]++] = j;
-        }
-    for (int l = 0; l < nl; l++)
-        g->parent[l] = -2;  /* unvisited */
-    int head = 0, tail = 0;
-    queue[tail++] = 0;
-    g->parent[0] = -1;
-    g->pjoint[0] = -1;
-    while (head < tail) {
-        int l = queue[head++];
-        for (int k = g->adj_start[l]; k < g->adj_start[l + 1]; k++) {
-            const mech_joint *j = &m->joints[g->adj[k]];
-            int other = j->link[0] == l ? j->link[1] : j->link[0];
-            if (g->parent[other] != -2)
-                continue;
-            g->parent[other] = l;
-            g->pjoint[other] = g->adj[k];
-            g->depth[other] = g->depth[l] + 1;
-            g->tree[g->adj[k]] = 1;
-            queue[tail++] = other;
-        }
-    }
-    free(queue);
-    free(fill);
-    return 0;
-}
+/* ---- automatic: cycle basis from the BFS spanning tree (spantree.c) --- */
 
 /* The loop closed by off-tree joint ji: cross ji from a to b, climb from b
  * to the common ancestor, descend to a. Body vectors join consecutive
  * crossings within each link. */
-static int cycle_terms(const mech_model *m, const graph *g, int ji, term_buf *b, int *path)
+static int cycle_terms(const mech_model *m, const span_tree *g, int ji, term_buf *b, int *path)
 {
     const mech_joint *jt = &m->joints[ji];
     int a = jt->link[0], c = jt->link[1];
@@ -140,17 +69,17 @@ static int cycle_terms(const mech_model *m, const graph *g, int ji, term_buf *b,
     int *down = path + 2 * (m->njoints + 1);  /* second half: the a-side chain */
     while (x != y) {  /* climb the deeper side until both meet */
         if (g->depth[y] >= g->depth[x]) {
-            path[n++] = g->pjoint[y];
+            path[n++] = g->parent_joint[y];
             path[n++] = y;
-            y = g->parent[y];
+            y = g->parent_link[y];
         } else {
             down[nup++] = x;
-            x = g->parent[x];
+            x = g->parent_link[x];
         }
     }
     for (int k = nup - 1; k >= 0; k--) {  /* descend from the ancestor to a */
-        path[n++] = g->pjoint[down[k]];
-        path[n++] = g->parent[down[k]];
+        path[n++] = g->parent_joint[down[k]];
+        path[n++] = g->parent_link[down[k]];
     }
     /* path holds (joint, from) pairs; the link after crossing k is the
      * "other" side, and it is left by crossing k+1 (cyclically) */
@@ -168,38 +97,41 @@ static int cycle_terms(const mech_model *m, const graph *g, int ji, term_buf *b,
     return 0;
 }
 
-static int build_automatic(const mech_model *m, loop_set *ls, mech_diag *d)
+static int build_automatic(const mech_model *m, const span_tree *g, loop_set *ls, mech_diag *d)
 {
-    graph g = {0};
     term_buf b = {0};
     int nloops = m->njoints - m->nlinks + 1;
     int *path = xcalloc(4 * ((size_t)m->njoints + 1) + 4, sizeof *path);
+    char *tree = xcalloc((size_t)m->njoints + 1, 1);  /* 1: a tree edge */
     ls->start = xcalloc((size_t)(nloops > 0 ? nloops : 0) + 1, sizeof *ls->start);
-    if (!path || !ls->start || graph_build(m, &g) < 0) {
+    if (!path || !tree || !ls->start) {
         diag_error(d, m->file, (mech_mark){0, 0}, "out of memory");
         goto fail;
     }
-    for (int l = 0; l < m->nlinks; l++)
-        if (g.parent[l] == -2) {
+    for (int l = 0; l < m->nlinks; l++) {
+        if (g->parent_joint[l] >= 0)
+            tree[g->parent_joint[l]] = 1;
+        if (g->depth[l] < 0) {
             diag_error(d, m->file, m->links[l].mark, "link '%s' is not connected to the ground",
                        m->links[l].name);
             goto fail;
         }
+    }
     for (int j = 0; j < m->njoints; j++) {
-        if (g.tree[j])
+        if (tree[j])
             continue;
-        if (cycle_terms(m, &g, j, &b, path) < 0) {
+        if (cycle_terms(m, g, j, &b, path) < 0) {
             diag_error(d, m->file, (mech_mark){0, 0}, "out of memory");
             goto fail;
         }
         ls->start[++ls->nloops] = b.n;
     }
     ls->terms = b.t;
-    graph_free(&g);
+    free(tree);
     free(path);
     return MECH_OK;
 fail:
-    graph_free(&g);
+    free(tree);
     free(path);
     free(b.t);
     loops_free(ls);
@@ -400,8 +332,8 @@ static int build_from_file(const mech_model *m, loop_set *ls, mech_diag *d)
     return rc;
 }
 
-int loops_build(const mech_model *m, loop_set *ls, mech_diag *d)
+int loops_build(const mech_model *m, const span_tree *t, loop_set *ls, mech_diag *d)
 {
     memset(ls, 0, sizeof *ls);
-    return m->nloops > 0 ? build_from_file(m, ls, d) : build_automatic(m, ls, d);
+    return m->nloops > 0 ? build_from_file(m, ls, d) : build_automatic(m, t, ls, d);
 }

@@ -466,6 +466,7 @@ void mech_system_free(mech_system **ps)
     free(s->link_angle);
     free(s->slide);
     loops_free(&s->loops);
+    span_tree_free(&s->span);
     expr_free(&s->ex);
     free(s->f);
     free(s->Jp);
@@ -495,7 +496,11 @@ int mech_system_new(const mech_model *m, mech_system **out, mech_diag *d)
     int *vars = NULL;
     if (assign_unknowns(s) < 0)
         goto fail;
-    if ((rc = loops_build(m, &s->loops, d)) != MECH_OK)
+    if (span_tree_build(m, &s->span) < 0) {
+        diag_error(d, m->file, (mech_mark){0, 0}, "out of memory");
+        goto fail;
+    }
+    if ((rc = loops_build(m, &s->span, &s->loops, d)) != MECH_OK)
         goto fail;
     s->m = 2 * s->loops.nloops;
     /* more equations than unknowns: redundant constraints, which the solver

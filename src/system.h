@@ -4,6 +4,7 @@
 #define MECH_SYSTEM_H
 
 #include "expr.h"
+#include "spantree.h"
 #include "internal.h"
 #include "tape.h"
 
@@ -49,6 +50,7 @@ struct mech_system {
     ex *slide;                 /* [njoints] expression of each slider's displacement */
     char **names;              /* [SYS_NVARS(n)] text names of variables */
     char **latex;              /* [SYS_NVARS(n)] LaTeX names */
+    span_tree span;            /* breadth-first spanning tree of the links */
     loop_set loops;
     expr_ctx ex;
     ex *f;                     /* [m] residual rows; row 2k, 2k+1 = loop k, x and y */
@@ -73,8 +75,9 @@ void sys_eval_velocity_rhs(mech_system *s, double qdot, double *rhs);
 void sys_eval_accel_rhs(mech_system *s, const double *xdot, double qdot, double qddot,
                         double *rhs);
 
-/* loops.c: the loops from the file (checked) or a cycle basis. */
-int loops_build(const mech_model *m, loop_set *ls, mech_diag *d);
+/* loops.c: the loops from the file (checked) or a cycle basis (the joints
+ * off the spanning tree t). */
+int loops_build(const mech_model *m, const span_tree *t, loop_set *ls, mech_diag *d);
 void loops_free(loop_set *ls);
 /* Attachment point of joint j on link l (point index in l). */
 int loops_attach(const mech_joint *j, int l);
