@@ -224,5 +224,39 @@ if run "mech sweep unknown parameter" 2 "$MECH" sweep mechanisms/slider-crank.ya
     has_line "$tmp/err" "no parameter 'rr'" "sweep: unknown parameter named"
 fi
 run "mech sweep bad range" 2 "$MECH" sweep mechanisms/slider-crank.yaml --vary r=30mm:60:4 && pass
+# a metric's column is checked before anything is solved (it gave nan rows, exit 0)
+sc=mechanisms/slider-crank.yaml
+if run "mech sweep unknown metric column" 2 "$MECH" sweep $sc --vary r=30mm:60mm:4 --metric range:x_B.ss; then
+    has_line "$tmp/err" "no column 'x_B.ss' in the output.*did you mean 'x_B.s'" "sweep: unknown metric column named"
+    [ -s "$tmp/out" ] && fail "sweep: unknown metric column: rows written" || pass
+fi
+run "mech sweep range:nosuch" 2 "$MECH" sweep $sc --vary r=30mm:60mm:2 --metric range:nosuch && pass
+run "mech sweep torque metric without --forces" 2 "$MECH" sweep $sc --vary r=30mm:60mm:2 --metric maxabs:driver.torque && pass
+if run "mech sweep transmission: unknown link" 2 "$MECH" sweep $sc --vary r=30mm:60mm:2 --metric transmission:crank,rid; then
+    has_line "$tmp/err" "no column 'rid.angle'.*did you mean 'rod.angle'" "sweep: transmission link named"
+fi
+# the first variant cannot assemble: its columns are known all the same
+if run "mech sweep, first variant fails" 0 "$MECH" sweep $sc --vary r=60mm:30mm:4 --list l=45mm,140mm --metric range:x_B.s; then
+    has_line "$tmp/out" '^0,60 mm,45mm,no-assembly,' "sweep: variant 0 cannot assemble"
+    has_line "$tmp/out" '^1,60 mm,140mm,ok,73,0.12$' "sweep: the others are solved"
+fi
+# every variant fails: exit 1, the rows still written
+if run "mech sweep, no variant solved" 1 "$MECH" sweep $sc --vary r=300mm:600mm:2 --metric range:x_B.s; then
+    rows=$(grep -c ',no-assembly,' "$tmp/out")
+    [ "$rows" -eq 2 ] && pass || fail "sweep, no variant solved: $rows no-assembly rows, expected 2"
+    has_line "$tmp/err" "none of the 2 variants could be solved" "sweep: no variant solved, said"
+fi
+run "mech sweep, a parameter varied twice" 2 "$MECH" sweep $sc --vary r=30mm:60mm:2 --list r=45mm && pass
+# a --list value cannot add rows or cells to the CSV
+nl='
+'
+if run "mech sweep --list with a newline" 2 "$MECH" sweep $sc --list "l=140mm${nl}99,injected"; then
+    has_line "$tmp/err" "control character (byte 0x0a)" "sweep: control character named"
+    [ -s "$tmp/out" ] && fail "sweep --list with a newline: rows written" || pass
+fi
+if run "mech sweep --list with a quote" 0 "$MECH" sweep $sc --list 'l=140mm,"9"'; then
+    has_line "$tmp/out" '^1,"""9""",invalid,0$' "sweep: a quote in a cell is quoted (RFC 4180)"
+    [ "$(wc -l <"$tmp/out")" -eq 3 ] && pass || fail "sweep --list with a quote: $(wc -l <"$tmp/out") lines, expected 3"
+fi
 
 summary
