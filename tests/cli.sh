@@ -137,6 +137,28 @@ run "mech solve bad option" 2 "$MECH" solve mechanisms/fourbar.yaml --frobnicate
 run "mech solve --steps 0" 2 "$MECH" solve mechanisms/fourbar.yaml --steps 0 && pass
 run "mech solve --from without --to" 2 "$MECH" solve mechanisms/fourbar.yaml --from 10 && pass
 run "mech solve --from with a wrong unit" 2 "$MECH" solve mechanisms/fourbar.yaml --from 10kg --to 20 && pass
+# command-line ranges are checked like the file's: finite, and positions a
+# step can still move (--to 1e20 said "assembles from 0 deg to 0 deg")
+if run "mech solve --to 1e20" 2 "$MECH" solve mechanisms/fourbar.yaml --from 0 --to 1e20; then
+    has_line "$tmp/err" "within +-1e6 rad" "--to 1e20: the limit named"
+fi
+run "mech solve --from -1e308" 2 "$MECH" solve mechanisms/fourbar.yaml --from -1e308 --to 0 && pass
+run "mech solve --to 1e400" 2 "$MECH" solve mechanisms/fourbar.yaml --from 0 --to 1e400 && pass
+run "mech solve --from/--to over 3 turns" 0 "$MECH" solve mechanisms/fourbar.yaml --from -360 --to 720 --steps 3 && pass
+# a tolerance below what double precision reaches is refused (1e-300 was
+# accepted, then "cannot assemble, residual 7e-18")
+if run "mech solve --tol 1e-300" 2 "$MECH" solve mechanisms/fourbar.yaml --tol 1e-300; then
+    has_line "$tmp/err" "from 1e-15" "--tol: the limit named"
+fi
+run "mech solve --tol nan" 2 "$MECH" solve mechanisms/fourbar.yaml --tol nan && pass
+run "mech solve --tol 1e-15" 0 "$MECH" solve mechanisms/fourbar.yaml --tol 1e-15 && pass
+# out of memory has its own message and exit status 3, not 2 "invalid input"
+# (a memory limit does not work with AddressSanitizer's shadow memory)
+if ! grep -q __asan_init "$MECH"; then
+    if run "mech solve out of memory" 3 sh -c "ulimit -v 200000; exec \"\$0\" solve mechanisms/conveyor.yaml --steps 1000000 --forces" "$MECH"; then
+        has_line "$tmp/err" "out of memory" "out of memory: said"
+    fi
+fi
 run "mech solve missing file" 3 "$MECH" solve "$tmp/nonexistent.yaml" && pass
 run "mech solve unwritable output" 3 "$MECH" solve mechanisms/fourbar.yaml -o "$tmp/no/such/dir/x.csv" && pass
 
