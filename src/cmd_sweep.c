@@ -234,7 +234,9 @@ static int check_column(const metric *mt, const char *col, const mech_table *t, 
  * base model m (the file with the first variant's values; parameters change
  * numbers, not names). mech_solve makes its table's columns before it
  * solves any position, so a solve over the first two driver positions gives
- * them even when the base variant cannot assemble. Returns -1 when all are
+ * them even when the base variant cannot assemble. The note that forces
+ * are all zero (no mass, no load) is printed here, once for the grid.
+ * Returns -1 when all are
  * there (or the columns cannot be known: the base does not even build, and
  * every variant will say why), else the exit status. */
 static int check_metrics(const sweep_run *r, const mech_model *m)
@@ -244,7 +246,8 @@ static int check_metrics(const sweep_run *r, const mech_model *m)
     mech_summary sum;
     int rc = mech_check(m, &sum, &d);
     mech_table t = {0};
-    if (rc == MECH_OK && r->nmetrics > 0 && m->has_driver && m->driver.nvalues > 0) {
+    if (rc == MECH_OK && (r->nmetrics > 0 || r->forces) && m->has_driver &&
+        m->driver.nvalues > 0) {
         mech_solve_options o;
         mech_solve_options_default(&o);
         o.forces = r->forces;
@@ -256,6 +259,10 @@ static int check_metrics(const sweep_run *r, const mech_model *m)
         }
         rc = mech_solve(m, &o, &t, NULL, &d);
     }
+    for (size_t i = 0; i < d.count; i++)
+        if (d.entries[i].severity == MECH_SEV_NOTE &&
+            strstr(d.entries[i].message, "no link has a mass"))
+            fprintf(stderr, "mech sweep: note: variant 0: %s\n", d.entries[i].message);
     mech_diag_free(&d);
     int code = -1;
     if (rc == MECH_ENOMEM) {

@@ -150,6 +150,16 @@ run "mech solve --from/--to over 3 turns" 0 "$MECH" solve mechanisms/fourbar.yam
 if run "mech solve --tol 1e-300" 2 "$MECH" solve mechanisms/fourbar.yaml --tol 1e-300; then
     has_line "$tmp/err" "from 1e-15" "--tol: the limit named"
 fi
+# forces of a mechanism without masses or loads are all zero: said, not silent
+if run "mech solve --forces, no mass" 0 "$MECH" solve mechanisms/slider-crank.yaml --forces; then
+    has_line "$tmp/err" "note: no link has a mass and there are no loads" "--forces without masses: a note"
+fi
+if run "mech solve --forces, masses" 0 "$MECH" solve mechanisms/conveyor.yaml --forces; then
+    grep -q "no link has a mass" "$tmp/err" && fail "--forces with masses: the no-mass note" || pass
+fi
+if run "mech sweep --forces, no mass" 0 "$MECH" sweep mechanisms/slider-crank.yaml --vary r=30mm:60mm:3 --forces; then
+    [ "$(grep -c 'no link has a mass' "$tmp/err")" -eq 1 ] && pass || fail "sweep --forces without masses: expected the note once: $(cat "$tmp/err")"
+fi
 run "mech solve --tol nan" 2 "$MECH" solve mechanisms/fourbar.yaml --tol nan && pass
 run "mech solve --tol 1e-15" 0 "$MECH" solve mechanisms/fourbar.yaml --tol 1e-15 && pass
 # out of memory has its own message and exit status 3, not 2 "invalid input"
