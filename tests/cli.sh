@@ -241,6 +241,14 @@ fi
 run "mech batch --shard 2/2" 2 "$MECH" batch --shard 2/2 mechanisms/fourbar.yaml && pass
 run "mech batch no files" 2 "$MECH" batch -j 2 && pass
 
+# ---- mech plot ------------------------------------------------------------
+
+# a long sweep is thinned to what a figure shows (200 000 steps wrote 71 MB)
+if run "mech plot --steps 200000" 0 "$MECH" plot mechanisms/fourbar.yaml --steps 200000 --out "$tmp/fig"; then
+    kb=$(du -sk "$tmp/fig" | cut -f1)
+    [ "$kb" -lt 3000 ] && pass || fail "plot of 200 000 steps: $kb KB of SVG, expected under 3 MB"
+fi
+
 # ---- mech sweep -----------------------------------------------------------
 
 if run "mech sweep" 0 "$MECH" sweep mechanisms/slider-crank.yaml --vary r=30mm:60mm:4 --list l=45mm,140mm --metric range:x_B.s -j 2 -o "$tmp/sw.csv"; then
