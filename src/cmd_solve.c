@@ -142,7 +142,7 @@ static int parse_valued(solve_args *a, const char *arg, const char *val)
             return cmd_usage_error("solve", "--set needs NAME=VALUE (at most 64), not '%s'", val);
         char *copy = strdup(val);
         if (!copy)
-            return MECH_EXIT_INPUT;
+            return fprintf(stderr, "mech solve: out of memory\n"), MECH_EXIT_IO;
         copy[eq - val] = '\0';
         a->set_text[a->nset] = copy;
         a->set[a->nset].name = copy;

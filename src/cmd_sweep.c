@@ -142,14 +142,12 @@ static int parse_vary(sweep_run *r, const char *arg, int is_list)
             return cmd_usage_error("sweep", "%s", msg);
         }
     char *spec = strdup(eq + 1), *save = NULL;
-    if (!spec)
-        return MECH_EXIT_INPUT;
-    int bad = 0;
-    if (is_list) {
-        for (char *w = strtok_r(spec, ",", &save); w && !bad; w = strtok_r(NULL, ",", &save))
-            bad = add_text(a, w) < 0;
-        bad |= a->count == 0;
-    } else {
+    int bad = 0, oom = !spec;
+    if (!oom && is_list) {
+        for (char *w = strtok_r(spec, ",", &save); w && !oom; w = strtok_r(NULL, ",", &save))
+            oom = add_text(a, w) < 0;
+        bad = a->count == 0;
+    } else if (!oom) {
         char *from = strtok_r(spec, ":", &save), *to = strtok_r(NULL, ":", &save);
         char *count = strtok_r(NULL, ":", &save), *end = NULL;
         double f, t;
@@ -158,14 +156,23 @@ static int parse_vary(sweep_run *r, const char *arg, int is_list)
         bad = !from || !to || !count || *end || n < 1 || n > 1000000 ||
               split_number(from, &f, uf, sizeof uf) < 0 ||
               split_number(to, &t, ut, sizeof ut) < 0 || strcmp(uf, ut) != 0;
-        for (long i = 0; !bad && i < n; i++) {
+        for (long i = 0; !bad && !oom && i < n; i++) {
             char text[96];
             double v = n == 1 ? f : f + (t - f) * (double)i / (double)(n - 1);
             snprintf(text, sizeof text, "%.15g %s", v, uf);
-            bad = add_text(a, text) < 0;
+            oom = add_text(a, text) < 0;
         }
     }
     free(spec);
+    if (bad || oom) {  /* the axis is not kept: free its texts here */
+        for (int i = 0; i < a->count; i++)
+            free(a->texts[i]);
+        free(a->texts);
+        a->texts = NULL;
+        a->count = 0;
+    }
+    if (oom)
+        return fprintf(stderr, "mech sweep: out of memory\n"), MECH_EXIT_IO;
     if (bad)
         return cmd_usage_error("sweep", is_list ? "--list needs NAME=A,B,..., not '%s'"
                                    : "--vary needs NAME=FROM:TO:COUNT with the same unit on "
