@@ -326,8 +326,8 @@ static int parse_row(csv_reader *r, compare_table *t)
                             t->names[i]);
         int ok = parse_cell(r->fields[i], &row[i]);
         if (ok == 0)
-            return error_at(r, r->cols[i], "'%.40s' in column '%s' is not a number (a decimal "
-                            "number, nan, inf or -inf)", r->fields[i], t->names[i]);
+            return error_at(r, r->cols[i], "'%.40s' in column '%s' is not a number",
+                            r->fields[i], t->names[i]);
         if (ok < 0)
             return error_at(r, r->cols[i], "'%.40s' in column '%s' is not a finite number "
                             "(beyond the range of a double)", r->fields[i], t->names[i]);
