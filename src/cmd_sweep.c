@@ -243,9 +243,9 @@ static int check_column(const metric *mt, const char *col, const mech_table *t, 
  * solves any position, so a solve over the first two driver positions gives
  * them even when the base variant cannot assemble. The note that forces
  * are all zero (no mass, no load) is printed here, once for the grid.
- * Returns -1 when all are
- * there (or the columns cannot be known: the base does not even build, and
- * every variant will say why), else the exit status. */
+ * Returns -1 when all are there (or the columns cannot be known: the base
+ * does not even build, and every variant will say why), else the exit
+ * status. */
 static int check_metrics(const sweep_run *r, const mech_model *m)
 {
     mech_diag d;
