@@ -76,9 +76,7 @@ static void base_name(const char *path, char *out, size_t size)
 
 static int exit_of(int rc)
 {
-    return rc == MECH_OK ? MECH_EXIT_OK
-           : rc == MECH_ESOLVE ? MECH_EXIT_SOLVE
-           : rc == MECH_EIO ? MECH_EXIT_IO : MECH_EXIT_INPUT;
+    return cmd_exit_status(rc);  /* out of memory: 3, with IO */
 }
 
 static void compare_golden(const batch *b, job *jb, const char *csv, FILE *msg)

@@ -195,7 +195,7 @@ static int solve(const plot_args *a, const mech_model *m, const mech_solve_optio
     if (rc == MECH_ESOLVE)
         fprintf(stderr, "mech %s: %d of the sweep's positions were solved before this; "
                 "nothing written\n", a->cmd, t->nrows);
-    return rc == MECH_OK ? MECH_EXIT_OK : rc == MECH_ESOLVE ? MECH_EXIT_SOLVE : MECH_EXIT_INPUT;
+    return cmd_exit_status(rc);
 }
 
 /* mkdir -p */
@@ -385,7 +385,7 @@ int cmd_animate(int argc, char **argv)
         int rc = plot_animation_write(m, &t, &a.anim, a.out ? a.out : "-", &d);
         mech_diag_print(&d, stderr);
         mech_diag_free(&d);
-        code = rc == MECH_OK ? MECH_EXIT_OK : rc == MECH_EINPUT ? MECH_EXIT_INPUT : MECH_EXIT_IO;
+        code = cmd_exit_status(rc);
     }
     free(trace);
     mech_table_free(&t);

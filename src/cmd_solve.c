@@ -1,6 +1,7 @@
 /* src/cmd_solve.c: `mech solve`, the driver sweep on the command line.
  * Parses options into mech_solve_options, runs mech_solve, writes the CSV
  * (whole or not at all) and the statistics. */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -27,7 +28,7 @@ const char cmd_solve_help[] =
     "                      degrees (crank) or millimetres (slider); units are\n"
     "                      allowed: --from 2.0864rad, --to 0.2m\n"
     "  --tol T             Newton tolerance relative to the largest length of the\n"
-    "                      mechanism (default 1e-12)\n"
+    "                      mechanism, from 1e-15 to below 1 (default 1e-12)\n"
     "  --max-iter N        Newton iterations per step before giving up (default 50)\n"
     "  --min-rcond R       reciprocal condition below which a position is reported\n"
     "                      singular (default 1e-6)\n"
@@ -58,6 +59,15 @@ const char cmd_solve_help[] =
     "no output is written), 2 invalid file or usage, 3 a file cannot be read or written\n";
 
 enum { MAX_SET = 64 };
+
+/* The smallest --tol: a residual is a sum of products of lengths, rounded
+ * to about DBL_EPSILON (2.2e-16) times the largest; below a few times that
+ * Newton cannot get (docs/solver.md: 4e-15 or better on every file). */
+#define MIN_TOL 1e-15
+/* The largest driver position on the command line, rad or m: beyond it a
+ * step of the sweep is lost in the rounding of the position itself
+ * (1e6 rad = 57 million degrees, ulp 1.2e-10 rad). */
+#define MAX_DRIVER 1e6
 
 typedef struct solve_args {
     const char *file, *out, *from, *to, *outputs;
@@ -106,8 +116,10 @@ static int parse_valued(solve_args *a, const char *arg, const char *val)
                                "not '%s'", val);
         a->steps = (int)num;
     } else if (strcmp(arg, "--tol") == 0) {
-        if (!parse_number(val, &num) || !(num > 0 && num < 1))
-            return cmd_usage_error("solve", "--tol needs a number between 0 and 1, not '%s'", val);
+        if (!parse_number(val, &num) || !(num >= MIN_TOL && num < 1))
+            return cmd_usage_error("solve", "--tol needs a number from 1e-15 (a smaller residual "
+                                   "is below what double precision can reach) to below 1, "
+                                   "not '%s'", val);
         a->opt.tol = num;
     } else if (strcmp(arg, "--max-iter") == 0) {
         if (!parse_number(val, &num) || num < 1 || num > 10000 || num != (int)num)
@@ -130,7 +142,7 @@ static int parse_valued(solve_args *a, const char *arg, const char *val)
             return cmd_usage_error("solve", "--set needs NAME=VALUE (at most 64), not '%s'", val);
         char *copy = strdup(val);
         if (!copy)
-            return MECH_EXIT_INPUT;
+            return fprintf(stderr, "mech solve: out of memory\n"), MECH_EXIT_IO;
         copy[eq - val] = '\0';
         a->set_text[a->nset] = copy;
         a->set[a->nset].name = copy;
@@ -197,16 +209,33 @@ static int parse_args(int argc, char **argv, solve_args *a)
     return -1;
 }
 
+/* One end of --from/--to into *si: a finite position within MAX_DRIVER, as
+ * the file's range must be finite (docs/limits.md). Returns -1 when fine,
+ * else the exit status (the problem printed). */
+static int parse_end(const char *opt, const char *text, int is_angle, double *si)
+{
+    char err[256];
+    if (mech_parse_value(text, is_angle, si, err, sizeof err) != MECH_OK)
+        return fprintf(stderr, "mech solve: %s '%s': %s\n", opt, text, err), MECH_EXIT_INPUT;
+    if (!(fabs(*si) <= MAX_DRIVER)) {
+        snprintf(err, sizeof err, "%s '%.40s' is %.3g %s: a driver %s must be within +-%s "
+                 "(beyond, a step is lost in the rounding of the position)", opt, text, *si,
+                 is_angle ? "rad" : "m", is_angle ? "angle" : "displacement",
+                 is_angle ? "1e6 rad (5.7e7 deg)" : "1e6 m");
+        return cmd_usage_error("solve", "%s", err);
+    }
+    return -1;
+}
+
 /* Apply --from/--to/--steps and --outputs to the loaded model. */
 static int apply_overrides(solve_args *a, mech_model *m)
 {
     char err[256];
-    int is_angle = m->driver.kind == MECH_DRIVE_ANGLE;
+    int is_angle = m->driver.kind == MECH_DRIVE_ANGLE, code;
     if (a->from) {
-        if (mech_parse_value(a->from, is_angle, &a->opt.from, err, sizeof err) != MECH_OK)
-            return fprintf(stderr, "mech solve: --from '%s': %s\n", a->from, err), MECH_EXIT_INPUT;
-        if (mech_parse_value(a->to, is_angle, &a->opt.to, err, sizeof err) != MECH_OK)
-            return fprintf(stderr, "mech solve: --to '%s': %s\n", a->to, err), MECH_EXIT_INPUT;
+        if ((code = parse_end("--from", a->from, is_angle, &a->opt.from)) >= 0 ||
+            (code = parse_end("--to", a->to, is_angle, &a->opt.to)) >= 0)
+            return code;
         a->opt.has_range = 1;
         a->opt.steps = a->steps > 0 ? a->steps : 360;
     } else if (a->steps > 0) {
@@ -276,8 +305,7 @@ int cmd_solve(int argc, char **argv)
     mech_diag_free(&d);
     if (a.stats)
         print_stats(m, &st, stderr);
-    code = rc == MECH_OK ? MECH_EXIT_OK
-           : rc == MECH_ESOLVE ? MECH_EXIT_SOLVE : MECH_EXIT_INPUT;
+    code = cmd_exit_status(rc);
     if (rc == MECH_OK) {
         mech_diag_init(&d);
         if (mech_table_write_csv(&t, a.out ? a.out : "-", &d) != MECH_OK)

@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "commands.h"
+#include "internal.h"
 
 const char cmd_sweep_help[] =
     "usage: mech sweep FILE --vary NAME=FROM:TO:COUNT [--vary ...] [--list NAME=A,B,...]\n"
@@ -42,8 +43,9 @@ const char cmd_sweep_help[] =
     "  --forces          also the force analysis (needed for driver.torque metrics)\n"
     "  -h, --help        show this help\n"
     "\n"
-    "exit status: 0 the sweep ran (whatever the variants did), 2 bad usage or an\n"
-    "invalid file or parameter name, 3 a file cannot be read or written\n";
+    "exit status: 0 the sweep ran and at least one variant was solved, 1 no variant\n"
+    "could be solved (the rows are still written), 2 bad usage or an invalid file,\n"
+    "parameter or metric column, 3 a file cannot be read or written, or out of memory\n";
 
 enum { MAX_VARY = 8, MAX_METRICS = 32 };
 
@@ -105,8 +107,26 @@ static int add_text(axis *a, const char *text)
     return a->texts[a->count++] ? 0 : -1;
 }
 
+/* The first control character of s (a byte below 32, or 127), or 0. The
+ * values become CSV cells and terminal text: a newline would add rows. */
+static int control_char(const char *s)
+{
+    for (; *s; s++)
+        if ((unsigned char)*s < 32 || *s == 127)
+            return (unsigned char)*s;
+    return 0;
+}
+
 static int parse_vary(sweep_run *r, const char *arg, int is_list)
 {
+    const char *opt = is_list ? "--list" : "--vary";
+    char msg[256];
+    int cc = control_char(arg);
+    if (cc) {
+        snprintf(msg, sizeof msg, "%s: a control character (byte 0x%02x) in the value; "
+                 "parameter values are text on one line", opt, (unsigned)cc);
+        return cmd_usage_error("sweep", "%s", msg);
+    }
     if (r->naxes == MAX_VARY)
         return cmd_usage_error("sweep", "at most 8 --vary/--list options ('%s')", arg);
     const char *eq = strchr(arg, '=');
@@ -115,15 +135,19 @@ static int parse_vary(sweep_run *r, const char *arg, int is_list)
     axis *a = &r->axes[r->naxes];
     memset(a, 0, sizeof *a);
     snprintf(a->name, sizeof a->name, "%.*s", (int)(eq - arg), arg);
+    for (int k = 0; k < r->naxes; k++)
+        if (strcmp(r->axes[k].name, a->name) == 0) {
+            snprintf(msg, sizeof msg, "%s %s: parameter '%s' is already varied by an earlier "
+                     "--vary or --list (give all its values in one option)", opt, arg, a->name);
+            return cmd_usage_error("sweep", "%s", msg);
+        }
     char *spec = strdup(eq + 1), *save = NULL;
-    if (!spec)
-        return MECH_EXIT_INPUT;
-    int bad = 0;
-    if (is_list) {
-        for (char *w = strtok_r(spec, ",", &save); w && !bad; w = strtok_r(NULL, ",", &save))
-            bad = add_text(a, w) < 0;
-        bad |= a->count == 0;
-    } else {
+    int bad = 0, oom = !spec;
+    if (!oom && is_list) {
+        for (char *w = strtok_r(spec, ",", &save); w && !oom; w = strtok_r(NULL, ",", &save))
+            oom = add_text(a, w) < 0;
+        bad = a->count == 0;
+    } else if (!oom) {
         char *from = strtok_r(spec, ":", &save), *to = strtok_r(NULL, ":", &save);
         char *count = strtok_r(NULL, ":", &save), *end = NULL;
         double f, t;
@@ -132,14 +156,23 @@ static int parse_vary(sweep_run *r, const char *arg, int is_list)
         bad = !from || !to || !count || *end || n < 1 || n > 1000000 ||
               split_number(from, &f, uf, sizeof uf) < 0 ||
               split_number(to, &t, ut, sizeof ut) < 0 || strcmp(uf, ut) != 0;
-        for (long i = 0; !bad && i < n; i++) {
+        for (long i = 0; !bad && !oom && i < n; i++) {
             char text[96];
             double v = n == 1 ? f : f + (t - f) * (double)i / (double)(n - 1);
             snprintf(text, sizeof text, "%.15g %s", v, uf);
-            bad = add_text(a, text) < 0;
+            oom = add_text(a, text) < 0;
         }
     }
     free(spec);
+    if (bad || oom) {  /* the axis is not kept: free its texts here */
+        for (int i = 0; i < a->count; i++)
+            free(a->texts[i]);
+        free(a->texts);
+        a->texts = NULL;
+        a->count = 0;
+    }
+    if (oom)
+        return fprintf(stderr, "mech sweep: out of memory\n"), MECH_EXIT_IO;
     if (bad)
         return cmd_usage_error("sweep", is_list ? "--list needs NAME=A,B,..., not '%s'"
                                    : "--vary needs NAME=FROM:TO:COUNT with the same unit on "
@@ -179,6 +212,78 @@ static int parse_metric(sweep_run *r, const char *arg)
         return -1;
     }
     return cmd_usage_error("sweep", "unknown metric '%s' (range:, max:, min:, maxabs:, transmission:)", arg);
+}
+
+/* ---- the metrics' columns, checked before the grid --------------------- */
+
+/* 0 when column `col` of metric mt is in t; else a usage error naming it,
+ * with the nearest column when it looks like a typo. */
+static int check_column(const metric *mt, const char *col, const mech_table *t, int r_forces)
+{
+    if (mech_table_column(t, col) >= 0)
+        return 0;
+    char msg[512];
+    const char *near = NULL;
+    const char **names = t->ncolumns <= 1000 ? xcalloc((size_t)t->ncolumns, sizeof *names) : NULL;
+    for (int c = 0; names && c < t->ncolumns; c++)
+        names[c] = t->columns[c].name;
+    if (names)
+        near = nearest_name(col, names, (size_t)t->ncolumns);
+    snprintf(msg, sizeof msg, "--metric %s: no column '%s' in the output of 'mech solve "
+             "FILE%s'%s%s%s%s", mt->label, col, r_forces ? " --forces" : "",
+             near ? " (did you mean '" : "", near ? near : "", near ? "'?)" : "",
+             mt->kind == MET_TRANSMISSION ? "; transmission: takes two moving links" : "");
+    free(names);
+    return cmd_usage_error("sweep", "%s", msg);
+}
+
+/* Every metric names columns the variants' tables will have: those of the
+ * base model m (the file with the first variant's values; parameters change
+ * numbers, not names). mech_solve makes its table's columns before it
+ * solves any position, so a solve over the first two driver positions gives
+ * them even when the base variant cannot assemble. The note that forces
+ * are all zero (no mass, no load) is printed here, once for the grid.
+ * Returns -1 when all are there (or the columns cannot be known: the base
+ * does not even build, and every variant will say why), else the exit
+ * status. */
+static int check_metrics(const sweep_run *r, const mech_model *m)
+{
+    mech_diag d;
+    mech_diag_init(&d);
+    mech_summary sum;
+    int rc = mech_check(m, &sum, &d);
+    mech_table t = {0};
+    if (rc == MECH_OK && (r->nmetrics > 0 || r->forces) && m->has_driver &&
+        m->driver.nvalues > 0) {
+        mech_solve_options o;
+        mech_solve_options_default(&o);
+        o.forces = r->forces;
+        if (m->driver.nvalues > 1) {
+            o.has_range = 1;
+            o.from = m->driver.values[0];
+            o.to = m->driver.values[1];
+            o.steps = 1;
+        }
+        rc = mech_solve(m, &o, &t, NULL, &d);
+    }
+    for (size_t i = 0; i < d.count; i++)
+        if (d.entries[i].severity == MECH_SEV_NOTE &&
+            strstr(d.entries[i].message, "no link has a mass"))
+            fprintf(stderr, "mech sweep: note: variant 0: %s\n", d.entries[i].message);
+    mech_diag_free(&d);
+    int code = -1;
+    if (rc == MECH_ENOMEM) {
+        fprintf(stderr, "mech sweep: out of memory\n");
+        code = MECH_EXIT_IO;
+    }
+    for (int k = 0; code < 0 && t.ncolumns > 0 && k < r->nmetrics; k++) {
+        const metric *mt = &r->metrics[k];
+        if (check_column(mt, mt->col, &t, r->forces) != 0 ||
+            (mt->kind == MET_TRANSMISSION && check_column(mt, mt->col2, &t, r->forces) != 0))
+            code = MECH_EXIT_INPUT;
+    }
+    mech_table_free(&t);
+    return code;
 }
 
 /* ---- one variant ------------------------------------------------------ */
@@ -277,22 +382,40 @@ static void sweep_job(void *ctx, int i)
 
 /* ---- output ------------------------------------------------------------ */
 
+/* ",CELL": quoted as RFC 4180 says ("a ""b"", c") when it holds a comma, a
+ * quote or a line end, so a text cell cannot split into more cells or rows. */
+static void put_cell(FILE *f, const char *s)
+{
+    fputc(',', f);
+    if (!s[strcspn(s, ",\"\r\n")]) {
+        fputs(s, f);
+        return;
+    }
+    fputc('"', f);
+    for (; *s; s++) {
+        if (*s == '"')
+            fputc('"', f);
+        fputc(*s, f);
+    }
+    fputc('"', f);
+}
+
 static void write_summary(const sweep_run *r, FILE *f)
 {
     mech_override ov[MAX_VARY];
     fprintf(f, "variant");
     for (int k = 0; k < r->naxes; k++)
-        fprintf(f, ",%s", r->axes[k].name);
+        put_cell(f, r->axes[k].name);
     fprintf(f, ",status,rows");
     for (int k = 0; k < r->nmetrics; k++)
-        fprintf(f, ",%s", r->metrics[k].label);
+        put_cell(f, r->metrics[k].label);
     fputc('\n', f);
     for (int i = 0; i < r->nvars; i++) {
         const variant *v = &r->vars[i];
         variant_overrides(r, v->index, ov);
         fprintf(f, "%d", v->index);
         for (int k = 0; k < r->naxes; k++)
-            fprintf(f, ",%s", ov[k].text);
+            put_cell(f, ov[k].text);
         fprintf(f, ",%s,%d", v->status, v->rows);
         for (int k = 0; k < r->nmetrics; k++)
             fprintf(f, ",%.17g", v->value[k]);
@@ -405,21 +528,34 @@ int cmd_sweep(int argc, char **argv)
     int rc = mech_load_file_with(r.file, ov, r.naxes, &m, &d);
     mech_diag_print(&d, stderr);
     mech_diag_free(&d);
+    code = rc == MECH_OK ? check_metrics(&r, m) : cmd_exit_status(rc);
     mech_model_free(&m);
-    if (rc != MECH_OK) {
+    if (code >= 0) {
         free_run(&r);
-        return rc == MECH_EIO ? MECH_EXIT_IO : MECH_EXIT_INPUT;
+        return code;
     }
     r.vars = calloc((size_t)total, sizeof *r.vars);
-    for (long i = 0; r.vars && i < total; i++)
+    if (!r.vars) {
+        fprintf(stderr, "mech sweep: out of memory\n");
+        free_run(&r);
+        return MECH_EXIT_IO;
+    }
+    for (long i = 0; i < total; i++)
         if (i % shard_m == shard_k)
             r.vars[r.nvars++].index = (int)i;
-    if (r.vars)
-        cmd_run_parallel(r.nvars, (int)nthreads, sweep_job, &r);
-    for (int i = 0; r.vars && i < r.nvars; i++)
-        if (r.vars[i].messages && strcmp(r.vars[i].status, "ok") != 0)
+    cmd_run_parallel(r.nvars, (int)nthreads, sweep_job, &r);
+    int nok = 0;
+    for (int i = 0; i < r.nvars; i++) {
+        if (strcmp(r.vars[i].status, "ok") == 0)
+            nok++;
+        else if (r.vars[i].messages)
             fputs(r.vars[i].messages, stderr);
-    code = r.vars ? write_file(&r, out) : MECH_EXIT_INPUT;
+    }
+    code = write_file(&r, out);
+    if (code == MECH_EXIT_OK && r.nvars > 0 && nok == 0) {
+        fprintf(stderr, "mech sweep: none of the %d variants could be solved\n", r.nvars);
+        code = MECH_EXIT_SOLVE;
+    }
     free_run(&r);
     return code;
 }

@@ -13,6 +13,16 @@ int cmd_load_checked(const char *path, mech_model **m);
 /* The same with some of the file's parameters replaced (--set). */
 int cmd_load_checked_with(const char *path, const mech_override *ov, int nov, mech_model **m);
 
+/* The exit status of a library status: MECH_OK 0, MECH_ESOLVE 1, MECH_EINPUT
+ * 2, MECH_EIO and MECH_ENOMEM 3 (the system failed the run, not the input;
+ * the message says which: docs/cli.md, "Exit status"). */
+static inline int cmd_exit_status(int rc)
+{
+    return rc == MECH_OK ? MECH_EXIT_OK
+           : rc == MECH_ESOLVE ? MECH_EXIT_SOLVE
+           : rc == MECH_EIO || rc == MECH_ENOMEM ? MECH_EXIT_IO : MECH_EXIT_INPUT;
+}
+
 /* cmd_common.c: "mech COMMAND: MESSAGE (see 'mech COMMAND --help')" on
  * stderr; returns MECH_EXIT_INPUT. fmt has one %s for arg. */
 int cmd_usage_error(const char *command, const char *fmt, const char *arg);

@@ -5,7 +5,9 @@
  *   skipped = a blank line, or a comment: first non-blank character '#'
  *   header  = field { ',' field }       field = NAME [blanks] '[' UNIT ']'
  *   row     = number { ',' number }      as many fields as the header
- *   number  = what strtod reads whole: %.17g output, nan, inf, -inf
+ *   number  = a finite decimal number: [sign] digits [. digits] [e [sign] digits]
+ *             (digits before or after the point), as %.17g writes it; or
+ *             nan, -nan, inf, -inf, spelled as printf writes them
  * Fields may have blanks around them; lines end with \n or \r\n. There is no
  * limit on the length of a line or the number of columns (getline grows its
  * buffer). Both files are read whole, then compared column by column. */
@@ -260,6 +262,42 @@ static int parse_number(const char *s, double *v)
     return end != s && *end == '\0';
 }
 
+/* *v = the number in cell s, when s is written as the solver writes numbers
+ * (%.17g): a decimal number, or exactly nan, -nan, inf or -inf. Returns 1;
+ * 0 when s is something else (hex 0x1p3, "infinity", "1OO"); -1 when a
+ * decimal number overflows a double (1e999 would read as inf and then
+ * match an inf). */
+static int parse_cell(const char *s, double *v)
+{
+    static const char *const special[] = {"nan", "-nan", "inf", "-inf"};
+    for (size_t i = 0; i < sizeof special / sizeof special[0]; i++)
+        if (strcmp(s, special[i]) == 0) {
+            *v = strtod(s, NULL);
+            return 1;
+        }
+    static const char digit[] = "0123456789";
+    const char *p = s + (*s == '+' || *s == '-');
+    size_t whole = strspn(p, digit), frac = 0;
+    p += whole;
+    if (*p == '.') {
+        frac = strspn(p + 1, digit);
+        p += 1 + frac;
+    }
+    if (whole + frac == 0)
+        return 0;
+    if (*p == 'e' || *p == 'E') {
+        p += 1 + (p[1] == '+' || p[1] == '-');
+        size_t exp = strspn(p, digit);
+        if (exp == 0)
+            return 0;
+        p += exp;
+    }
+    if (*p != '\0')
+        return 0;
+    *v = strtod(s, NULL);  /* an underflow is a finite value near 0: kept */
+    return isfinite(*v) ? 1 : -1;
+}
+
 /* The field count of the current line against the header's. Returns 0 or
  * the error (recorded), placed at the first extra field or the line's end. */
 static int check_field_count(csv_reader *r, const compare_table *t)
@@ -286,9 +324,13 @@ static int parse_row(csv_reader *r, compare_table *t)
         if (r->fields[i][0] == '\0')
             return error_at(r, r->cols[i], "empty field in column '%s' (expected a number)",
                             t->names[i]);
-        if (!parse_number(r->fields[i], &row[i]))
+        int ok = parse_cell(r->fields[i], &row[i]);
+        if (ok == 0)
             return error_at(r, r->cols[i], "'%.40s' in column '%s' is not a number",
                             r->fields[i], t->names[i]);
+        if (ok < 0)
+            return error_at(r, r->cols[i], "'%.40s' in column '%s' is not a finite number "
+                            "(beyond the range of a double)", r->fields[i], t->names[i]);
     }
     t->nrows++;
     return MECH_OK;
@@ -696,6 +738,7 @@ int compare_exit_status(int status)
     case COMPARE_DIFFER:
         return 1;  /* both files valid, some value or column differs */
     case MECH_EIO:
+    case MECH_ENOMEM:  /* "out of memory" is recorded; not the files' fault */
         return MECH_EXIT_IO;
     default:
         return MECH_EXIT_INPUT;

@@ -76,7 +76,8 @@ int compare_tables(const compare_table *out, const compare_table *golden, const 
 int compare_csv_files(const char *out, const char *golden, const compare_options *o,
                       FILE *report, FILE *errors);
 
-/* Exit code of a status: 0 match, 1 differ, 2 malformed or bad usage, 3 unreadable. */
+/* Exit code of a status: 0 match, 1 differ, 2 malformed or bad usage, 3 unreadable
+ * or out of memory. */
 int compare_exit_status(int status);
 
 /* `mech compare [options] OUT.csv GOLDEN.csv`: argv[0] is "compare";

@@ -209,6 +209,18 @@ static int build_pattern(forces_plan *fp)
     return 0;
 }
 
+/* 1 when nothing in m can load a joint: no moving link has a mass or an
+ * inertia and there are no loads (gravity acts on masses only). */
+static int nothing_loads(const mech_model *m)
+{
+    if (m->nloads > 0)
+        return 0;
+    for (int i = 1; i < m->nlinks; i++)
+        if (m->links[i].mass != 0.0 || m->links[i].inertia != 0.0)
+            return 0;
+    return 1;
+}
+
 static int no_memory(const mech_model *m, mech_diag *d)
 {
     return diag_error(d, m->file, (mech_mark){0, 0}, "out of memory"), MECH_ENOMEM;
@@ -249,6 +261,11 @@ int forces_plan_init(forces_plan *fp, const solver_plan *sp, int friction, mech_
         return diag_error(d, m->file, m->driver.mark,
                           "the force analysis is structurally singular: some reaction appears in "
                           "no equilibrium equation that could determine it"), MECH_EINPUT;
+    if (nothing_loads(m))  /* the zeros are right, but likely not what was meant */
+        diag_note(d, m->file, m->driver.mark,
+                  "no link has a mass and there are no loads: every joint reaction and the "
+                  "driver %s are zero (give links a 'mass' or add 'loads')",
+                  m->driver.kind == MECH_DRIVE_ANGLE ? "torque" : "force");
     return MECH_OK;
 }
 

@@ -25,6 +25,11 @@ void diag_warning(mech_diag *d, const char *file, mech_mark at, const char *fmt,
 
 /* ---- util.c: checked allocation and small string helpers. */
 void *xcalloc(size_t n, size_t size);           /* NULL on overflow or failure */
+/* For tests of the out-of-memory paths: when > 0, it counts down at every
+ * xcalloc, xrealloc_array and xstrdup of this thread, and the one that
+ * brings it to 0 fails (later ones succeed). Thread-local: a test that sets
+ * it does not disturb other threads. */
+extern _Thread_local long xalloc_fail_countdown;
 void *xrealloc_array(void *p, size_t n, size_t size);
 char *xstrdup(const char *s);
 int edit_distance(const char *a, const char *b); /* Levenshtein, capped at 99 */

@@ -5,8 +5,18 @@
 
 #include "internal.h"
 
+_Thread_local long xalloc_fail_countdown;
+
+/* 1 when the test hook says this allocation fails. */
+static int fail_now(void)
+{
+    return xalloc_fail_countdown > 0 && --xalloc_fail_countdown == 0;
+}
+
 void *xcalloc(size_t n, size_t size)
 {
+    if (fail_now())
+        return NULL;
     if (n == 0 || size == 0)
         n = size = 1;
     return calloc(n, size);
@@ -14,7 +24,7 @@ void *xcalloc(size_t n, size_t size)
 
 void *xrealloc_array(void *p, size_t n, size_t size)
 {
-    if (size && n > SIZE_MAX / size)
+    if (fail_now() || (size && n > SIZE_MAX / size))
         return NULL;
     size_t bytes = n * size;
     return realloc(p, bytes ? bytes : 1);
@@ -22,6 +32,8 @@ void *xrealloc_array(void *p, size_t n, size_t size)
 
 char *xstrdup(const char *s)
 {
+    if (fail_now())
+        return NULL;
     size_t n = strlen(s) + 1;
     char *c = malloc(n);
     if (c)

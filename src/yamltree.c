@@ -79,7 +79,10 @@ static int append(ynode *parent, ynode *child)
     return 0;
 }
 
-/* Attach a finished node to the open collection (or make it the root). */
+/* Attach a finished node to the open collection (or make it the root).
+ * When there is no memory to, n is freed and the error recorded here, at
+ * n's mark: a caller must not touch n after a failure (on_open used to
+ * read n->mark for its message after n was freed). */
 static int attach(builder *b, ynode *n)
 {
     if (b->depth == 0) {
@@ -87,8 +90,9 @@ static int attach(builder *b, ynode *n)
         return 0;
     }
     if (append(b->stack[b->depth - 1], n) < 0) {
+        mech_mark at = n->mark;
         ytree_free(n);
-        return -1;
+        return diag_error(b->d, b->file, at, "out of memory");
     }
     return 0;
 }
@@ -148,7 +152,7 @@ static int on_open(builder *b, const yaml_event_t *ev, ynode_kind kind)
     if (!n)
         return -1;
     if (attach(b, n) < 0)
-        return diag_error(b->d, b->file, n->mark, "out of memory");
+        return -1;  /* n is freed, the error recorded */
     b->stack[b->depth++] = n;
     return 0;
 }

@@ -137,6 +137,38 @@ run "mech solve bad option" 2 "$MECH" solve mechanisms/fourbar.yaml --frobnicate
 run "mech solve --steps 0" 2 "$MECH" solve mechanisms/fourbar.yaml --steps 0 && pass
 run "mech solve --from without --to" 2 "$MECH" solve mechanisms/fourbar.yaml --from 10 && pass
 run "mech solve --from with a wrong unit" 2 "$MECH" solve mechanisms/fourbar.yaml --from 10kg --to 20 && pass
+# command-line ranges are checked like the file's: finite, and positions a
+# step can still move (--to 1e20 said "assembles from 0 deg to 0 deg")
+if run "mech solve --to 1e20" 2 "$MECH" solve mechanisms/fourbar.yaml --from 0 --to 1e20; then
+    has_line "$tmp/err" "within +-1e6 rad" "--to 1e20: the limit named"
+fi
+run "mech solve --from -1e308" 2 "$MECH" solve mechanisms/fourbar.yaml --from -1e308 --to 0 && pass
+run "mech solve --to 1e400" 2 "$MECH" solve mechanisms/fourbar.yaml --from 0 --to 1e400 && pass
+run "mech solve --from/--to over 3 turns" 0 "$MECH" solve mechanisms/fourbar.yaml --from -360 --to 720 --steps 3 && pass
+# a tolerance below what double precision reaches is refused (1e-300 was
+# accepted, then "cannot assemble, residual 7e-18")
+if run "mech solve --tol 1e-300" 2 "$MECH" solve mechanisms/fourbar.yaml --tol 1e-300; then
+    has_line "$tmp/err" "from 1e-15" "--tol: the limit named"
+fi
+# forces of a mechanism without masses or loads are all zero: said, not silent
+if run "mech solve --forces, no mass" 0 "$MECH" solve mechanisms/slider-crank.yaml --forces; then
+    has_line "$tmp/err" "note: no link has a mass and there are no loads" "--forces without masses: a note"
+fi
+if run "mech solve --forces, masses" 0 "$MECH" solve mechanisms/conveyor.yaml --forces; then
+    grep -q "no link has a mass" "$tmp/err" && fail "--forces with masses: the no-mass note" || pass
+fi
+if run "mech sweep --forces, no mass" 0 "$MECH" sweep mechanisms/slider-crank.yaml --vary r=30mm:60mm:3 --forces; then
+    [ "$(grep -c 'no link has a mass' "$tmp/err")" -eq 1 ] && pass || fail "sweep --forces without masses: expected the note once: $(cat "$tmp/err")"
+fi
+run "mech solve --tol nan" 2 "$MECH" solve mechanisms/fourbar.yaml --tol nan && pass
+run "mech solve --tol 1e-15" 0 "$MECH" solve mechanisms/fourbar.yaml --tol 1e-15 && pass
+# out of memory has its own message and exit status 3, not 2 "invalid input"
+# (a memory limit does not work with AddressSanitizer's shadow memory)
+if ! grep -q __asan_init "$MECH"; then
+    if run "mech solve out of memory" 3 sh -c "ulimit -v 200000; exec \"\$0\" solve mechanisms/conveyor.yaml --steps 1000000 --forces" "$MECH"; then
+        has_line "$tmp/err" "out of memory" "out of memory: said"
+    fi
+fi
 run "mech solve missing file" 3 "$MECH" solve "$tmp/nonexistent.yaml" && pass
 run "mech solve unwritable output" 3 "$MECH" solve mechanisms/fourbar.yaml -o "$tmp/no/such/dir/x.csv" && pass
 
@@ -209,6 +241,14 @@ fi
 run "mech batch --shard 2/2" 2 "$MECH" batch --shard 2/2 mechanisms/fourbar.yaml && pass
 run "mech batch no files" 2 "$MECH" batch -j 2 && pass
 
+# ---- mech plot ------------------------------------------------------------
+
+# a long sweep is thinned to what a figure shows (200 000 steps wrote 71 MB)
+if run "mech plot --steps 200000" 0 "$MECH" plot mechanisms/fourbar.yaml --steps 200000 --out "$tmp/fig"; then
+    kb=$(du -sk "$tmp/fig" | cut -f1)
+    [ "$kb" -lt 3000 ] && pass || fail "plot of 200 000 steps: $kb KB of SVG, expected under 3 MB"
+fi
+
 # ---- mech sweep -----------------------------------------------------------
 
 if run "mech sweep" 0 "$MECH" sweep mechanisms/slider-crank.yaml --vary r=30mm:60mm:4 --list l=45mm,140mm --metric range:x_B.s -j 2 -o "$tmp/sw.csv"; then
@@ -224,6 +264,40 @@ if run "mech sweep unknown parameter" 2 "$MECH" sweep mechanisms/slider-crank.ya
     has_line "$tmp/err" "no parameter 'rr'" "sweep: unknown parameter named"
 fi
 run "mech sweep bad range" 2 "$MECH" sweep mechanisms/slider-crank.yaml --vary r=30mm:60:4 && pass
+# a metric's column is checked before anything is solved (it gave nan rows, exit 0)
+sc=mechanisms/slider-crank.yaml
+if run "mech sweep unknown metric column" 2 "$MECH" sweep $sc --vary r=30mm:60mm:4 --metric range:x_B.ss; then
+    has_line "$tmp/err" "no column 'x_B.ss' in the output.*did you mean 'x_B.s'" "sweep: unknown metric column named"
+    [ -s "$tmp/out" ] && fail "sweep: unknown metric column: rows written" || pass
+fi
+run "mech sweep range:nosuch" 2 "$MECH" sweep $sc --vary r=30mm:60mm:2 --metric range:nosuch && pass
+run "mech sweep torque metric without --forces" 2 "$MECH" sweep $sc --vary r=30mm:60mm:2 --metric maxabs:driver.torque && pass
+if run "mech sweep transmission: unknown link" 2 "$MECH" sweep $sc --vary r=30mm:60mm:2 --metric transmission:crank,rid; then
+    has_line "$tmp/err" "no column 'rid.angle'.*did you mean 'rod.angle'" "sweep: transmission link named"
+fi
+# the first variant cannot assemble: its columns are known all the same
+if run "mech sweep, first variant fails" 0 "$MECH" sweep $sc --vary r=60mm:30mm:4 --list l=45mm,140mm --metric range:x_B.s; then
+    has_line "$tmp/out" '^0,60 mm,45mm,no-assembly,' "sweep: variant 0 cannot assemble"
+    has_line "$tmp/out" '^1,60 mm,140mm,ok,73,0.12$' "sweep: the others are solved"
+fi
+# every variant fails: exit 1, the rows still written
+if run "mech sweep, no variant solved" 1 "$MECH" sweep $sc --vary r=300mm:600mm:2 --metric range:x_B.s; then
+    rows=$(grep -c ',no-assembly,' "$tmp/out")
+    [ "$rows" -eq 2 ] && pass || fail "sweep, no variant solved: $rows no-assembly rows, expected 2"
+    has_line "$tmp/err" "none of the 2 variants could be solved" "sweep: no variant solved, said"
+fi
+run "mech sweep, a parameter varied twice" 2 "$MECH" sweep $sc --vary r=30mm:60mm:2 --list r=45mm && pass
+# a --list value cannot add rows or cells to the CSV
+nl='
+'
+if run "mech sweep --list with a newline" 2 "$MECH" sweep $sc --list "l=140mm${nl}99,injected"; then
+    has_line "$tmp/err" "control character (byte 0x0a)" "sweep: control character named"
+    [ -s "$tmp/out" ] && fail "sweep --list with a newline: rows written" || pass
+fi
+if run "mech sweep --list with a quote" 0 "$MECH" sweep $sc --list 'l=140mm,"9"'; then
+    has_line "$tmp/out" '^1,"""9""",invalid,0$' "sweep: a quote in a cell is quoted (RFC 4180)"
+    [ "$(wc -l <"$tmp/out")" -eq 3 ] && pass || fail "sweep --list with a quote: $(wc -l <"$tmp/out") lines, expected 3"
+fi
 
 # ---- bare driver angles are radians (issue 16 item 8) -----------------------
 

@@ -397,6 +397,36 @@ Test(compare, malformed_rows_give_line_and_column)
     run_free(&r);
 }
 
+/* Cells are numbers as the solver writes them: 1e999 read as inf and then
+ * "matched" an inf, and hex was taken; both are errors at their place. */
+Test(compare, cells_are_finite_decimal_numbers_or_nan_inf)
+{
+    static const char golden[] = "q [rad],B.x [m]\n0,inf\n1,8\n2,1\n3,-inf\n4,5\n";
+    run r = compare_texts("q [rad],B.x [m]\n0,1e999\n1,0x1p3\n2,Infinity\n3,-1e999\n4,5.\n",
+                          golden);
+    cr_expect_eq(r.rc, MECH_EINPUT, "errors:\n%s\nreport:\n%s", r.errors, r.report);
+    expect_error(&r, r.out, 2, 3, "'1e999' in column 'B.x' is not a finite number");
+    expect_error(&r, r.out, 3, 3, "'0x1p3' in column 'B.x' is not a number");
+    expect_error(&r, r.out, 4, 3, "'Infinity' in column 'B.x' is not a number");
+    expect_error(&r, r.out, 5, 3, "'-1e999' in column 'B.x' is not a finite number");
+    cr_expect_null(strstr(r.errors, ":6:"), "'5.' is a number: %s", r.errors);
+    run_free(&r);
+    npaths = 0;
+    /* what %.17g writes is read back: signs, exponents, nan, -nan, inf */
+    r = compare_texts("a [m],b [m]\n-1.5e-07,nan\n+2,-nan\n.5,inf\n1E+300,-inf\n1e-999,0\n",
+                      "a [m],b [m]\n-1.5e-07,nan\n2,nan\n0.5,inf\n1e300,-inf\n0,0\n");
+    cr_expect_eq(r.rc, MECH_OK, "errors:\n%s\nreport:\n%s", r.errors, r.report);
+    run_free(&r);
+}
+
+/* Out of memory is not a malformed file: exit 3 with its message, not 2. */
+Test(compare, out_of_memory_is_exit_3)
+{
+    cr_expect_eq(compare_exit_status(MECH_ENOMEM), 3);
+    cr_expect_eq(compare_exit_status(MECH_EINPUT), 2);
+    cr_expect_eq(compare_exit_status(MECH_EIO), 3);
+}
+
 Test(compare, malformed_header)
 {
     run r = compare_texts(golden3, "q [rad],B.x,B.x [m], [s]\n0,1,2,3\n");

@@ -105,3 +105,104 @@ Test(plot, figures_follow_the_outputs)
     mech_table_free(&t);
     mech_model_free(&m);
 }
+
+/* The vertices of the first series' path in an SVG figure (its "d"), as
+ * pixel y values; returns how many, and the smallest and largest y (top
+ * and bottom of the curve) as printed. */
+static int path_vertices(const char *svg, char *ymin, char *ymax, size_t size)
+{
+    const char *d = strstr(svg, "<path stroke=\"#1f4e99\"");
+    cr_assert(d, "no series path");
+    d = strstr(d, " d=\"") + 4;
+    const char *end = strchr(d, '"');
+    int n = 0;
+    double lo = INFINITY, hi = -INFINITY;
+    for (const char *p = d; p < end;) {
+        p += strspn(p, "ML ");
+        char *e;
+        strtod(p, &e);  /* x */
+        cr_assert_eq(*e, ',', "a vertex is x,y: %.40s", p);
+        const char *ys = e + 1;
+        double y = strtod(ys, &e);
+        size_t len = (size_t)(e - ys);
+        if (y < lo) {
+            lo = y;
+            snprintf(ymin, size, "%.*s", (int)len, ys);
+        }
+        if (y > hi) {
+            hi = y;
+            snprintf(ymax, size, "%.*s", (int)len, ys);
+        }
+        n++;
+        p = e;
+    }
+    return n;
+}
+
+static char *read_whole(const char *path, size_t *len)
+{
+    FILE *fp = fopen(path, "rb");
+    cr_assert(fp);
+    fseek(fp, 0, SEEK_END);
+    *len = (size_t)ftell(fp);
+    rewind(fp);
+    char *buf = malloc(*len + 1);
+    cr_assert(buf && fread(buf, 1, *len, fp) == *len);
+    buf[*len] = '\0';
+    fclose(fp);
+    return buf;
+}
+
+/* A table of n rows: q from 0 to 360 deg, column 1 a sine with a one-row
+ * spike up (row n/3, +5) and down (row 2n/3, -7). */
+static void spiky_table(mech_table *t, int n)
+{
+    t->ncolumns = 2;
+    t->nrows = n;
+    t->columns = calloc(2, sizeof *t->columns);
+    t->columns[0] = (mech_column){strdup("q"), strdup("rad")};
+    t->columns[1] = (mech_column){strdup("y"), strdup("-")};
+    t->values = malloc(2 * (size_t)n * sizeof *t->values);
+    for (int r = 0; r < n; r++) {
+        double q = 6.283185307179586 * r / (n - 1);
+        t->values[2 * r] = q;
+        t->values[2 * r + 1] = r == n / 3 ? 5.0 : r == 2 * n / 3 ? -7.0 : sin(q);
+    }
+}
+
+/* A 200 000-step figure is thinned to its pixel columns (it took 70 MB for
+ * a four-bar's figures) and keeps the curve's extremes: the one-row spikes
+ * are drawn to the same pixel as in a short table with the same range. */
+Test(plot, long_sweeps_are_thinned_to_the_pixel_columns)
+{
+    mech_model *m = load(fourbar);
+    plot_figure fg = {.name = "y", .title = "spikes", .ylabel = "y", .yunit = "-",
+                      .yscale = 1.0, .col = {1}, .label = {"y"}, .nseries = 1};
+    char dir[] = "/tmp/mech-plot-XXXXXX", path[96];
+    cr_assert(mkdtemp(dir));
+    snprintf(path, sizeof path, "%s/f.svg", dir);
+    mech_diag d;
+    mech_diag_init(&d);
+    char top[2][32], bottom[2][32];
+    int nvert[2];
+    size_t bytes[2];
+    const int rows[2] = {200001, 1000};  /* thinned; drawn whole (same axes) */
+    for (int k = 0; k < 2; k++) {
+        mech_table t = {0};
+        spiky_table(&t, rows[k]);
+        cr_assert_eq(plot_figure_write(m, &t, &fg, NULL, path, &d), MECH_OK);
+        char *svg = read_whole(path, &bytes[k]);
+        nvert[k] = path_vertices(svg, top[k], bottom[k], sizeof top[k]);
+        free(svg);
+        mech_table_free(&t);
+    }
+    cr_expect_lt(bytes[0], 200000, "a 200 000-row figure takes %zu bytes", bytes[0]);
+    cr_expect_leq(nvert[0], 4 * 505, "%d vertices for 505 pixel columns", nvert[0]);
+    cr_expect_eq(nvert[1], 1000, "a short table is drawn whole");
+    cr_expect_str_eq(top[0], top[1], "the spike up is lost");
+    cr_expect_str_eq(bottom[0], bottom[1], "the spike down is lost");
+    unlink(path);
+    rmdir(dir);
+    mech_diag_free(&d);
+    mech_model_free(&m);
+}
