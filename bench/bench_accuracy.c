@@ -433,6 +433,7 @@ static int run(const char *base, const mech_model *m, double tol, int steps, res
         mech_solve_options o;
         mech_solve_options_default(&o);
         o.tol = tol;
+        o.forces = -1; /* kinematics only */
         o.has_range = 1;
         o.from = m->driver.values[0];
         o.to = o.from + 2 * M_PI;
@@ -501,7 +502,6 @@ int main(int argc, char **argv)
             return 1;
         }
         mech_diag_free(&d);
-        m->outputs.forces = 0;
         for (int k = 0; k < NTOL; k++) {
             if (run(files[f], m, tols[k], 360, &rt[f][k]))
                 rt[f][k].ms_per_rev = NAN;

@@ -402,6 +402,7 @@ static double time_interpreter(const mech_model *m, double tol, mech_table *keep
         mech_solve_options o;
         mech_solve_options_default(&o);
         o.tol = tol;
+        o.forces = -1; /* kinematics only, like the hand-written solvers */
         mech_table t = {0};
         mech_diag d;
         mech_diag_init(&d);
@@ -468,7 +469,6 @@ static mech_model *load(const char *dir, const char *file)
         exit(1);
     }
     mech_diag_free(&d);
-    m->outputs.forces = 0; /* kinematics only, like the hand-written solvers */
     return m;
 }
 

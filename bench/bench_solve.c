@@ -19,18 +19,16 @@ static int cmp(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-static void bench_level(mech_model *m, const char *file, const char *label, int want,
+static void bench_level(const mech_model *m, const char *file, const char *label, int want,
                         int forces)
 {
-    int file_forces = m->outputs.forces;
-    m->outputs.forces = forces; /* the kinematic levels without the file's forces */
     double us[REPS];
     mech_solve_stats st = {0};
     for (int r = 0; r < REPS; r++) {
         mech_solve_options o;
         mech_solve_options_default(&o);
         o.want = want;
-        o.forces = forces;
+        o.forces = forces ? 1 : -1; /* the kinematic levels without the file's forces */
         mech_table t = {0};
         mech_diag d;
         mech_diag_init(&d);
@@ -38,14 +36,12 @@ static void bench_level(mech_model *m, const char *file, const char *label, int 
             mech_diag_print(&d, stderr);
             mech_diag_free(&d);
             mech_table_free(&t);
-            m->outputs.forces = file_forces;
             return;
         }
         mech_diag_free(&d);
         mech_table_free(&t);
         us[r] = st.seconds / st.steps * 1e6;
     }
-    m->outputs.forces = file_forces;
     qsort(us, REPS, sizeof us[0], cmp);
     printf("%-24s %-6s %5d %4d/%-4d %9.3f %9.3f %9.3f %8.2f %5d %10.2e %9.3g\n", file,
            label, st.steps, st.nsolved, st.nunknowns, us[REPS / 2], us[0], us[REPS - 1],

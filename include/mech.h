@@ -273,8 +273,11 @@ typedef struct mech_solve_options {
     double from, to;   /* driver positions, SI (rad or m) */
     int steps;
     FILE *log;         /* when not NULL: which blocks are solved, and why (--verbose) */
-    int forces;        /* 1: joint reactions and driver torque even if the file's
-                          outputs do not ask for them (outputs: forces: true) */
+    int forces;        /* 0: joint reactions and driver torque when the outputs ask
+                          for them (outputs: forces: true); 1: also when they do not;
+                          -1: not even when they do */
+    const mech_outputs *outputs; /* what to output instead of the file's outputs
+                          (mech_outputs_parse), or NULL; borrowed for the analysis */
     int friction;      /* MECH_FRICTION_*: how joint friction enters the forces */
     int linear_solver; /* MECH_LINEAR_*: how the Jacobians are factored */
 } mech_solve_options;
@@ -381,10 +384,14 @@ int mech_analysis_solve(const mech_analysis *a, const double *q, int nq, mech_ta
  * (is_angle) or millimetres, or give a unit ("2.0864 rad", "0.15 m"). */
 int mech_parse_value(const char *text, int is_angle, double *si, char *err, size_t errsize);
 
-/* Replace the model's kinematic outputs by a comma-separated list of point,
- * moving-link and slider names; on an unknown name returns MECH_EINPUT with
- * a message in err (the model is unchanged). */
-int mech_select_outputs(mech_model *m, const char *list, char *err, size_t errsize);
+/* Parse a comma-separated list of point, moving-link and slider names into
+ * *out (the model's `forces` choice is kept); the caller frees it with
+ * mech_outputs_free and passes it as mech_solve_options.outputs: the model
+ * itself never changes after load. On an unknown, repeated or empty name
+ * returns MECH_EINPUT with a message in err (*out untouched). */
+int mech_outputs_parse(const mech_model *m, const char *list, mech_outputs *out, char *err,
+                       size_t errsize);
+void mech_outputs_free(mech_outputs *o);
 
 /* Write a table as CSV (header "name [unit]"), to a temporary file in the
  * same directory renamed over `path` when complete; "-" writes to stdout.

@@ -305,56 +305,53 @@ int cmd_plot(int argc, char **argv)
     if (code >= 0)
         return code;
     char err[256];
-    if (a.outputs && mech_select_outputs(m, a.outputs, err, sizeof err) != MECH_OK) {
+    /* --outputs: the figures and the solve see a view of the model with
+       other outputs; the loaded model itself never changes */
+    mech_model view = *m;
+    mech_outputs selected = {0};
+    if (a.outputs && mech_outputs_parse(m, a.outputs, &selected, err, sizeof err) != MECH_OK) {
         fprintf(stderr, "mech plot: --outputs: %s\n", err);
         mech_model_free(&m);
         return MECH_EXIT_INPUT;
     }
+    if (a.outputs)
+        view.outputs = selected;
     mech_solve_options o;
     mech_solve_options_default(&o);
     o.forces = a.forces;
     if (a.friction >= 0)
         o.friction = a.friction;
-    else if ((a.forces || m->outputs.forces) && any_friction(m))
+    else if ((a.forces || view.outputs.forces) && any_friction(m))
         o.friction = MECH_FRICTION_BOTH;
     apply_steps(&a, m, &o);
     mech_table t = {0};
-    code = solve(&a, m, &o, &t);
+    code = solve(&a, &view, &o, &t);
     if (code == MECH_EXIT_OK)
-        code = write_figures(&a, m, &t);
+        code = write_figures(&a, &view, &t);
     mech_table_free(&t);
+    mech_outputs_free(&selected);
     mech_model_free(&m);
     return code;
 }
 
-/* Outputs of the animation: every point name and every moving link; the
- * file's output points are kept in *trace (owned by the caller). */
-static int select_everything(mech_model *m, int **trace, int *ntrace)
+/* Outputs of the animation: every point name and every moving link, no
+ * forces (*all, owned by the caller). */
+static int select_everything(const mech_model *m, mech_outputs *all)
 {
-    int *pts = malloc(((size_t)m->npoint_names + 1) * sizeof *pts);
-    int *links = malloc(((size_t)m->nlinks + 1) * sizeof *links);
-    int *sliders = malloc(sizeof *sliders);
-    if (!pts || !links || !sliders) {
-        free(pts);
-        free(links);
-        free(sliders);
+    memset(all, 0, sizeof *all);
+    all->points = malloc(((size_t)m->npoint_names + 1) * sizeof *all->points);
+    all->links = malloc(((size_t)m->nlinks + 1) * sizeof *all->links);
+    all->sliders = malloc(sizeof *all->sliders);
+    if (!all->points || !all->links || !all->sliders) {
+        mech_outputs_free(all);
         return -1;
     }
     for (int p = 0; p < m->npoint_names; p++)
-        pts[p] = p;
+        all->points[p] = p;
     for (int i = 1; i < m->nlinks; i++)
-        links[i - 1] = i;
-    *trace = m->outputs.points;
-    *ntrace = m->outputs.npoints;
-    free(m->outputs.links);
-    free(m->outputs.sliders);
-    m->outputs.points = pts;
-    m->outputs.npoints = m->npoint_names;
-    m->outputs.links = links;
-    m->outputs.nlinks = m->nlinks - 1;
-    m->outputs.sliders = sliders;
-    m->outputs.nsliders = 0;
-    m->outputs.forces = 0;
+        all->links[i - 1] = i;
+    all->npoints = m->npoint_names;
+    all->nlinks = m->nlinks - 1;
     return 0;
 }
 
@@ -365,29 +362,32 @@ int cmd_animate(int argc, char **argv)
     int code = begin("animate", argc, argv, &a, &m);
     if (code >= 0)
         return code;
-    int *trace = NULL, ntrace = 0;
-    if (select_everything(m, &trace, &ntrace) != 0) {
+    /* the file's output points are traced; every point and link is drawn,
+       through a view of the model with those outputs */
+    mech_model view = *m;
+    if (select_everything(m, &view.outputs) != 0) {
         fprintf(stderr, "mech animate: out of memory\n");
         mech_model_free(&m);
         return MECH_EXIT_IO;
     }
-    a.anim.trace = trace;
-    a.anim.ntrace = ntrace;
+    a.anim.trace = m->outputs.points;
+    a.anim.ntrace = m->outputs.npoints;
     mech_solve_options o;
     mech_solve_options_default(&o);
     o.want = MECH_WANT_POSITION;
+    o.forces = -1;
     apply_steps(&a, m, &o);
     mech_table t = {0};
-    code = solve(&a, m, &o, &t);
+    code = solve(&a, &view, &o, &t);
     if (code == MECH_EXIT_OK) {
         mech_diag d;
         mech_diag_init(&d);
-        int rc = plot_animation_write(m, &t, &a.anim, a.out ? a.out : "-", &d);
+        int rc = plot_animation_write(&view, &t, &a.anim, a.out ? a.out : "-", &d);
         mech_diag_print(&d, stderr);
         mech_diag_free(&d);
         code = cmd_exit_status(rc);
     }
-    free(trace);
+    mech_outputs_free(&view.outputs);
     mech_table_free(&t);
     mech_model_free(&m);
     return code;

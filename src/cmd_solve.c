@@ -75,6 +75,7 @@ typedef struct solve_args {
     char *set_text[MAX_SET];
     int nset;
     int steps, stats, verbose;
+    mech_outputs selected;       /* --outputs, parsed (opt.outputs points here) */
     mech_solve_options opt;
 } solve_args;
 
@@ -227,8 +228,9 @@ static int parse_end(const char *opt, const char *text, int is_angle, double *si
     return -1;
 }
 
-/* Apply --from/--to/--steps and --outputs to the loaded model. */
-static int apply_overrides(solve_args *a, mech_model *m)
+/* --from/--to/--steps and --outputs into the options (the model is not
+ * changed). */
+static int apply_overrides(solve_args *a, const mech_model *m)
 {
     char err[256];
     int is_angle = m->driver.kind == MECH_DRIVE_ANGLE, code;
@@ -245,8 +247,11 @@ static int apply_overrides(solve_args *a, mech_model *m)
         a->opt.to = m->driver.values[m->driver.nvalues - 1];
         a->opt.steps = a->steps;
     }
-    if (a->outputs && mech_select_outputs(m, a->outputs, err, sizeof err) != MECH_OK)
-        return fprintf(stderr, "mech solve: --outputs: %s\n", err), MECH_EXIT_INPUT;
+    if (a->outputs) {
+        if (mech_outputs_parse(m, a->outputs, &a->selected, err, sizeof err) != MECH_OK)
+            return fprintf(stderr, "mech solve: --outputs: %s\n", err), MECH_EXIT_INPUT;
+        a->opt.outputs = &a->selected;
+    }
     return -1;
 }
 
@@ -314,6 +319,7 @@ int cmd_solve(int argc, char **argv)
         mech_diag_free(&d);
     }
     mech_table_free(&t);
+    mech_outputs_free(&a.selected);
     mech_model_free(&m);
     return code;
 }

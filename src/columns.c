@@ -49,7 +49,8 @@ static int add_levels(column_layout *cl, int level, column_source src, int obj, 
     return rc;
 }
 
-static int kinematic_columns(column_layout *cl, const mech_model *m, int level)
+static int kinematic_columns(column_layout *cl, const mech_model *m, const mech_outputs *o,
+                             int level)
 {
     static const char *const pt_sfx[] = {".x", ".y", ".vx", ".vy", ".ax", ".ay"};
     static const char *const pt_unit[] = {"m", "m", "m/s", "m/s", "m/s^2", "m/s^2"};
@@ -57,7 +58,6 @@ static int kinematic_columns(column_layout *cl, const mech_model *m, int level)
     static const char *const link_unit[] = {"rad", "rad/s", "rad/s^2"};
     static const char *const slide_sfx[] = {".s", ".v", ".a"};
     static const char *const slide_unit[] = {"m", "m/s", "m/s^2"};
-    const mech_outputs *o = &m->outputs;
     int rc = add(cl, SRC_DRIVER, 0, 0, "q", "", m->driver.kind == MECH_DRIVE_ANGLE ? "rad" : "m");
     for (int i = 0; i < o->npoints; i++)
         for (int k = 0; k < 6; k++)
@@ -192,7 +192,7 @@ static int make_groups(column_layout *cl)
 int columns_build(column_layout *cl, const mech_model *m, const column_request *rq)
 {
     memset(cl, 0, sizeof *cl);
-    int rc = kinematic_columns(cl, m, rq->level);
+    int rc = kinematic_columns(cl, m, rq->outputs, rq->level);
     if (!rc && rq->forces)
         rc = dynamic_columns(cl, m, rq);
     if (!rc && rq->diagnostics)

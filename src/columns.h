@@ -59,13 +59,14 @@ typedef struct column_layout {
 
 /* What a layout must hold. */
 typedef struct column_request {
+    const mech_outputs *outputs; /* the points, links and sliders */
     int level;           /* MECH_WANT_* bits: rates of points, links, sliders */
     int forces;          /* reactions, driver load, power residual */
     int friction;        /* 0 none, 1 friction columns, 2 also the frictionless set */
     int diagnostics;     /* iterations, residual, rcond, substeps */
 } column_request;
 
-/* The columns of the model's outputs. MECH_OK or MECH_ENOMEM. */
+/* The columns of the request's outputs. MECH_OK or MECH_ENOMEM. */
 int columns_build(column_layout *cl, const mech_model *m, const column_request *rq);
 void columns_free(column_layout *cl);
 /* Give the table the layout's names and units (owned copies) and room for

@@ -364,7 +364,8 @@ static const char **all_names(const mech_model *m, int *count)
     return v;
 }
 
-int mech_select_outputs(mech_model *m, const char *list, char *err, size_t errsize)
+int mech_outputs_parse(const mech_model *m, const char *list, mech_outputs *out, char *err,
+                       size_t errsize)
 {
     size_t len = strlen(list);
     char *copy = xstrdup(list);
@@ -404,9 +405,16 @@ int mech_select_outputs(mech_model *m, const char *list, char *err, size_t errsi
         free(o.sliders);
         return rc;
     }
-    free(m->outputs.points);
-    free(m->outputs.links);
-    free(m->outputs.sliders);
-    m->outputs = o;
+    *out = o;
     return MECH_OK;
+}
+
+void mech_outputs_free(mech_outputs *o)
+{
+    if (!o)
+        return;
+    free(o->points);
+    free(o->links);
+    free(o->sliders);
+    memset(o, 0, sizeof *o);
 }

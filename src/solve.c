@@ -59,8 +59,8 @@ static double largest_length(const mech_model *m)
 static void needed_unknowns(solver_plan *sp, unsigned char *need)
 {
     const mech_model *m = sp->m;
-    const mech_outputs *o = &m->outputs;
-    if (sp->opt.all_blocks || o->forces) {
+    const mech_outputs *o = sp->opt.outputs ? sp->opt.outputs : &m->outputs;
+    if (sp->opt.all_blocks) {
         memset(need, 1, (size_t)sp->n);
         for (int l = 1; l < m->nlinks; l++)
             sp->tree.active[l] = 1;

@@ -21,7 +21,8 @@
 
 struct mech_analysis {
     const mech_model *m;       /* borrowed: must outlive the analysis */
-    mech_solve_options opt;
+    mech_solve_options opt;    /* opt.outputs points to outputs */
+    mech_outputs outputs;      /* what is output (a copy: options' or the file's) */
     solver_plan sp;
     int want_forces;           /* joint reactions wanted */
     forces_plan fp;            /* when want_forces */
@@ -94,6 +95,22 @@ static int friction_columns(const mech_analysis *a)
     return a->opt.friction == MECH_FRICTION_BOTH ? 2 : 1;
 }
 
+static int copy_outputs(mech_outputs *to, const mech_outputs *from)
+{
+    *to = *from;
+    to->points = xcalloc((size_t)from->npoints + 1, sizeof *to->points);
+    to->links = xcalloc((size_t)from->nlinks + 1, sizeof *to->links);
+    to->sliders = xcalloc((size_t)from->nsliders + 1, sizeof *to->sliders);
+    if (!to->points || !to->links || !to->sliders) {
+        mech_outputs_free(to);
+        return -1;
+    }
+    memcpy(to->points, from->points, (size_t)from->npoints * sizeof *to->points);
+    memcpy(to->links, from->links, (size_t)from->nlinks * sizeof *to->links);
+    memcpy(to->sliders, from->sliders, (size_t)from->nsliders * sizeof *to->sliders);
+    return 0;
+}
+
 static int build_plans(mech_analysis *a, mech_diag *d)
 {
     const mech_model *m = a->m;
@@ -107,7 +124,8 @@ static int build_plans(mech_analysis *a, mech_diag *d)
     }
     if (rc != MECH_OK)
         return rc;
-    column_request rq = {a->sp.level, a->want_forces, friction_columns(a), a->opt.diagnostics};
+    column_request rq = {&a->outputs, a->sp.level, a->want_forces, friction_columns(a),
+                         a->opt.diagnostics};
     if (columns_build(&a->cols, m, &rq) != MECH_OK)
         return no_memory(m, d);
     if (!(a->values = sweep_values(m, &a->opt, &a->nvalues)))
@@ -127,7 +145,12 @@ int mech_analysis_new(const mech_model *m, const mech_solve_options *o, mech_ana
         return no_memory(m, d);
     a->m = m;
     a->opt = *o;
-    a->want_forces = o->forces || m->outputs.forces;
+    if (copy_outputs(&a->outputs, o->outputs ? o->outputs : &m->outputs) != 0) {
+        free(a);
+        return no_memory(m, d);
+    }
+    a->opt.outputs = &a->outputs;
+    a->want_forces = o->forces > 0 || (o->forces == 0 && a->outputs.forces);
     if (a->want_forces) {  /* reactions need every link's acceleration */
         a->opt.all_blocks = 1;
         a->opt.want = MECH_WANT_ALL;
@@ -148,6 +171,7 @@ void mech_analysis_free(mech_analysis **pa)
     if (!a)
         return;
     columns_free(&a->cols);
+    mech_outputs_free(&a->outputs);
     forces_plan_free(&a->fp);
     solver_plan_free(&a->sp);
     free(a->values);

@@ -115,3 +115,43 @@ Test(analysis, caller_positions_match_the_sweep)
     mech_diag_free(&d);
     mech_model_free(&m);
 }
+
+/* The model does not change after load: --outputs and "no forces" are
+ * options; the table follows them and the model's outputs stay the file's. */
+Test(analysis, outputs_are_options_not_model_changes)
+{
+    mech_model *m = load_path("mechanisms/conveyor.yaml");
+    mech_outputs before = m->outputs;
+    int *points = malloc(((size_t)before.npoints + 1) * sizeof *points);
+    memcpy(points, before.points, (size_t)before.npoints * sizeof *points);
+    mech_outputs sel = {0};
+    char err[256];
+    cr_assert_eq(mech_outputs_parse(m, "C, tray", &sel, err, sizeof err), MECH_OK, "%s", err);
+    mech_solve_options o;
+    mech_solve_options_default(&o);
+    o.outputs = &sel;
+    o.forces = -1;
+    mech_diag d;
+    mech_diag_init(&d);
+    mech_table t = {0};
+    cr_assert_eq(mech_solve(m, &o, &t, NULL, &d), MECH_OK);
+    /* q, C: x y vx vy ax ay, tray: angle omega alpha */
+    cr_assert_eq(t.ncolumns, 10, "%d columns", t.ncolumns);
+    cr_assert_str_eq(t.columns[1].name, "C.x");
+    cr_assert_str_eq(t.columns[7].name, "tray.angle");
+    cr_assert_eq(mech_table_column(&t, "driver.torque"), -1, "forces: -1 leaves them out");
+    cr_assert_eq(m->outputs.npoints, before.npoints);
+    cr_assert_eq(m->outputs.points, before.points);
+    cr_assert(memcmp(m->outputs.points, points, (size_t)before.npoints * sizeof *points) == 0);
+    cr_assert_eq(m->outputs.forces, before.forces);
+    mech_table_free(&t);
+    o.outputs = NULL;
+    o.forces = 0;  /* the file's: conveyor.yaml asks for forces */
+    cr_assert_eq(mech_solve(m, &o, &t, NULL, &d), MECH_OK);
+    cr_assert_geq(mech_table_column(&t, "driver.torque"), 0);
+    mech_table_free(&t);
+    mech_outputs_free(&sel);
+    free(points);
+    mech_diag_free(&d);
+    mech_model_free(&m);
+}
