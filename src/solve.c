@@ -249,78 +249,14 @@ done:
     return rc;
 }
 
-/* Pattern of the solved rows and columns, and the tape computing them. */
-static int compile_subset(solver_plan *sp, const unsigned char *row_on, const unsigned char *col_on)
+/* The tape of the solved rows: the residuals and Jacobian entries, then the
+ * velocity and acceleration right-hand sides, with the part that depends
+ * on the driver alone hoisted. */
+static int compile_tape(solver_plan *sp)
 {
-    const mech_system *s = sp->sys;
-    int n = sp->n, rows = s->m, ns = 0, nr = 0;
-    int *rowmap = xcalloc((size_t)rows + 1, sizeof *rowmap);
-    sp->col = xcalloc((size_t)n + 1, sizeof *sp->col);
-    sp->row = xcalloc((size_t)rows + 1, sizeof *sp->row);
-    int *Jp = xcalloc((size_t)n + 1, sizeof *Jp);
-    if (!rowmap || !sp->col || !sp->row || !Jp) {
-        free(rowmap);
-        free(Jp);
-        return -1;
-    }
-    for (int r = 0; r < rows; r++) {
-        rowmap[r] = row_on[r] ? nr : -1;
-        if (row_on[r])
-            sp->row[nr++] = r;
-    }
-    for (int c = 0; c < n; c++)
-        if (col_on[c])
-            sp->col[ns++] = c;
-    sp->ns = ns;
-    sp->nr = nr;
-    int nnz = 0;
-    for (int k = 0; k < ns; k++)
-        for (int p = s->Jp[sp->col[k]]; p < s->Jp[sp->col[k] + 1]; p++)
-            nnz += rowmap[s->Ji[p]] >= 0;
-    sp->nnzJ = nnz;
-    int *Ji = xcalloc((size_t)nnz + 1, sizeof *Ji);
-    sp->proot = xcalloc((size_t)(nr + nnz) + 1, sizeof *sp->proot);
-    sp->vroot = xcalloc((size_t)nr + 1, sizeof *sp->vroot);
-    sp->aroot = xcalloc((size_t)nr + 1, sizeof *sp->aroot);
-    if (!Ji || !sp->proot || !sp->vroot || !sp->aroot) {
-        free(rowmap);
-        free(Jp);
-        free(Ji);
-        return -1;
-    }
-    for (int i = 0; i < nr; i++) {
-        sp->proot[i] = s->f[sp->row[i]];
-        sp->vroot[i] = s->vel[sp->row[i]];
-        sp->aroot[i] = s->acc[sp->row[i]];
-    }
-    int at = 0;
-    for (int k = 0; k < ns; k++) {
-        Jp[k] = at;
-        for (int p = s->Jp[sp->col[k]]; p < s->Jp[sp->col[k] + 1]; p++)
-            if (rowmap[s->Ji[p]] >= 0) {
-                Ji[at] = rowmap[s->Ji[p]];
-                sp->proot[nr + at++] = s->Jx[p];
-            }
-    }
-    Jp[ns] = at;
-    free(rowmap);
-    int rc = 0;
-    if (sp->aug) {
-        rc = augmented_pattern(sp, Jp, Ji);
-        free(Jp);
-        free(Ji);
-    } else {  /* square: J itself is factored */
-        sp->Ap = Jp;
-        sp->Ai = Ji;
-        sp->Ax0 = xcalloc((size_t)nnz + 1, sizeof *sp->Ax0);
-        sp->N = ns;
-        sp->nnz = nnz;
-        rc = sp->Ax0 ? 0 : -1;
-    }
-    if (rc < 0)
-        return -1;
+    int n = sp->n, nr = sp->nr;
     const ex *roots[NPHASES] = {sp->proot, sp->vroot, sp->aroot};
-    int nroots[NPHASES] = {nr + nnz, nr, nr};
+    int nroots[NPHASES] = {nr + sp->nnzJ, nr, nr};
     /* dx/dq and d2x/dq2 feed the predictor even for positions only: all three
        phases (two solves with factors already there cost less than the
        Newton iteration a second-order predictor needs) */
@@ -335,6 +271,85 @@ static int compile_subset(solver_plan *sp, const unsigned char *row_on, const un
     tape_hoist(&sp->tp, PHASE_POSITION, invariant);
     free(invariant);
     return 0;
+}
+
+/* The solved rows (row) and columns (col); rowmap[r]: solved index of
+ * equation r, or -1. */
+static int choose_subset(solver_plan *sp, const unsigned char *row_on,
+                         const unsigned char *col_on, int *rowmap)
+{
+    int n = sp->n, rows = sp->sys->m;
+    sp->col = xcalloc((size_t)n + 1, sizeof *sp->col);
+    sp->row = xcalloc((size_t)rows + 1, sizeof *sp->row);
+    if (!sp->col || !sp->row)
+        return -1;
+    for (int r = 0; r < rows; r++) {
+        rowmap[r] = row_on[r] ? sp->nr : -1;
+        if (row_on[r])
+            sp->row[sp->nr++] = r;
+    }
+    for (int c = 0; c < n; c++)
+        if (col_on[c])
+            sp->col[sp->ns++] = c;
+    return 0;
+}
+
+/* The Jacobian of the solved subset (CSC: Jp, Ji) and the roots of the
+ * three phases (residuals then Jacobian entries; rate right-hand sides). */
+static int subset_jacobian(solver_plan *sp, const int *rowmap, int *Jp, int **Ji)
+{
+    const mech_system *s = sp->sys;
+    int ns = sp->ns, nr = sp->nr, nnz = 0;
+    for (int k = 0; k < ns; k++)
+        for (int p = s->Jp[sp->col[k]]; p < s->Jp[sp->col[k] + 1]; p++)
+            nnz += rowmap[s->Ji[p]] >= 0;
+    sp->nnzJ = nnz;
+    *Ji = xcalloc((size_t)nnz + 1, sizeof **Ji);
+    sp->proot = xcalloc((size_t)(nr + nnz) + 1, sizeof *sp->proot);
+    sp->vroot = xcalloc((size_t)nr + 1, sizeof *sp->vroot);
+    sp->aroot = xcalloc((size_t)nr + 1, sizeof *sp->aroot);
+    if (!*Ji || !sp->proot || !sp->vroot || !sp->aroot)
+        return -1;
+    for (int i = 0; i < nr; i++) {
+        sp->proot[i] = s->f[sp->row[i]];
+        sp->vroot[i] = s->vel[sp->row[i]];
+        sp->aroot[i] = s->acc[sp->row[i]];
+    }
+    int at = 0;
+    for (int k = 0; k < ns; k++) {
+        Jp[k] = at;
+        for (int p = s->Jp[sp->col[k]]; p < s->Jp[sp->col[k] + 1]; p++)
+            if (rowmap[s->Ji[p]] >= 0) {
+                (*Ji)[at] = rowmap[s->Ji[p]];
+                sp->proot[nr + at++] = s->Jx[p];
+            }
+    }
+    Jp[ns] = at;
+    return 0;
+}
+
+/* Pattern of the solved rows and columns, and the tape computing them. */
+static int compile_subset(solver_plan *sp, const unsigned char *row_on, const unsigned char *col_on)
+{
+    int *rowmap = xcalloc((size_t)sp->sys->m + 1, sizeof *rowmap);
+    int *Jp = xcalloc((size_t)sp->n + 1, sizeof *Jp), *Ji = NULL;
+    int rc = rowmap && Jp && choose_subset(sp, row_on, col_on, rowmap) == 0 &&
+                     subset_jacobian(sp, rowmap, Jp, &Ji) == 0 ? 0 : -1;
+    free(rowmap);
+    if (rc == 0 && sp->aug) {
+        rc = augmented_pattern(sp, Jp, Ji);
+    } else if (rc == 0) {  /* square: J itself is factored */
+        sp->Ap = Jp;
+        sp->Ai = Ji;
+        Jp = Ji = NULL;
+        sp->Ax0 = xcalloc((size_t)sp->nnzJ + 1, sizeof *sp->Ax0);
+        sp->N = sp->ns;
+        sp->nnz = sp->nnzJ;
+        rc = sp->Ax0 ? 0 : -1;
+    }
+    free(Jp);
+    free(Ji);
+    return rc == 0 ? compile_tape(sp) : -1;
 }
 
 static int level_of(int want)
