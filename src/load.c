@@ -50,9 +50,9 @@ static void load_document(loader *ld, const ynode *root)
             load_err(ld, root, "missing '%s' (a mechanism file needs name, ground, links and driver)",
                      required[i]);
     if ((v = ymap_get(root, "name")))
-        m->name = load_get_string(ld, v, "'name'", 200);
+        m->name = load_get_string(ld, v, "'name'", 200, 0);
     if ((v = ymap_get(root, "description")))
-        m->description = load_get_string(ld, v, "'description'", 4000);
+        m->description = load_get_string(ld, v, "'description'", 4000, 1);
     if ((v = ymap_get(root, "units")))
         load_units(ld, v);
     if ((v = ymap_get(root, "parameters")))
