@@ -348,8 +348,9 @@ int mech_solve(const mech_model *m, const mech_solve_options *o, mech_table *out
 int mech_parse_value(const char *text, int is_angle, double *si, char *err, size_t errsize);
 
 /* Replace the model's kinematic outputs by a comma-separated list of point,
- * moving-link and slider names; on an unknown name returns MECH_EINPUT with
- * a message in err (the model is unchanged). */
+ * moving-link and slider names; on an unknown name, a name given twice or an
+ * empty item ("B,,C", "B,") returns MECH_EINPUT with a message in err (the
+ * model is unchanged). */
 int mech_select_outputs(mech_model *m, const char *list, char *err, size_t errsize);
 
 /* Write a table as CSV (header "name [unit]"), to a temporary file in the

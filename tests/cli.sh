@@ -158,6 +158,25 @@ fi
 if run "mech solve --outputs typo" 2 "$MECH" solve mechanisms/fourbar.yaml --outputs cuopler; then
     has_line "$tmp/err" "did you mean 'coupler'" "--outputs typo"
 fi
+if run "mech solve --outputs empty item" 2 "$MECH" solve mechanisms/fourbar.yaml --outputs B,,C -o "$tmp/e.csv"; then
+    has_line "$tmp/err" "^mech solve: --outputs: item 2 of the list is empty (names are separated by one comma)$" "--outputs B,,C"
+    [ ! -e "$tmp/e.csv" ] && pass || fail "--outputs B,,C: wrote $tmp/e.csv"
+fi
+if run "mech solve --outputs trailing comma" 2 "$MECH" solve mechanisms/fourbar.yaml --outputs B, -o "$tmp/e.csv"; then
+    has_line "$tmp/err" "^mech solve: --outputs: item 2 of the list is empty" "--outputs B,"
+fi
+if run "mech solve --outputs empty" 2 "$MECH" solve mechanisms/fourbar.yaml --outputs "" -o "$tmp/e.csv"; then
+    has_line "$tmp/err" "^mech solve: --outputs: the list is empty$" "--outputs ''"
+fi
+if run "mech solve --outputs twice" 2 "$MECH" solve mechanisms/fourbar.yaml --outputs B,coupler,B -o "$tmp/e.csv"; then
+    has_line "$tmp/err" "^mech solve: --outputs: 'B' is listed twice$" "--outputs B,coupler,B"
+fi
+if run "mech plot --outputs twice" 2 "$MECH" plot mechanisms/fourbar.yaml --outputs coupler,coupler --out "$tmp/figs"; then
+    has_line "$tmp/err" "^mech plot: --outputs: 'coupler' is listed twice$" "plot --outputs coupler,coupler"
+fi
+if run "mech solve --outputs with spaces" 0 "$MECH" solve mechanisms/fourbar.yaml --outputs "A, B" -o "$tmp/ab.csv"; then
+    has_line "$tmp/ab.csv" '^q \[rad\],A\.x \[m\],' "--outputs 'A, B'"
+fi
 
 run "mech solve bad option" 2 "$MECH" solve mechanisms/fourbar.yaml --frobnicate && pass
 run "mech solve --steps 0" 2 "$MECH" solve mechanisms/fourbar.yaml --steps 0 && pass
