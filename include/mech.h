@@ -388,7 +388,8 @@ int mech_parse_value(const char *text, int is_angle, double *si, char *err, size
  * *out (the model's `forces` choice is kept); the caller frees it with
  * mech_outputs_free and passes it as mech_solve_options.outputs: the model
  * itself never changes after load. On an unknown, repeated or empty name
- * returns MECH_EINPUT with a message in err (*out untouched). */
+ * returns MECH_EINPUT with a message in err (*out untouched); an
+ * empty item ("B,,C", "B,") or a name given twice is an error too. */
 int mech_outputs_parse(const mech_model *m, const char *list, mech_outputs *out, char *err,
                        size_t errsize);
 void mech_outputs_free(mech_outputs *o);

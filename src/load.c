@@ -27,9 +27,13 @@
  * (shared tree walking), load_links.c, load_joints.c, load_motion.c and
  * load_outputs.c; load.h holds the loader's state. */
 #include <errno.h>
+#include <fcntl.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "load.h"
 
@@ -50,9 +54,9 @@ static void load_document(loader *ld, const ynode *root)
             load_err(ld, root, "missing '%s' (a mechanism file needs name, ground, links and driver)",
                      required[i]);
     if ((v = ymap_get(root, "name")))
-        m->name = load_get_string(ld, v, "'name'", 200);
+        m->name = load_get_string(ld, v, "'name'", 200, 0);
     if ((v = ymap_get(root, "description")))
-        m->description = load_get_string(ld, v, "'description'", 4000);
+        m->description = load_get_string(ld, v, "'description'", 4000, 1);
     if ((v = ymap_get(root, "units")))
         load_units(ld, v);
     if ((v = ymap_get(root, "parameters")))
@@ -167,15 +171,53 @@ static int load_string_with(const char *text, size_t len, const char *name,
     return MECH_OK;
 }
 
-/* Read a whole file into memory, refusing more than `max` bytes. */
-static char *read_file(const char *path, size_t max, size_t *len, mech_diag *d, int *rc)
+/* What a file that is not a regular file is, for the message. */
+static const char *file_kind(mode_t mode)
 {
-    FILE *f = fopen(path, "rb");
-    if (!f) {
+    return S_ISDIR(mode) ? "a directory" : S_ISFIFO(mode) ? "a FIFO (named pipe)"
+         : S_ISCHR(mode) || S_ISBLK(mode) ? "a device" : S_ISSOCK(mode) ? "a socket"
+         : "a special file";
+}
+
+/* Open a mechanism file: a regular file of at most `max` bytes, checked
+ * before anything is read (O_NONBLOCK: opening a FIFO does not wait for a
+ * writer). NULL with *rc set and the problem recorded. */
+static FILE *open_input(const char *path, size_t max, mech_diag *d, int *rc)
+{
+    int fd = open(path, O_RDONLY | O_NONBLOCK);
+    struct stat st;
+    if (fd < 0 || fstat(fd, &st) != 0) {
         *rc = MECH_EIO;
         diag_error(d, path, (mech_mark){0, 0}, "cannot open: %s", strerror(errno));
-        return NULL;
+    } else if (!S_ISREG(st.st_mode)) {
+        *rc = MECH_EIO;
+        diag_error(d, path, (mech_mark){0, 0}, "cannot read: %s, not a regular file",
+                   file_kind(st.st_mode));
+    } else if ((uintmax_t)st.st_size > (uintmax_t)max) {
+        *rc = MECH_EINPUT;
+        diag_error(d, path, (mech_mark){0, 0}, "file too large (%jd bytes; at most %zu)",
+                   (intmax_t)st.st_size, max);
+    } else {
+        int flags = fcntl(fd, F_GETFL);
+        FILE *f = flags >= 0 && fcntl(fd, F_SETFL, flags & ~O_NONBLOCK) == 0 ? fdopen(fd, "rb")
+                                                                            : NULL;
+        if (f)
+            return f;
+        *rc = MECH_EIO;
+        diag_error(d, path, (mech_mark){0, 0}, "cannot open: %s", strerror(errno));
     }
+    if (fd >= 0)
+        close(fd);
+    return NULL;
+}
+
+/* Read a whole file into memory, refusing more than `max` bytes (checked
+ * again while reading: the file may grow). */
+static char *read_file(const char *path, size_t max, size_t *len, mech_diag *d, int *rc)
+{
+    FILE *f = open_input(path, max, d, rc);
+    if (!f)
+        return NULL;
     size_t cap = 1 << 16, n = 0;
     char *buf = malloc(cap);
     while (buf) {

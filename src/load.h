@@ -85,7 +85,8 @@ const ynode *load_key_of(const ynode *map, const char *key);
 int load_uses_bad_param(const loader *ld, const char *text);
 int load_valid_name(const char *s);
 const char *load_get_name(loader *ld, const ynode *n, const char *what); /* borrowed */
-char *load_get_string(loader *ld, const ynode *n, const char *what, size_t max); /* caller frees */
+/* caller frees; `lines`: line breaks and tabs allowed */
+char *load_get_string(loader *ld, const ynode *n, const char *what, size_t max, int lines);
 int load_get_quantity(loader *ld, const ynode *n, quantity q, const char *what, double *out);
 int load_get_count(loader *ld, const ynode *n, const char *what, long lo, long hi, long *out);
 int load_get_bool(loader *ld, const ynode *n, const char *what, int *out);

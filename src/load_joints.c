@@ -208,7 +208,7 @@ static int load_slider_joint(loader *ld, const ynode *map)
     set_joint_name(ld, j, ymap_get(map, "name"), deflt);
     const ynode *sym = ymap_get(map, "symbol");
     if (sym)
-        j->symbol = load_get_string(ld, sym, "symbol", 32);
+        j->symbol = load_get_string(ld, sym, "symbol", 32, 0);
     get_friction(ld, map, j);
     return 1;
 }

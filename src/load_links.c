@@ -362,7 +362,7 @@ static void load_link(loader *ld, mech_link *l, const ynode *k, const ynode *v)
         *failed |= LINK_FAILED;
     }
     if (sym)
-        l->symbol = load_get_string(ld, sym, "symbol", 32);
+        l->symbol = load_get_string(ld, sym, "symbol", 32, 0);
     load_mass(ld, l, v);
 }
 

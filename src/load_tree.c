@@ -41,14 +41,37 @@ int load_point_in_link(const loader *ld, int li, int id)
     return lo < end && ld->carrier_link[lo] == li ? ld->carrier_point[lo] : -1;
 }
 
+/* Offset of the first control character (a byte below 0x20 or 0x7f) in
+ * s[0..len-1] other than those in `allowed`, or -1. */
+static long control_char(const char *s, size_t len, const char *allowed)
+{
+    for (size_t i = 0; i < len; i++) {
+        unsigned char c = (unsigned char)s[i];
+        if ((c < 0x20 || c == 0x7f) && !(c && strchr(allowed, c)))
+            return (long)i;
+    }
+    return -1;
+}
+
+/* The message quotes names and text from the file: its control characters
+ * are written \xNN, so that it stays one printable line. */
 int load_err(loader *ld, const ynode *n, const char *fmt, ...)
 {
-    char buf[900];
+    char buf[900], out[4 * sizeof buf];
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(buf, sizeof buf, fmt, ap);
     va_end(ap);
-    return diag_error(ld->d, ld->file, n ? n->mark : (mech_mark){0, 0}, "%s", buf);
+    size_t k = 0;
+    for (const char *s = buf; *s; s++) {
+        unsigned char c = (unsigned char)*s;
+        if (c < 0x20 || c == 0x7f)
+            k += (size_t)snprintf(out + k, sizeof out - k, "\\x%02x", c);
+        else
+            out[k++] = (char)c;
+    }
+    out[k] = '\0';
+    return diag_error(ld->d, ld->file, n ? n->mark : (mech_mark){0, 0}, "%s", out);
 }
 
 /* ---- shape checks -------------------------------------------------- */
@@ -190,6 +213,13 @@ const char *load_get_name(loader *ld, const ynode *n, const char *what)
                  MAX_NAME);
         return NULL;
     }
+    long at = control_char(n->text, n->len, "");
+    if (at >= 0) {
+        load_err(ld, n, "%s '%s' contains a control character (byte 0x%02x at character %ld); "
+                        "use letters, digits and '_', starting with a letter", what, n->text,
+                 (unsigned char)n->text[at], at + 1);
+        return NULL;
+    }
     if (!load_valid_name(n->text)) {
         load_err(ld, n, "%s '%s' is not a valid name (use letters, digits and '_', starting with a letter)",
                  what, n->text);
@@ -198,12 +228,22 @@ const char *load_get_name(loader *ld, const ynode *n, const char *what)
     return n->text;
 }
 
-char *load_get_string(loader *ld, const ynode *n, const char *what, size_t max)
+/* A text of at most `max` bytes, without control characters (they would
+ * reach the terminal, SVG and LaTeX as they are) except line breaks and
+ * tabs when `lines`. */
+char *load_get_string(loader *ld, const ynode *n, const char *what, size_t max, int lines)
 {
     if (!load_want_kind(ld, n, YNODE_SCALAR, what))
         return NULL;
     if (n->len > max) {
         load_err(ld, n, "%s is too long (at most %zu characters)", what, max);
+        return NULL;
+    }
+    long at = control_char(n->text, n->len, lines ? "\n\t" : "");
+    if (at >= 0) {
+        load_err(ld, n, "%s contains a control character (byte 0x%02x at character %ld); "
+                        "write %sprintable characters only", what, (unsigned char)n->text[at],
+                 at + 1, lines ? "" : "one line of ");
         return NULL;
     }
     return xstrdup(n->text);

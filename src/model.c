@@ -364,6 +364,66 @@ static const char **all_names(const mech_model *m, int *count)
     return v;
 }
 
+/* Add output `w` (a point, moving link or slider name) to `o`; MECH_EINPUT
+ * with a message in err when it is none of them. */
+static int add_output(const mech_model *m, mech_outputs *o, const char *w, char *err,
+                      size_t errsize)
+{
+    int k;
+    if ((k = mech_find_point(m, w)) >= 0)
+        o->points[o->npoints++] = k;
+    else if ((k = mech_find_link(m, w)) > 0)
+        o->links[o->nlinks++] = k;
+    else if ((k = mech_find_joint(m, w)) >= 0 && m->joints[k].kind == MECH_JOINT_SLIDER)
+        o->sliders[o->nsliders++] = k;
+    else {
+        int n;
+        const char **names = all_names(m, &n);
+        const char *near = names ? nearest_name(w, names, (size_t)n) : NULL;
+        snprintf(err, errsize, "'%s' is not a point, moving link or slider of %s%s%s%s", w,
+                 m->file, near ? " (did you mean '" : "", near ? near : "", near ? "'?)" : "");
+        free(names);
+        return MECH_EINPUT;
+    }
+    return MECH_OK;
+}
+
+/* The items of `list` (edited in place: NULs end the words): separated by
+ * commas, each one or more words separated by spaces. An empty item (two
+ * commas with nothing between, or a comma at either end) and a name given
+ * twice are errors. */
+static int parse_outputs(const mech_model *m, char *list, mech_outputs *o, char *err,
+                         size_t errsize)
+{
+    name_map seen = {0};  /* words already listed (keys borrowed from list) */
+    int rc = MECH_OK, item = 1;
+    for (char *s = list; rc == MECH_OK; item++) {
+        char *comma = strchr(s, ',');
+        if (comma)
+            *comma = '\0';
+        int words = 0;
+        for (char *save = NULL, *w = strtok_r(s, " ", &save); w && rc == MECH_OK;
+             w = strtok_r(NULL, " ", &save), words++) {
+            if (name_map_get(&seen, w) >= 0)
+                snprintf(err, errsize, "'%s' is listed twice", w), rc = MECH_EINPUT;
+            else if (name_map_put(&seen, w, 1) < 0)
+                snprintf(err, errsize, "out of memory"), rc = MECH_ENOMEM;
+            else
+                rc = add_output(m, o, w, err, errsize);
+        }
+        if (rc == MECH_OK && words == 0 && !comma && item == 1)
+            snprintf(err, errsize, "the list is empty"), rc = MECH_EINPUT;
+        else if (rc == MECH_OK && words == 0)
+            snprintf(err, errsize, "item %d of the list is empty (names are separated by one "
+                     "comma)", item), rc = MECH_EINPUT;
+        if (!comma)
+            break;
+        s = comma + 1;
+    }
+    name_map_free(&seen);
+    return rc;
+}
+
 int mech_outputs_parse(const mech_model *m, const char *list, mech_outputs *out, char *err,
                        size_t errsize)
 {
@@ -379,25 +439,8 @@ int mech_outputs_parse(const mech_model *m, const char *list, mech_outputs *out,
         snprintf(err, errsize, "out of memory");
         rc = MECH_ENOMEM;
     }
-    for (char *save = NULL, *w = copy ? strtok_r(copy, ", ", &save) : NULL; w && rc == MECH_OK;
-         w = strtok_r(NULL, ", ", &save)) {
-        int k;
-        if ((k = mech_find_point(m, w)) >= 0)
-            o.points[o.npoints++] = k;
-        else if ((k = mech_find_link(m, w)) > 0)
-            o.links[o.nlinks++] = k;
-        else if ((k = mech_find_joint(m, w)) >= 0 && m->joints[k].kind == MECH_JOINT_SLIDER)
-            o.sliders[o.nsliders++] = k;
-        else {
-            int n;
-            const char **names = all_names(m, &n);
-            const char *near = names ? nearest_name(w, names, (size_t)n) : NULL;
-            snprintf(err, errsize, "'%s' is not a point, moving link or slider of %s%s%s%s", w,
-                     m->file, near ? " (did you mean '" : "", near ? near : "", near ? "'?)" : "");
-            free(names);
-            rc = MECH_EINPUT;
-        }
-    }
+    if (rc == MECH_OK)
+        rc = parse_outputs(m, copy, &o, err, errsize);
     free(copy);
     if (rc != MECH_OK) {
         free(o.points);

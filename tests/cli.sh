@@ -64,6 +64,32 @@ if run "mech check $missing" 3 "$MECH" check "$missing"; then
     fi
 fi
 
+# ---- input files that are not regular, or too large (issue 16 item 11d):
+#      refused from fstat before reading, so a FIFO cannot hang `check` ----
+
+# without timeout(1) a regression would hang here instead of failing
+limit=""
+command -v timeout >/dev/null 2>&1 && limit="timeout 20"
+if mkfifo "$tmp/fifo.yaml" 2>/dev/null; then
+    if run "mech check FIFO" 3 $limit "$MECH" check "$tmp/fifo.yaml"; then
+        has_line "$tmp/err" "fifo.yaml: error: cannot read: a FIFO (named pipe), not a regular file" "check: FIFO refused"
+    fi
+fi
+mkdir "$tmp/dir.yaml"
+if run "mech check directory" 3 "$MECH" check "$tmp/dir.yaml"; then
+    has_line "$tmp/err" "dir.yaml: error: cannot read: a directory, not a regular file" "check: directory refused"
+fi
+if run "mech solve directory" 3 "$MECH" solve "$tmp/dir.yaml" -o "$tmp/dir.csv"; then
+    has_line "$tmp/err" "dir.yaml: error: cannot read: a directory, not a regular file" "solve: directory refused"
+fi
+# one byte over 64 MiB, sparse: refused from its size, not after reading it
+if truncate -s 67108865 "$tmp/big.yaml" 2>/dev/null; then
+    if run "mech check 64 MiB + 1" 2 "$MECH" check "$tmp/big.yaml"; then
+        has_line "$tmp/err" "big.yaml: error: file too large (67108865 bytes; at most 67108864)" "check: size from fstat"
+    fi
+    rm -f "$tmp/big.yaml"
+fi
+
 # ---- malformed files: status 2, and the first diagnostic is the first
 #      '# expect:' line of the file, prefixed with the file name --------------
 
@@ -131,6 +157,25 @@ fi
 
 if run "mech solve --outputs typo" 2 "$MECH" solve mechanisms/fourbar.yaml --outputs cuopler; then
     has_line "$tmp/err" "did you mean 'coupler'" "--outputs typo"
+fi
+if run "mech solve --outputs empty item" 2 "$MECH" solve mechanisms/fourbar.yaml --outputs B,,C -o "$tmp/e.csv"; then
+    has_line "$tmp/err" "^mech solve: --outputs: item 2 of the list is empty (names are separated by one comma)$" "--outputs B,,C"
+    [ ! -e "$tmp/e.csv" ] && pass || fail "--outputs B,,C: wrote $tmp/e.csv"
+fi
+if run "mech solve --outputs trailing comma" 2 "$MECH" solve mechanisms/fourbar.yaml --outputs B, -o "$tmp/e.csv"; then
+    has_line "$tmp/err" "^mech solve: --outputs: item 2 of the list is empty" "--outputs B,"
+fi
+if run "mech solve --outputs empty" 2 "$MECH" solve mechanisms/fourbar.yaml --outputs "" -o "$tmp/e.csv"; then
+    has_line "$tmp/err" "^mech solve: --outputs: the list is empty$" "--outputs ''"
+fi
+if run "mech solve --outputs twice" 2 "$MECH" solve mechanisms/fourbar.yaml --outputs B,coupler,B -o "$tmp/e.csv"; then
+    has_line "$tmp/err" "^mech solve: --outputs: 'B' is listed twice$" "--outputs B,coupler,B"
+fi
+if run "mech plot --outputs twice" 2 "$MECH" plot mechanisms/fourbar.yaml --outputs coupler,coupler --out "$tmp/figs"; then
+    has_line "$tmp/err" "^mech plot: --outputs: 'coupler' is listed twice$" "plot --outputs coupler,coupler"
+fi
+if run "mech solve --outputs with spaces" 0 "$MECH" solve mechanisms/fourbar.yaml --outputs "A, B" -o "$tmp/ab.csv"; then
+    has_line "$tmp/ab.csv" '^q \[rad\],A\.x \[m\],' "--outputs 'A, B'"
 fi
 
 run "mech solve bad option" 2 "$MECH" solve mechanisms/fourbar.yaml --frobnicate && pass

@@ -787,6 +787,45 @@ Test(load_driver, bare_angles_in_radians_warn)
     }
 }
 
+/* Control characters in a link name or a description are refused (they
+ * would reach the terminal, SVG and LaTeX raw); the message writes them
+ * \xNN. A description may span lines. */
+Test(load_names, control_characters)
+{
+    static const char link_bell[] =
+        "name: four-bar\n"
+        "ground: {O: [0, 0]}\n"
+        "links:\n"
+        "  \"cr\\aank\": {points: {O: [0, 0], A: [0.02, 0]}}\n"
+        "driver: {link: crank, angle: {from: 0 deg, to: 90 deg, steps: 3}}\n";
+    mech_diag d;
+    mech_diag_init(&d);
+    load_fails("link name with a bell", link_bell, &d);
+    int k = diag_find(&d, "link name 'cr\\x07ank' contains a control character (byte 0x07 at "
+                          "character 3)");
+    cr_expect_geq(k, 0, "got:%s", diag_text(&d));
+    if (k >= 0)
+        cr_expect(d.entries[k].mark.line == 4 && d.entries[k].mark.col == 3, "at 4:3, not %d:%d",
+                  d.entries[k].mark.line, d.entries[k].mark.col);
+    for (size_t i = 0; i < d.count; i++)
+        cr_expect_null(strchr(d.entries[i].message, '\a'), "a raw bell in: %s",
+                       d.entries[i].message);
+    mech_diag_free(&d);
+
+    char yaml[1024];
+    snprintf(yaml, sizeof yaml, "%sdescription: \"two\\nlines\\tand a tab\"\n", FOURBAR);
+    mech_model *m = load_ok("description on two lines", yaml);
+    cr_expect_str_eq(m->description, "two\nlines\tand a tab");
+    mech_model_free(&m);
+    snprintf(yaml, sizeof yaml, "%sdescription: \"red \\e[31m\"\n", FOURBAR);
+    mech_diag_init(&d);
+    load_fails("description with an escape", yaml, &d);
+    cr_expect_geq(diag_find(&d, "'description' contains a control character (byte 0x1b at "
+                                "character 5); write printable characters only"), 0, "got:%s",
+                  diag_text(&d));
+    mech_diag_free(&d);
+}
+
 Test(load_driver, bad_steps)
 {
     static const char *const bad[] = {"0", "1.5", "1000001", "2*180", "many"};
