@@ -53,7 +53,8 @@ $(BUILD)/mech: $(CMD_OBJ) $(BUILD)/libmech.a
 $(BUILD)/tests/%.o: tests/unit/%.c $(HEADERS) $(wildcard tests/unit/*.h) | $(BUILD)/tests
 	$(CC) $(CFLAGS) -Isrc -c $< -o $@
 
-$(BUILD)/unit-tests: $(TEST_OBJ) $(BUILD)/libmech.a
+# test_compare.c also runs the command line of mech compare (cmd_compare.c)
+$(BUILD)/unit-tests: $(TEST_OBJ) $(BUILD)/obj/cmd_compare.o $(BUILD)/libmech.a
 	$(CC) $(LDFLAGS) -o $@ $^ $(CRIT_LIBS) $(LDLIBS)
 
 $(BUILD)/obj $(BUILD)/tests:

@@ -1,13 +1,40 @@
-/* src/cmd_common.c: pieces several commands share: usage errors, --shard,
- * the default number of workers, and running independent jobs on worker
- * threads (mech batch, mech sweep). */
+/* src/cmd_common.c: pieces several commands share: --help, loading a
+ * checked file, usage errors, --shard, the default number of workers, and
+ * running independent jobs on worker threads (mech batch, mech sweep). */
 #include <pthread.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #include <unistd.h>
 
 #include "commands.h"
+
+int cmd_wants_help(const char *arg)
+{
+    return strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0;
+}
+
+int cmd_load_checked(const char *path, mech_model **m)
+{
+    return cmd_load_checked_with(path, NULL, 0, m);
+}
+
+int cmd_load_checked_with(const char *path, const mech_override *ov, int nov, mech_model **m)
+{
+    mech_diag d;
+    mech_diag_init(&d);
+    mech_summary s;
+    int rc = mech_load_file_with(path, ov, nov, m, &d);
+    if (rc == MECH_OK)
+        rc = mech_check(*m, &s, &d);
+    mech_diag_print(&d, stderr);
+    mech_diag_free(&d);
+    if (rc == MECH_OK)
+        return MECH_EXIT_OK;
+    mech_model_free(m);
+    return rc == MECH_EIO ? MECH_EXIT_IO : MECH_EXIT_INPUT;
+}
 
 int cmd_usage_error(const char *command, const char *fmt, const char *arg)
 {

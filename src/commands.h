@@ -5,7 +5,13 @@
 
 #include "mech.h"
 
-/* "-h" or "--help" */
+#if defined(__GNUC__)
+#define CMD_PRINTF(f, a) __attribute__((format(printf, f, a)))
+#else
+#define CMD_PRINTF(f, a)
+#endif
+
+/* cmd_common.c: "-h" or "--help" */
 int cmd_wants_help(const char *arg);
 /* Load and check one file, printing diagnostics; returns an exit status
  * (MECH_EXIT_OK with *m set, else *m is NULL). */
@@ -22,6 +28,12 @@ int cmd_default_jobs(void);  /* processors online */
 /* job(ctx, i) for i = 0 .. njobs-1 on up to nthreads threads (each i once). */
 void cmd_run_parallel(int njobs, int nthreads, void (*job)(void *ctx, int i), void *ctx);
 
+extern const char cmd_check_help[];
+int cmd_check(int argc, char **argv);
+
+extern const char cmd_equations_help[];
+int cmd_equations(int argc, char **argv);
+
 extern const char cmd_solve_help[];
 int cmd_solve(int argc, char **argv);
 
@@ -30,5 +42,10 @@ int cmd_batch(int argc, char **argv);
 
 extern const char cmd_sweep_help[];
 int cmd_sweep(int argc, char **argv);
+
+/* `mech compare [options] OUT.csv GOLDEN.csv` (cmd_compare.c): argv[0] is
+ * "compare"; returns the exit code. */
+extern const char cmd_compare_help[];
+int cmd_compare(int argc, char **argv);
 
 #endif

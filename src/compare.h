@@ -5,8 +5,9 @@
  * compare_tables() matches the columns by name and checks every value with
  *     |out - golden| <= atol + rtol * |golden|
  * (NaN matches only NaN, inf only an inf of the same sign), printing one line
- * per column and a verdict. compare_csv_files() does both for two paths, and
- * cmd_compare() is the command line on top of it (docs/cli.md, section mech compare).
+ * per column and a verdict. compare_csv_files() does both for two paths;
+ * cmd_compare() (src/cmd_compare.c) is the command line on top of it
+ * (docs/cli.md, section mech compare).
  *
  * Status values (like the rest of libmech): MECH_OK the files match,
  * COMPARE_DIFFER (> 0) both files are valid but differ, MECH_EINPUT a
@@ -78,10 +79,5 @@ int compare_csv_files(const char *out, const char *golden, const compare_options
 
 /* Exit code of a status: 0 match, 1 differ, 2 malformed or bad usage, 3 unreadable. */
 int compare_exit_status(int status);
-
-/* `mech compare [options] OUT.csv GOLDEN.csv`: argv[0] is "compare";
- * returns the exit code. compare_help is its --help text. */
-int cmd_compare(int argc, char **argv);
-extern const char compare_help[];
 
 #endif /* MECH_COMPARE_H */
