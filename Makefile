@@ -76,6 +76,7 @@ test: deps
 	$(BUILD)/unit-tests --jobs 2
 	MECH=$(BUILD)/mech sh tests/cli.sh
 	MECH=$(BUILD)/mech sh tests/cli_compare.sh
+	MECH=$(BUILD)/mech sh tests/files.sh
 	MECH=$(BUILD)/mech sh tests/golden.sh
 	MECH=$(BUILD)/mech MECH_SANITIZE=$(if $(SAN),1,) sh tests/sweep.sh
 

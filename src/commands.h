@@ -22,6 +22,16 @@ int cmd_load_checked_with(const char *path, const mech_override *ov, int nov, me
 /* cmd_common.c: "mech COMMAND: MESSAGE (see 'mech COMMAND --help')" on
  * stderr; returns MECH_EXIT_INPUT. fmt has one %s for arg. */
 int cmd_usage_error(const char *command, const char *fmt, const char *arg);
+/* *v = the whole number text (strtod syntax: 100, 1e3) when lo <= it <= hi;
+ * returns 1, or 0 (NaN, out of range, not whole, not a number). */
+int cmd_parse_int(const char *text, int lo, int hi, int *v);
+/* An output that is one of the n input files (the same st_dev and st_ino,
+ * through any link) would destroy it: prints "mech COMMAND: the output OUT
+ * is the input file IN; ..." and returns MECH_EXIT_INPUT; else -1. NULL
+ * inputs are skipped; out NULL, "-" or not an existing regular file: -1. */
+int cmd_refuse_input(const char *command, const char *out, const char *const *inputs, int n);
+/* mkdir -p: 0, or -1 with errno set. */
+int cmd_make_dir(const char *dir);
 /* "K/M" with 0 <= K < M: 0, or -1 when malformed. */
 int cmd_parse_shard(const char *s, int *k, int *mod);
 int cmd_default_jobs(void);  /* processors online */

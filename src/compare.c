@@ -74,7 +74,9 @@ static int read_line(csv_reader *r)
     ssize_t n = getline(&r->line, &r->cap, r->f);
     if (n < 0) {
         if (ferror(r->f)) {
-            diag_error(r->d, r->path, (mech_mark){0, 0}, "cannot read: %s", strerror(errno));
+            char ebuf[128];
+            diag_error(r->d, r->path, (mech_mark){0, 0}, "cannot read: %s",
+                       diag_strerror(errno, ebuf, sizeof ebuf));
             return MECH_EIO;
         }
         return errno == ENOMEM ? MECH_ENOMEM : 0;  /* the caller records ENOMEM */
@@ -333,7 +335,9 @@ int compare_read_csv(const char *path, compare_table *t, mech_diag *d)
     csv_reader r = {.path = path, .d = d};
     r.f = fopen(path, "rb");
     if (!r.f) {
-        diag_error(d, path, (mech_mark){0, 0}, "cannot open: %s", strerror(errno));
+        char ebuf[128];
+        diag_error(d, path, (mech_mark){0, 0}, "cannot open: %s",
+                   diag_strerror(errno, ebuf, sizeof ebuf));
         return MECH_EIO;
     }
     int rc = read_header(&r, t);
@@ -679,6 +683,53 @@ int compare_csv_files(const char *out, const char *golden, const compare_options
     int rc = worse(ra, rb);
     if (rc == MECH_OK)
         rc = compare_tables(&a, &b, out, golden, o, report, &d);
+    if (errors)
+        mech_diag_print(&d, errors);
+    mech_diag_free(&d);
+    compare_table_free(&a);
+    compare_table_free(&b);
+    return rc;
+}
+
+/* *c = a copy of the solver's table t, as compare_read_csv would read its
+ * CSV (%.17g reads back as the same double). MECH_OK or MECH_ENOMEM. */
+static int table_of_result(const mech_table *t, compare_table *c)
+{
+    memset(c, 0, sizeof *c);
+    size_t nc = (size_t)t->ncolumns, nr = (size_t)t->nrows, nv = nc * nr;  /* t holds nv */
+    c->names = xcalloc(nc ? nc : 1, sizeof *c->names);
+    c->units = xcalloc(nc ? nc : 1, sizeof *c->units);
+    c->values = xcalloc(nv ? nv : 1, sizeof *c->values);
+    int bad = !c->names || !c->units || !c->values;
+    c->ncols = c->names && c->units ? nc : 0;
+    for (size_t i = 0; i < c->ncols; i++) {
+        c->names[i] = strdup(t->columns[i].name);
+        c->units[i] = strdup(t->columns[i].unit);
+        bad |= !c->names[i] || !c->units[i];
+    }
+    if (bad) {
+        compare_table_free(c);
+        return MECH_ENOMEM;
+    }
+    if (nv)
+        memcpy(c->values, t->values, nv * sizeof *c->values);
+    c->nrows = nr;
+    return MECH_OK;
+}
+
+int compare_result_file(const mech_table *out, const char *out_name, const char *golden,
+                        const compare_options *o, FILE *report, FILE *errors)
+{
+    mech_diag d;
+    mech_diag_init(&d);
+    compare_table a, b;
+    int ra = table_of_result(out, &a);
+    if (ra != MECH_OK)
+        diag_error(&d, out_name, (mech_mark){0, 0}, "out of memory");
+    int rb = compare_read_csv(golden, &b, &d);
+    int rc = worse(ra, rb);
+    if (rc == MECH_OK)
+        rc = compare_tables(&a, &b, out_name, golden, o, report, &d);
     if (errors)
         mech_diag_print(&d, errors);
     mech_diag_free(&d);

@@ -77,6 +77,12 @@ int compare_tables(const compare_table *out, const compare_table *golden, const 
 int compare_csv_files(const char *out, const char *golden, const compare_options *o,
                       FILE *report, FILE *errors);
 
+/* The same with OUT the solver's table in memory (called out_name in
+ * messages) instead of a file: what `mech batch --golden` compares, with no
+ * temporary file. */
+int compare_result_file(const mech_table *out, const char *out_name, const char *golden,
+                        const compare_options *o, FILE *report, FILE *errors);
+
 /* Exit code of a status: 0 match, 1 differ, 2 malformed or bad usage, 3 unreadable. */
 int compare_exit_status(int status);
 

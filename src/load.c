@@ -1821,7 +1821,9 @@ static char *read_file(const char *path, size_t max, size_t *len, mech_diag *d, 
     FILE *f = fopen(path, "rb");
     if (!f) {
         *rc = MECH_EIO;
-        diag_error(d, path, (mech_mark){0, 0}, "cannot open: %s", strerror(errno));
+        char ebuf[128];
+        diag_error(d, path, (mech_mark){0, 0}, "cannot open: %s",
+                   diag_strerror(errno, ebuf, sizeof ebuf));
         return NULL;
     }
     size_t cap = 1 << 16, n = 0;

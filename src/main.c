@@ -1,11 +1,14 @@
 /* src/main.c: the `mech` command line, a thin layer over libmech.
- * Maps library status to the documented exit codes (docs/cli.md). */
+ * Maps library status to the documented exit codes (docs/cli.md); a
+ * command whose standard output was lost exits 3. */
+#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "cmd_plot.h"
 #include "commands.h"
+#include "output.h"
 
 typedef struct command {
     const char *name;
@@ -51,7 +54,7 @@ static void print_usage(FILE *out)
             "  3  a file could not be read or written\n");
 }
 
-int main(int argc, char **argv)
+static int dispatch(int argc, char **argv)
 {
     if (argc < 2) {
         print_usage(stderr);
@@ -76,4 +79,27 @@ int main(int argc, char **argv)
             return commands[i].run(argc - 1, argv + 1);
     fprintf(stderr, "mech: unknown command '%s' (see 'mech --help')\n", argv[1]);
     return MECH_EXIT_INPUT;
+}
+
+/* Standard output is where most commands put their results: a lost write
+ * (a full disk, /dev/full, a closed pipe's EIO) is an error, exit 3. */
+static int check_stdout(int code)
+{
+    errno = 0;
+    int bad = fflush(stdout) != 0;
+    int e = errno;
+    if (!bad && !ferror(stdout))
+        return code;
+    if (output_stdout_reported())
+        return MECH_EXIT_IO;
+    if (!e)  /* an earlier write failed; its errno is gone, try one more byte */
+        e = fputc('\n', stdout) == EOF || fflush(stdout) != 0 ? errno : 0;
+    fprintf(stderr, "mech: cannot write standard output: %s\n", strerror(e ? e : EIO));
+    return MECH_EXIT_IO;
+}
+
+int main(int argc, char **argv)
+{
+    output_catch_signals();
+    return check_stdout(dispatch(argc, argv));
 }
