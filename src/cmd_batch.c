@@ -362,18 +362,23 @@ int cmd_batch(int argc, char **argv)
         free(files);
         return MECH_EXIT_INPUT;
     }
-    for (int i = 0; i < nfiles; i++)
-        if (i % shard_m == shard_k) {
-            job *jb = &b.jobs[b.njobs++];
-            jb->path = files[i];
-            base_name(files[i], jb->name, sizeof jb->name);
-        }
-    int code = prepare_outputs(&b);
-    if (code >= 0) {
-        for (int i = 0; i < b.njobs; i++) {
+    for (int i = 0; i < nfiles; i++) {
+        job *jb = &b.jobs[b.njobs++];
+        jb->path = files[i];
+        base_name(files[i], jb->name, sizeof jb->name);
+    }
+    /* outputs checked over every file, so that shards merged later cannot
+       collide either; then only this shard's files are kept */
+    int code = prepare_outputs(&b), kept = 0;
+    for (int i = 0; i < b.njobs; i++)
+        if (code < 0 && i % shard_m == shard_k) {
+            b.jobs[kept++] = b.jobs[i];
+        } else {
             free(b.jobs[i].csv);
             free(b.jobs[i].golden_path);
         }
+    b.njobs = kept;
+    if (code >= 0) {
         free(b.jobs);
         free(files);
         return code;

@@ -273,6 +273,9 @@ if run "batch, two files named m.yaml" 2 "$MECH" batch -q "$d/a/m.yaml" "$d/b/m.
     [ -e "$d/out" ] && fail "batch collision: the output directory was made" || pass
     [ -s "$tmp/out" ] && fail "batch collision: a table was printed (something was solved)" || pass
 fi
+if run "batch --shard, two files named m.yaml in two shards" 2 "$MECH" batch -q --shard 0/2 "$d/a/m.yaml" "$d/b/m.yaml" --out-dir "$d/out"; then
+    has_line "$tmp/err" "would both be written to" "batch --shard collision: message"
+fi
 run "batch, the same names without --out-dir" 0 "$MECH" batch -q "$d/a/m.yaml" "$d/b/m.yaml" && pass
 if run "batch --out-dir missing/deep" 0 "$MECH" batch -q $fb $sc --out-dir "$d/new/deep/er"; then
     [ -f "$d/new/deep/er/fourbar.csv" ] && [ -f "$d/new/deep/er/slider-crank.csv" ] && pass ||
