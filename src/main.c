@@ -92,8 +92,6 @@ static int check_stdout(int code)
         return code;
     if (output_stdout_reported())
         return MECH_EXIT_IO;
-    if (!e)  /* an earlier write failed; its errno is gone, try one more byte */
-        e = fputc('\n', stdout) == EOF || fflush(stdout) != 0 ? errno : 0;
     fprintf(stderr, "mech: cannot write standard output: %s\n", strerror(e ? e : EIO));
     return MECH_EXIT_IO;
 }
