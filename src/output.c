@@ -133,6 +133,9 @@ void output_catch_signals(void)
 static pthread_once_t mask_once = PTHREAD_ONCE_INIT;
 static mode_t file_mask;  /* the process's umask, read once */
 
+/* umask cannot be read without being set: it is 0 for a moment, which is
+ * safe because only write_file_whole creates files while workers run, and
+ * it waits for this (pthread_once). */
 static void read_umask(void)
 {
     file_mask = umask(0);
