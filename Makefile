@@ -53,8 +53,14 @@ $(BUILD)/mech: $(CMD_OBJ) $(BUILD)/libmech.a
 $(BUILD)/tests/%.o: tests/unit/%.c $(HEADERS) $(wildcard tests/unit/*.h) | $(BUILD)/tests
 	$(CC) $(CFLAGS) -Isrc -c $< -o $@
 
-$(BUILD)/unit-tests: $(TEST_OBJ) $(BUILD)/libmech.a
+# test_compare.c also runs the command line of mech compare (cmd_compare.c)
+$(BUILD)/unit-tests: $(TEST_OBJ) $(BUILD)/obj/cmd_compare.o $(BUILD)/libmech.a
 	$(CC) $(LDFLAGS) -o $@ $^ $(CRIT_LIBS) $(LDLIBS)
+
+# cmd_run_parallel with a pthread_create failing half-way (tests/pool/pool_fail.c
+# replaces pthread_create and pthread_join)
+$(BUILD)/pool-fail: tests/pool/pool_fail.c $(BUILD)/obj/cmd_common.o $(BUILD)/libmech.a $(HEADERS)
+	$(CC) $(CFLAGS) -Isrc -o $@ $< $(BUILD)/obj/cmd_common.o $(BUILD)/libmech.a $(LDLIBS)
 
 $(BUILD)/obj $(BUILD)/tests:
 	mkdir -p $@
@@ -73,14 +79,17 @@ run: deps
 test: deps
 	@$(MAKE) --no-print-directory $(BUILD)/mech $(BUILD)/unit-tests
 	$(BUILD)/unit-tests --jobs 2
+	@$(MAKE) --no-print-directory $(BUILD)/pool-fail
+	$(BUILD)/pool-fail
 	MECH=$(BUILD)/mech sh tests/cli.sh
 	MECH=$(BUILD)/mech sh tests/cli_compare.sh
+	MECH=$(BUILD)/mech sh tests/files.sh
 	MECH=$(BUILD)/mech sh tests/golden.sh
 	MECH=$(BUILD)/mech MECH_SANITIZE=$(if $(SAN),1,) sh tests/sweep.sh
 
 test-san:
 	@$(MAKE) --no-print-directory test BUILD=build/san OPT="-O1 -g -fno-omit-frame-pointer" \
-	    SAN="-fsanitize=address,undefined -fno-sanitize-recover=all"
+	    SAN="-fsanitize=address,undefined,float-cast-overflow -fno-sanitize-recover=all"
 
 # Fuzzing with clang's libFuzzer (tests/fuzz/README.md): fuzz runs
 # FUZZ_SECONDS (default 60); fuzz-replay only the regression inputs.

@@ -7,10 +7,12 @@
  * workers. Work is handed out by an atomic counter; --shard K/M keeps only
  * the files whose index i satisfies i % M == K, for running one batch over
  * several machines (GNU Parallel, Slurm job arrays). */
+#include <errno.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -29,7 +31,8 @@ const char cmd_batch_help[] =
     "options:\n"
     "  -j, --jobs N      worker threads (default: the number of processors)\n"
     "  --out-dir DIR     write DIR/NAME.csv for each FILE (NAME = its base name\n"
-    "                    without .yaml); without it nothing is written\n"
+    "                    without .yaml; DIR created if missing; two files with\n"
+    "                    the same NAME are refused); without it nothing is written\n"
     "  --golden DIR      compare each result with DIR/NAME.csv (mech compare)\n"
     "  --rtol R, --atol A  tolerances of the golden comparison (1e-9, 1e-12)\n"
     "  --shard K/M       solve only the files with index % M == K (0 <= K < M),\n"
@@ -45,6 +48,8 @@ const char cmd_batch_help[] =
 typedef struct job {
     const char *path;
     char name[256];
+    char *csv;           /* --out-dir: DIR/NAME.csv, owned */
+    char *golden_path;   /* --golden: GOLDEN/NAME.csv, owned */
     int code;            /* exit status of this file */
     int steps;
     double worst_residual, us_per_step;
@@ -79,10 +84,10 @@ static int exit_of(int rc)
     return cmd_exit_status(rc);  /* out of memory: 3, with IO */
 }
 
-static void compare_golden(const batch *b, job *jb, const char *csv, FILE *msg)
+static void compare_golden(const batch *b, job *jb, const mech_table *t, const char *csv,
+                           FILE *msg)
 {
-    char golden[4096];
-    snprintf(golden, sizeof golden, "%s/%s.csv", b->golden_dir, jb->name);
+    const char *golden = jb->golden_path;
     if (access(golden, R_OK) != 0) {
         jb->golden = "missing";
         fprintf(msg, "%s: no golden file %s\n", jb->path, golden);
@@ -90,13 +95,13 @@ static void compare_golden(const batch *b, job *jb, const char *csv, FILE *msg)
             jb->code = MECH_EXIT_SOLVE;
         return;
     }
-    int st = compare_csv_files(csv, golden, &b->cmp, NULL, NULL);
+    int st = compare_result_file(t, csv, golden, &b->cmp, NULL, NULL);
     jb->golden = st == MECH_OK ? "match" : st == COMPARE_DIFFER ? "DIFFER" : "error";
     if (st != MECH_OK) {  /* again, to say what differs */
         compare_options o = b->cmp;
         o.table = 1;
         fprintf(msg, "%s: differs from %s:\n", jb->path, golden);
-        compare_csv_files(csv, golden, &o, msg, msg);
+        compare_result_file(t, csv, golden, &o, msg, msg);
     }
     if (st != MECH_OK && jb->code == MECH_EXIT_OK)
         jb->code = compare_exit_status(st);
@@ -129,28 +134,128 @@ static void run_job(const batch *b, job *jb)
     jb->steps = st.steps;
     jb->worst_residual = st.worst_residual;
     jb->us_per_step = st.steps ? st.seconds / st.steps * 1e6 : 0.0;
-    char csv[4096] = "";
-    if (rc == MECH_OK && (b->out_dir || b->golden_dir)) {
-        if (b->out_dir)
-            snprintf(csv, sizeof csv, "%s/%s.csv", b->out_dir, jb->name);
-        else  /* golden only: a private temporary file */
-            snprintf(csv, sizeof csv, "%s/mech-batch-%ld-%d.csv",
-                     getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp", (long)getpid(),
-                     (int)(jb - b->jobs));
+    if (rc == MECH_OK && b->out_dir) {
         mech_diag_init(&d);
-        if (mech_table_write_csv(&t, csv, &d) != MECH_OK)
+        if (mech_table_write_csv(&t, jb->csv, &d) != MECH_OK)
             jb->code = MECH_EXIT_IO;
         mech_diag_print(&d, out);
         mech_diag_free(&d);
-        if (jb->code == MECH_EXIT_OK && b->golden_dir)
-            compare_golden(b, jb, csv, out);
-        if (!b->out_dir)
-            remove(csv);
     }
+    /* the table in memory against the golden file: no temporary file */
+    if (rc == MECH_OK && b->golden_dir && jb->code == MECH_EXIT_OK)
+        compare_golden(b, jb, &t, b->out_dir ? jb->csv : jb->path, out);
     mech_table_free(&t);
     mech_model_free(&m);
     if (msg)
         fclose(msg);
+}
+
+/* ---- checks before anything is solved (docs/cli.md, section Files) ---- */
+
+static int by_name(const void *a, const void *b)
+{
+    const job *x = *(const job *const *)a, *y = *(const job *const *)b;
+    int c = strcmp(x->name, y->name);
+    return c ? c : (x < y ? -1 : x > y);
+}
+
+/* Two files with the same NAME would both write DIR/NAME.csv. */
+static int refuse_collisions(const batch *b)
+{
+    const job **order = malloc((size_t)b->njobs * sizeof *order + 1);
+    if (!order)
+        return fprintf(stderr, "mech batch: out of memory\n"), MECH_EXIT_INPUT;
+    for (int i = 0; i < b->njobs; i++)
+        order[i] = &b->jobs[i];
+    qsort(order, (size_t)b->njobs, sizeof *order, by_name);
+    int code = -1;
+    for (int i = 1; i < b->njobs; i++)
+        if (strcmp(order[i - 1]->name, order[i]->name) == 0) {
+            fprintf(stderr, "mech batch: %s and %s would both be written to %s; nothing "
+                    "solved (give files with distinct names)\n", order[i - 1]->path,
+                    order[i]->path, order[i]->csv);
+            code = MECH_EXIT_INPUT;
+        }
+    free(order);
+    return code;
+}
+
+typedef struct file_id {
+    dev_t dev;
+    ino_t ino;
+    const char *path;
+} file_id;
+
+static int by_id(const void *a, const void *b)
+{
+    const file_id *x = a, *y = b;
+    if (x->dev != y->dev)
+        return x->dev < y->dev ? -1 : 1;
+    return x->ino < y->ino ? -1 : x->ino > y->ino;
+}
+
+/* No DIR/NAME.csv may be an input: a mechanism file or a golden file. */
+static int refuse_inputs(const batch *b)
+{
+    file_id *ids = malloc((size_t)b->njobs * 2 * sizeof *ids + 1);
+    if (!ids)
+        return fprintf(stderr, "mech batch: out of memory\n"), MECH_EXIT_INPUT;
+    size_t n = 0;
+    struct stat st;
+    for (int i = 0; i < b->njobs; i++) {
+        const job *jb = &b->jobs[i];
+        if (stat(jb->path, &st) == 0)
+            ids[n++] = (file_id){st.st_dev, st.st_ino, jb->path};
+        if (jb->golden_path && stat(jb->golden_path, &st) == 0)
+            ids[n++] = (file_id){st.st_dev, st.st_ino, jb->golden_path};
+    }
+    qsort(ids, n, sizeof *ids, by_id);
+    int code = -1;
+    for (int i = 0; i < b->njobs; i++) {
+        const job *jb = &b->jobs[i];
+        if (stat(jb->csv, &st) != 0 || !S_ISREG(st.st_mode))
+            continue;
+        file_id key = {st.st_dev, st.st_ino, NULL};
+        const file_id *hit = bsearch(&key, ids, n, sizeof *ids, by_id);
+        if (hit) {
+            fprintf(stderr, "mech batch: the output %s is the input file %s; not overwriting "
+                    "it, nothing solved\n", jb->csv, hit->path);
+            code = MECH_EXIT_INPUT;
+        }
+    }
+    free(ids);
+    return code;
+}
+
+/* DIR/NAME.csv and the golden paths of every job; then no two outputs the
+ * same, no output an input, DIR created. Returns -1 to go on, else the exit
+ * status. */
+static int prepare_outputs(batch *b)
+{
+    for (int i = 0; i < b->njobs; i++) {
+        job *jb = &b->jobs[i];
+        const char *dirs[2] = {b->out_dir, b->golden_dir};
+        char **paths[2] = {&jb->csv, &jb->golden_path};
+        for (int k = 0; k < 2; k++) {
+            if (!dirs[k])
+                continue;
+            size_t len = strlen(dirs[k]) + strlen(jb->name) + 6;
+            if (!(*paths[k] = malloc(len)))
+                return fprintf(stderr, "mech batch: out of memory\n"), MECH_EXIT_INPUT;
+            snprintf(*paths[k], len, "%s/%s.csv", dirs[k], jb->name);
+        }
+    }
+    if (!b->out_dir)
+        return -1;
+    int code = refuse_collisions(b);
+    if (code < 0)
+        code = refuse_inputs(b);
+    if (code < 0 && cmd_make_dir(b->out_dir) != 0) {
+        fprintf(stderr, "mech batch: cannot create the directory %s: %s\n", b->out_dir,
+                strerror(errno));
+        code = MECH_EXIT_IO;
+    }
+    return code;
 }
 
 static void progress(const batch *b, int done)
@@ -255,20 +360,37 @@ int cmd_batch(int argc, char **argv)
         free(files);
         return MECH_EXIT_INPUT;
     }
-    for (int i = 0; i < nfiles; i++)
-        if (i % shard_m == shard_k) {
-            job *jb = &b.jobs[b.njobs++];
-            jb->path = files[i];
-            base_name(files[i], jb->name, sizeof jb->name);
+    for (int i = 0; i < nfiles; i++) {
+        job *jb = &b.jobs[b.njobs++];
+        jb->path = files[i];
+        base_name(files[i], jb->name, sizeof jb->name);
+    }
+    /* outputs checked over every file, so that shards merged later cannot
+       collide either; then only this shard's files are kept */
+    int code = prepare_outputs(&b), kept = 0;
+    for (int i = 0; i < b.njobs; i++)
+        if (code < 0 && i % shard_m == shard_k) {
+            b.jobs[kept++] = b.jobs[i];
+        } else {
+            free(b.jobs[i].csv);
+            free(b.jobs[i].golden_path);
         }
+    b.njobs = kept;
+    if (code >= 0) {
+        free(b.jobs);
+        free(files);
+        return code;
+    }
     b.progress = !quiet && isatty(STDERR_FILENO);
     cmd_run_parallel(b.njobs, nthreads, batch_job, &b);
-    int code = MECH_EXIT_OK;
+    code = MECH_EXIT_OK;
     for (int i = 0; i < b.njobs; i++) {
         job *jb = &b.jobs[i];
         if (!quiet && jb->messages && jb->msize)
             fputs(jb->messages, stderr);
         free(jb->messages);
+        free(jb->csv);
+        free(jb->golden_path);
         /* worst outcome: a failed solve or differing golden (1) outranks
            invalid input (2) and unreadable files (3), then success */
         if (jb->code == MECH_EXIT_SOLVE || (code == MECH_EXIT_OK && jb->code != MECH_EXIT_OK))

@@ -1,13 +1,42 @@
-/* src/cmd_common.c: pieces several commands share: usage errors, --shard,
- * the default number of workers, and running independent jobs on worker
- * threads (mech batch, mech sweep). */
+/* src/cmd_common.c: pieces several commands share: --help, loading a
+ * checked file, usage errors, --shard, the default number of workers, and
+ * running independent jobs on worker threads (mech batch, mech sweep). */
+#include <errno.h>
 #include <pthread.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "commands.h"
+
+int cmd_wants_help(const char *arg)
+{
+    return strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0;
+}
+
+int cmd_load_checked(const char *path, mech_model **m)
+{
+    return cmd_load_checked_with(path, NULL, 0, m);
+}
+
+int cmd_load_checked_with(const char *path, const mech_override *ov, int nov, mech_model **m)
+{
+    mech_diag d;
+    mech_diag_init(&d);
+    mech_summary s;
+    int rc = mech_load_file_with(path, ov, nov, m, &d);
+    if (rc == MECH_OK)
+        rc = mech_check(*m, &s, &d);
+    mech_diag_print(&d, stderr);
+    mech_diag_free(&d);
+    if (rc == MECH_OK)
+        return MECH_EXIT_OK;
+    mech_model_free(m);
+    return rc == MECH_EIO ? MECH_EXIT_IO : MECH_EXIT_INPUT;
+}
 
 int cmd_usage_error(const char *command, const char *fmt, const char *arg)
 {
@@ -15,6 +44,65 @@ int cmd_usage_error(const char *command, const char *fmt, const char *arg)
     fprintf(stderr, fmt, arg);
     fprintf(stderr, " (see 'mech %s --help')\n", command);
     return MECH_EXIT_INPUT;
+}
+
+int cmd_parse_int(const char *text, int lo, int hi, int *v)
+{
+    char *end;
+    double x = strtod(text, &end);
+    /* !(lo <= x <= hi) also refuses NaN: converting it (or anything out of
+       int's range) to int is undefined */
+    if (end == text || *end != '\0' || !(x >= lo && x <= hi) || x != (double)(int)x)
+        return 0;
+    *v = (int)x;
+    return 1;
+}
+
+int cmd_refuse_input(const char *command, const char *out, const char *const *inputs, int n)
+{
+    struct stat so, si;
+    if (!out || strcmp(out, "-") == 0 || stat(out, &so) != 0 || !S_ISREG(so.st_mode))
+        return -1;  /* new, or not a file an input can be */
+    for (int i = 0; i < n; i++)
+        if (inputs[i] && stat(inputs[i], &si) == 0 && si.st_dev == so.st_dev &&
+            si.st_ino == so.st_ino) {
+            fprintf(stderr, "mech %s: the output %s is the input file %s; not overwriting it\n",
+                    command, out, inputs[i]);
+            return MECH_EXIT_INPUT;
+        }
+    return -1;
+}
+
+int cmd_make_dir(const char *dir)
+{
+    char *p = malloc(strlen(dir) + 1);
+    if (!p)
+        return -1;
+    strcpy(p, dir);
+    for (char *s = p + 1;; s++) {
+        if (*s == '/' || *s == '\0') {
+            char c = *s;
+            *s = '\0';
+            if (mkdir(p, 0777) != 0 && errno != EEXIST) {
+                int e = errno;
+                free(p);
+                errno = e;
+                return -1;
+            }
+            *s = c;
+            if (c == '\0')
+                break;
+        }
+    }
+    free(p);
+    struct stat st;
+    if (stat(dir, &st) != 0)
+        return -1;
+    if (!S_ISDIR(st.st_mode)) {
+        errno = ENOTDIR;
+        return -1;
+    }
+    return 0;
 }
 
 int cmd_parse_shard(const char *s, int *k, int *mod)
@@ -59,9 +147,10 @@ void cmd_run_parallel(int njobs, int nthreads, void (*job)(void *ctx, int i), vo
     if (nthreads > njobs)
         nthreads = njobs > 0 ? njobs : 1;
     pthread_t *tid = calloc((size_t)nthreads, sizeof *tid);
-    int started = 0;
+    int started = 0;  /* tid[0 .. started-1] are the threads created */
     for (int t = 0; tid && t < nthreads; t++)
-        started += pthread_create(&tid[t], NULL, worker, &p) == 0;
+        if (pthread_create(&tid[started], NULL, worker, &p) == 0)
+            started++;
     if (started == 0)
         worker(&p);  /* no threads: do the work here */
     for (int t = 0; t < started; t++)

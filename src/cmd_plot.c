@@ -5,7 +5,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 #include "cmd_plot.h"
 #include "commands.h"
@@ -71,16 +70,6 @@ typedef struct plot_args {
 } plot_args;
 
 
-static int parse_count(const char *text, int lo, int hi, int *v)
-{
-    char *end;
-    double x = strtod(text, &end);
-    if (end == text || *end != '\0' || x < lo || x > hi || x != (int)x)
-        return 0;
-    *v = (int)x;
-    return 1;
-}
-
 /* One option of either command; *i advances past its value.
  * Returns -1 to go on, else the exit status. */
 static int parse_option(plot_args *a, int argc, char **argv, int *i)
@@ -107,7 +96,7 @@ static int parse_option(plot_args *a, int argc, char **argv, int *i)
         return cmd_usage_error(a->cmd, "option '%s' needs a value", arg);
     const char *val = argv[++*i];
     if (strcmp(arg, "--steps") == 0) {
-        if (!parse_count(val, 1, 100000000, &a->steps))
+        if (!cmd_parse_int(val, 1, 100000000, &a->steps))
             return cmd_usage_error(a->cmd, "--steps needs a whole number from 1 to 1e8, not '%s'", val);
     } else if (!animate && (strcmp(arg, "--out") == 0 || strcmp(arg, "-d") == 0)) {
         a->out = val;
@@ -131,7 +120,7 @@ static int parse_option(plot_args *a, int argc, char **argv, int *i)
             return cmd_usage_error(a->cmd, "--duration needs seconds from 0.01 to 86400, not '%s'", val);
         a->anim.duration = s;
     } else if (animate && strcmp(arg, "--frame") == 0) {
-        if (!parse_count(val, 0, 100000000, &a->anim.frame))
+        if (!cmd_parse_int(val, 0, 100000000, &a->anim.frame))
             return cmd_usage_error(a->cmd, "--frame needs a position number from 0, not '%s'", val);
     } else if (animate && strcmp(arg, "--pause-at") == 0) {
         char *end;
@@ -140,7 +129,7 @@ static int parse_option(plot_args *a, int argc, char **argv, int *i)
             return cmd_usage_error(a->cmd, "--pause-at needs seconds from 0 to 86400, not '%s'", val);
         a->anim.pause_at = s;
     } else if (animate && strcmp(arg, "--frames") == 0) {
-        if (!parse_count(val, 2, 1000000, &a->anim.max_frames))
+        if (!cmd_parse_int(val, 2, 1000000, &a->anim.max_frames))
             return cmd_usage_error(a->cmd, "--frames needs a whole number from 2 to 1e6, not '%s'", val);
     } else {
         return cmd_usage_error(a->cmd, "unknown option '%s'", arg);
@@ -198,31 +187,6 @@ static int solve(const plot_args *a, const mech_model *m, const mech_solve_optio
     return cmd_exit_status(rc);
 }
 
-/* mkdir -p */
-static int make_dir(const char *dir)
-{
-    char *p = malloc(strlen(dir) + 1);
-    if (!p)
-        return -1;
-    strcpy(p, dir);
-    for (char *s = p + 1;; s++) {
-        if (*s == '/' || *s == '\0') {
-            char c = *s;
-            *s = '\0';
-            if (mkdir(p, 0777) != 0 && errno != EEXIST) {
-                free(p);
-                return -1;
-            }
-            *s = c;
-            if (c == '\0')
-                break;
-        }
-    }
-    free(p);
-    struct stat st;
-    return stat(dir, &st) == 0 && S_ISDIR(st.st_mode) ? 0 : -1;
-}
-
 /* The file's name without directory and .yaml/.yml. */
 static void file_stem(const char *path, char *buf, size_t n)
 {
@@ -243,17 +207,32 @@ static int any_friction(const mech_model *m)
     return 0;
 }
 
+/* DIR/STEM-NAME.svg of every figure into paths[n] (each malloc'ed; NULL
+ * when out of memory). */
+static void figure_paths(const char *dir, const char *stem, const plot_figure *figs, int n,
+                         char **paths)
+{
+    for (int k = 0; k < n; k++) {
+        size_t len = strlen(dir) + strlen(stem) + strlen(figs[k].name) + 8;
+        if ((paths[k] = malloc(len)))
+            snprintf(paths[k], len, "%s/%s-%s.svg", dir, stem, figs[k].name);
+    }
+}
+
 static int write_figures(const plot_args *a, const mech_model *m, const mech_table *t)
 {
     enum { MAXFIG = 4096 };
     const char *dir = a->out ? a->out : ".";
-    if (make_dir(dir) != 0) {
+    if (cmd_make_dir(dir) != 0) {
         fprintf(stderr, "%s: error: cannot create the directory: %s\n", dir, strerror(errno));
         return MECH_EXIT_IO;
     }
     plot_figure *figs = calloc(MAXFIG, sizeof *figs);
-    if (!figs) {
+    char **paths = calloc(MAXFIG, sizeof *paths);
+    if (!figs || !paths) {
         fprintf(stderr, "mech plot: out of memory\n");
+        free(figs);
+        free(paths);
         return MECH_EXIT_IO;
     }
     int n = plot_plan(m, t, figs, MAXFIG);
@@ -261,25 +240,25 @@ static int write_figures(const plot_args *a, const mech_model *m, const mech_tab
         fprintf(stderr, "mech plot: %s: nothing to plot (no outputs)\n", a->file);
     char stem[256];
     file_stem(a->file, stem, sizeof stem);
+    figure_paths(dir, stem, figs, n, paths);
     int code = MECH_EXIT_OK;
+    for (int k = 0; k < n && code == MECH_EXIT_OK; k++)  /* every path before any is written */
+        code = !paths[k] ? MECH_EXIT_IO
+               : cmd_refuse_input("plot", paths[k], &a->file, 1) >= 0 ? MECH_EXIT_INPUT
+               : MECH_EXIT_OK;
     for (int k = 0; k < n && code == MECH_EXIT_OK; k++) {
-        size_t len = strlen(dir) + strlen(stem) + strlen(figs[k].name) + 8;
-        char *path = malloc(len);
-        if (!path) {
-            code = MECH_EXIT_IO;
-            break;
-        }
-        snprintf(path, len, "%s/%s-%s.svg", dir, stem, figs[k].name);
         mech_diag d;
         mech_diag_init(&d);
-        if (plot_figure_write(m, t, &figs[k], m->name, path, &d) != MECH_OK)
+        if (plot_figure_write(m, t, &figs[k], m->name, paths[k], &d) != MECH_OK)
             code = MECH_EXIT_IO;
         else
-            printf("%s\n", path);
+            printf("%s\n", paths[k]);
         mech_diag_print(&d, stderr);
         mech_diag_free(&d);
-        free(path);
     }
+    for (int k = 0; k < n; k++)
+        free(paths[k]);
+    free(paths);
     free(figs);
     return code;
 }
@@ -362,6 +341,10 @@ int cmd_animate(int argc, char **argv)
     int code = begin("animate", argc, argv, &a, &m);
     if (code >= 0)
         return code;
+    if ((code = cmd_refuse_input("animate", a.out, &a.file, 1)) >= 0) {
+        mech_model_free(&m);
+        return code;
+    }
     /* the file's output points are traced; every point and link is drawn,
        through a view of the model with those outputs */
     mech_model view = *m;

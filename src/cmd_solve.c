@@ -112,10 +112,9 @@ static int parse_valued(solve_args *a, const char *arg, const char *val)
     else if (strcmp(arg, "--outputs") == 0)
         a->outputs = val;
     else if (strcmp(arg, "--steps") == 0) {
-        if (!parse_number(val, &num) || num < 1 || num > 1e6 || num != (int)num)
+        if (!cmd_parse_int(val, 1, 1000000, &a->steps))
             return cmd_usage_error("solve", "--steps needs a whole number from 1 to 1000000 (as in a file), "
                                "not '%s'", val);
-        a->steps = (int)num;
     } else if (strcmp(arg, "--tol") == 0) {
         if (!parse_number(val, &num) || !(num >= MIN_TOL && num < 1))
             return cmd_usage_error("solve", "--tol needs a number from 1e-15 (a smaller residual "
@@ -123,9 +122,8 @@ static int parse_valued(solve_args *a, const char *arg, const char *val)
                                    "not '%s'", val);
         a->opt.tol = num;
     } else if (strcmp(arg, "--max-iter") == 0) {
-        if (!parse_number(val, &num) || num < 1 || num > 10000 || num != (int)num)
+        if (!cmd_parse_int(val, 1, 10000, &a->opt.max_iter))
             return cmd_usage_error("solve", "--max-iter needs a whole number from 1 to 10000, not '%s'", val);
-        a->opt.max_iter = (int)num;
     } else if (strcmp(arg, "--min-rcond") == 0) {
         if (!parse_number(val, &num) || !(num > 0 && num < 1))
             return cmd_usage_error("solve", "--min-rcond needs a number between 0 and 1, not '%s'", val);
@@ -287,7 +285,9 @@ int cmd_solve(int argc, char **argv)
         return code;
     }
     mech_model *m = NULL;
-    code = cmd_load_checked_with(a.file, a.set, a.nset, &m);
+    code = cmd_refuse_input("solve", a.out, &a.file, 1);
+    if (code < 0)
+        code = cmd_load_checked_with(a.file, a.set, a.nset, &m);
     for (int i = 0; i < a.nset; i++)
         free(a.set_text[i]);
     if (code != MECH_EXIT_OK)

@@ -9,10 +9,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "commands.h"
 #include "internal.h"
+#include "output.h"
 
 const char cmd_sweep_help[] =
     "usage: mech sweep FILE --vary NAME=FROM:TO:COUNT [--vary ...] [--list NAME=A,B,...]\n"
@@ -423,29 +423,21 @@ static void write_summary(const sweep_run *r, FILE *f)
     }
 }
 
-/* Whole or not at all, as the solver's CSV. */
+static int emit_summary(FILE *f, const void *r)
+{
+    write_summary(r, f);
+    return ferror(f) ? -1 : 0;
+}
+
+/* Whole or not at all, as the solver's CSV (src/output.h). */
 static int write_file(const sweep_run *r, const char *path)
 {
-    if (!path) {
-        write_summary(r, stdout);
-        return fflush(stdout) == 0 ? MECH_EXIT_OK : MECH_EXIT_IO;
-    }
-    char tmp[4096];
-    snprintf(tmp, sizeof tmp, "%s.tmp%ld", path, (long)getpid());
-    FILE *f = fopen(tmp, "w");
-    if (!f) {
-        fprintf(stderr, "mech sweep: cannot write %s\n", path);
-        return MECH_EXIT_IO;
-    }
-    write_summary(r, f);
-    int bad = ferror(f);
-    bad |= fclose(f) != 0;
-    if (bad || rename(tmp, path) != 0) {
-        remove(tmp);
-        fprintf(stderr, "mech sweep: cannot write %s\n", path);
-        return MECH_EXIT_IO;
-    }
-    return MECH_EXIT_OK;
+    mech_diag d;
+    mech_diag_init(&d);
+    int rc = write_file_whole(path ? path : "-", emit_summary, r, &d);
+    mech_diag_print(&d, stderr);
+    mech_diag_free(&d);
+    return rc == MECH_OK ? MECH_EXIT_OK : MECH_EXIT_IO;
 }
 
 static void free_run(sweep_run *r)
@@ -511,6 +503,8 @@ int cmd_sweep(int argc, char **argv)
         code = cmd_usage_error("sweep", "%s", "no file given (usage: mech sweep FILE --vary NAME=FROM:TO:COUNT)");
     if (code < 0 && r.naxes == 0)
         code = cmd_usage_error("sweep", "%s", "nothing to vary: give --vary NAME=FROM:TO:COUNT or --list");
+    if (code < 0)
+        code = cmd_refuse_input("sweep", out, &r.file, 1);
     long total = 1;
     for (int k = 0; code < 0 && k < r.naxes; k++)
         if ((total *= r.axes[k].count) > 10000000)

@@ -5,7 +5,13 @@
 
 #include "mech.h"
 
-/* "-h" or "--help" */
+#if defined(__GNUC__)
+#define CMD_PRINTF(f, a) __attribute__((format(printf, f, a)))
+#else
+#define CMD_PRINTF(f, a)
+#endif
+
+/* cmd_common.c: "-h" or "--help" */
 int cmd_wants_help(const char *arg);
 /* Load and check one file, printing diagnostics; returns an exit status
  * (MECH_EXIT_OK with *m set, else *m is NULL). */
@@ -26,11 +32,27 @@ static inline int cmd_exit_status(int rc)
 /* cmd_common.c: "mech COMMAND: MESSAGE (see 'mech COMMAND --help')" on
  * stderr; returns MECH_EXIT_INPUT. fmt has one %s for arg. */
 int cmd_usage_error(const char *command, const char *fmt, const char *arg);
+/* *v = the whole number text (strtod syntax: 100, 1e3) when lo <= it <= hi;
+ * returns 1, or 0 (NaN, out of range, not whole, not a number). */
+int cmd_parse_int(const char *text, int lo, int hi, int *v);
+/* An output that is one of the n input files (the same st_dev and st_ino,
+ * through any link) would destroy it: prints "mech COMMAND: the output OUT
+ * is the input file IN; ..." and returns MECH_EXIT_INPUT; else -1. NULL
+ * inputs are skipped; out NULL, "-" or not an existing regular file: -1. */
+int cmd_refuse_input(const char *command, const char *out, const char *const *inputs, int n);
+/* mkdir -p: 0, or -1 with errno set. */
+int cmd_make_dir(const char *dir);
 /* "K/M" with 0 <= K < M: 0, or -1 when malformed. */
 int cmd_parse_shard(const char *s, int *k, int *mod);
 int cmd_default_jobs(void);  /* processors online */
 /* job(ctx, i) for i = 0 .. njobs-1 on up to nthreads threads (each i once). */
 void cmd_run_parallel(int njobs, int nthreads, void (*job)(void *ctx, int i), void *ctx);
+
+extern const char cmd_check_help[];
+int cmd_check(int argc, char **argv);
+
+extern const char cmd_equations_help[];
+int cmd_equations(int argc, char **argv);
 
 extern const char cmd_solve_help[];
 int cmd_solve(int argc, char **argv);
@@ -40,5 +62,10 @@ int cmd_batch(int argc, char **argv);
 
 extern const char cmd_sweep_help[];
 int cmd_sweep(int argc, char **argv);
+
+/* `mech compare [options] OUT.csv GOLDEN.csv` (cmd_compare.c): argv[0] is
+ * "compare"; returns the exit code. */
+extern const char cmd_compare_help[];
+int cmd_compare(int argc, char **argv);
 
 #endif

@@ -5,8 +5,9 @@
  * compare_tables() matches the columns by name and checks every value with
  *     |out - golden| <= atol + rtol * |golden|
  * (NaN matches only NaN, inf only an inf of the same sign), printing one line
- * per column and a verdict. compare_csv_files() does both for two paths, and
- * cmd_compare() is the command line on top of it (docs/cli.md, section mech compare).
+ * per column and a verdict. compare_csv_files() does both for two paths;
+ * cmd_compare() (src/cmd_compare.c) is the command line on top of it
+ * (docs/cli.md, section mech compare).
  *
  * Status values (like the rest of libmech): MECH_OK the files match,
  * COMPARE_DIFFER (> 0) both files are valid but differ, MECH_EINPUT a
@@ -76,13 +77,14 @@ int compare_tables(const compare_table *out, const compare_table *golden, const 
 int compare_csv_files(const char *out, const char *golden, const compare_options *o,
                       FILE *report, FILE *errors);
 
+/* The same with OUT the solver's table in memory (called out_name in
+ * messages) instead of a file: what `mech batch --golden` compares, with no
+ * temporary file. */
+int compare_result_file(const mech_table *out, const char *out_name, const char *golden,
+                        const compare_options *o, FILE *report, FILE *errors);
+
 /* Exit code of a status: 0 match, 1 differ, 2 malformed or bad usage, 3 unreadable
  * or out of memory. */
 int compare_exit_status(int status);
-
-/* `mech compare [options] OUT.csv GOLDEN.csv`: argv[0] is "compare";
- * returns the exit code. compare_help is its --help text. */
-int cmd_compare(int argc, char **argv);
-extern const char compare_help[];
 
 #endif /* MECH_COMPARE_H */

@@ -5,6 +5,13 @@
 
 #include "internal.h"
 
+const char *diag_strerror(int e, char *buf, size_t size)
+{
+    if (strerror_r(e, buf, size) != 0)  /* the POSIX (int) strerror_r */
+        snprintf(buf, size, "error %d", e);
+    return buf;
+}
+
 void mech_diag_init(mech_diag *d)
 {
     memset(d, 0, sizeof *d);

@@ -14,6 +14,10 @@
 #define MECH_PRINTF(f, a)
 #endif
 
+/* ---- diag.c: strerror for any thread: the message of errno value e in
+ *      buf[size] (POSIX strerror_r), returned. */
+const char *diag_strerror(int e, char *buf, size_t size);
+
 /* ---- diag.c: record a problem; returns MECH_EINPUT so a call site can be
  *      one `return diag_error(...)` line. */
 int diag_error(mech_diag *d, const char *file, mech_mark at, const char *fmt, ...)
@@ -144,11 +148,8 @@ void ytree_free(ynode *n);
 ynode *ymap_get(const ynode *map, const char *key);      /* value or NULL */
 const char *ynode_kind_name(ynode_kind k);
 
-/* ---- output.c: write a file whole or not at all: emit (returns 0 on
- *      success) writes into a temporary file beside `path`, renamed over it
- *      when complete; "-" is standard output. MECH_OK or MECH_EIO. */
-int write_file_whole(const char *path, int (*emit)(FILE *, const void *), const void *ctx,
-                     mech_diag *d);
+/* ---- output.c: write_file_whole (src/output.h) */
+#include "output.h"
 
 /* ---- model.c */
 int model_point_in_link(const mech_link *l, int name_id);  /* index or -1 */

@@ -204,7 +204,9 @@ static FILE *open_input(const char *path, size_t max, mech_diag *d, int *rc)
         if (f)
             return f;
         *rc = MECH_EIO;
-        diag_error(d, path, (mech_mark){0, 0}, "cannot open: %s", strerror(errno));
+        char ebuf[128];
+        diag_error(d, path, (mech_mark){0, 0}, "cannot open: %s",
+                   diag_strerror(errno, ebuf, sizeof ebuf));
     }
     if (fd >= 0)
         close(fd);

@@ -17,6 +17,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "commands.h"
 #include "compare.h"
 
 /* ---- a private directory per test --------------------------------------- */
@@ -539,9 +540,9 @@ Test(compare_cli, help, .init = cr_redirect_stdout)
 {
     cr_expect_eq(cmd(2, (const char *[]){"compare", "--help", NULL}), 0);
     fflush(stdout);
-    cr_expect_stdout_eq_str(compare_help);
-    cr_expect(strncmp(compare_help, "usage: mech compare ", 20) == 0);
-    const char *help = compare_help;
+    cr_expect_stdout_eq_str(cmd_compare_help);
+    cr_expect(strncmp(cmd_compare_help, "usage: mech compare ", 20) == 0);
+    const char *help = cmd_compare_help;
     expect_has(help, "default 1e-9");
     expect_has(help, "default 1e-12");
     expect_has(help, "exit status:");
