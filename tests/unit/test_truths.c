@@ -11,8 +11,10 @@
  *   and once from the sliding link; a point of that link against the closed
  *   form, over a full turn at four speeds with driver accelerations;
  * - slider friction: a block pushed up and down an inclined guide (driver
- *   force), and a slider-crank with friction in the piston guide (driver
- *   torque, reactions), both against hand statics with mu |N|;
+ *   force), the oscillating cylinder with friction in its bore (a moving
+ *   guide: the guide's share of the friction in the ground pin's force),
+ *   and a slider-crank with friction in the piston guide (driver torque,
+ *   reactions), all against hand statics with mu |N|;
  * - pin friction: a slider-crank with friction in its three pins, the moments
  *   mu r |F| against the relative rotation of each pin (driver torque,
  *   reactions, the piston guide's couple, the dissipated power);
@@ -247,6 +249,68 @@ Test(truths, slider_friction_incline)
         }
         mech_table_free(&t);
     }
+    mech_model_free(&m);
+}
+
+/* ---- 2a'. slider friction on a moving guide: the oscillating cylinder --- */
+
+/* tests/truths/oscillating-cylinder-friction.yaml: the geometry of 1 (rod
+ * sliding in the cylinder, A = C + s u, n = u turned +90 deg), no masses, a
+ * torque tau = 2 N*m on the cylinder, friction mu = 0.3 between rod and
+ * cylinder, the crank at w = 10 rad/s. By hand, with N n the cylinder's
+ * normal force on the rod at the contact point A, M the couple between them
+ * and f = -mu |N| sign(s') u the friction force on the rod (the cylinder
+ * receives the opposite of all three):
+ *   rod, moments about A: every force acts at A, so M = 0;
+ *   cylinder, moments about C: tau - M + (s u) x (-N n) = tau - s N = 0,
+ *     the friction force on the cylinder lies on the line through C, so
+ *     N = tau / s;
+ *   rod, forces: F_A + N n + f = 0 (F_A the crank's pin force on the rod);
+ *   cylinder, forces: F_C - N n - f = 0 (F_C the ground's pin force), so
+ *     F_C = N n - mu |N| sign(s') u: only the guide's share of the friction
+ *     makes F_C differ from N n;
+ *   crank: -F_A at A, T + A x (-F_A) = 0, so T = A x F_A;
+ *   dissipated power: mu |N| |s'|.
+ * s, s', u from the closed form of 1. */
+Test(truths, slider_friction_moving_guide)
+{
+    const double w = 10, tau = 2, mu = 0.3;
+    cylinder g = {0.05, 0.14, 0.03, -0.06, 0.015, -0.03, 0.012, 0};
+    mech_model *m = load_path("tests/truths/oscillating-cylinder-friction.yaml");
+    mech_table t = solve_ok(m, NULL);
+    int checked = 0;
+    for (int row = 0; row < t.nrows; row++) {
+        double q = at(&t, row, "q"), k[NCYL];
+        cylinder_ref(&g, q, w, 0, k);
+        double phi = k[18], sl = k[24], sl1 = k[25];
+        if (fabs(sl1) < 0.2 * g.r * w)
+            continue;  /* s' ~ 0 near the crank's nearest and farthest from C */
+        double ux = cos(phi), uy = sin(phi), nx = -uy, ny = ux;
+        double N = tau / sl, fr = mu * fabs(N) * sgn(sl1);
+        double FAx = -N * nx + fr * ux, FAy = -N * ny + fr * uy;
+        double FCx = N * nx - fr * ux, FCy = N * ny - fr * uy;
+        double T = k[0] * FAy - k[1] * FAx;
+        const double fs = 1e-9 * 25, ts = 1e-9 * 25 * 0.2;
+        cr_assert(fabs(at(&t, row, "s.N") - N) < fs, "q %g deg: N %.17g, expected %.17g", q / DEG,
+                  at(&t, row, "s.N"), N);
+        cr_assert(fabs(at(&t, row, "s.M")) < ts, "q %g deg: M %.17g, expected 0", q / DEG,
+                  at(&t, row, "s.M"));
+        cr_assert(fabs(at(&t, row, "A.Fx") - FAx) < fs && fabs(at(&t, row, "A.Fy") - FAy) < fs,
+                  "q %g deg: A (%.17g, %.17g), expected (%.17g, %.17g)", q / DEG,
+                  at(&t, row, "A.Fx"), at(&t, row, "A.Fy"), FAx, FAy);
+        cr_assert(fabs(at(&t, row, "C.Fx") - FCx) < fs && fabs(at(&t, row, "C.Fy") - FCy) < fs,
+                  "q %g deg: C (%.17g, %.17g), expected (%.17g, %.17g)", q / DEG,
+                  at(&t, row, "C.Fx"), at(&t, row, "C.Fy"), FCx, FCy);
+        cr_assert(fabs(at(&t, row, "driver.torque") - T) < ts,
+                  "q %g deg: driver torque %.17g, expected %.17g", q / DEG,
+                  at(&t, row, "driver.torque"), T);
+        cr_assert(fabs(at(&t, row, "friction.power") - mu * fabs(N * sl1)) < 1e-9 * 25 * 0.5,
+                  "q %g deg: friction power %.17g, expected %.17g", q / DEG,
+                  at(&t, row, "friction.power"), mu * fabs(N * sl1));
+        checked++;
+    }
+    cr_assert_geq(checked, 20);
+    mech_table_free(&t);
     mech_model_free(&m);
 }
 
