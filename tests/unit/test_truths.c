@@ -18,8 +18,10 @@
  * - pin friction: a slider-crank with friction in its three pins, the moments
  *   mu r |F| against the relative rotation of each pin (driver torque,
  *   reactions, the piston guide's couple, the dissipated power);
- * - the branch-jump guard (src/sweep.c, try_position): a four-bar output
- *   every half turn, which without the guard lands on the other assembly.
+ * - the branch-jump guard (src/sweep.c, try_position): a four-bar, and two
+ *   identical four-bars on one crank, output every half turn, which without
+ *   the guard land on the other assembly (the twin silently: det J keeps its
+ *   sign).
  */
 #include <criterion/criterion.h>
 #include <math.h>
@@ -484,31 +486,56 @@ Test(truths, pin_friction_slider_crank_reversed) { check_pin_friction(-10); }
 
 /* tests/truths/fourbar-coarse.yaml: the crank-rocker of
  * mechanisms/fourbar.yaml output every half turn, without a `branch:`
- * condition. From these start angles (the file's 225 deg and its
- * neighbours), Newton started from the continuation's prediction for the
- * next row converges on the crossed assembly; the guard in try_position
- * rejects that step (the correction is large next to the predicted move) and
- * halves it. Every row must match the closed form of the open assembly
- * (closed_forms.h, sign +1), on which row 0 is started (the guesses are set
- * near it for each start). */
-Test(truths, branch_jump_guard)
+ * condition; fourbar-twin-coarse.yaml: two identical copies of its dyad on
+ * one crank (B, coupler, rocker and E, coupler2, rocker2). From these start
+ * angles (the files' 225 deg and its neighbours), Newton started from the
+ * continuation's prediction for the row at q0 + 360 deg converges on the
+ * crossed assembly; the guard in try_position rejects that step (the
+ * correction is large next to the predicted move) and halves it. Every row
+ * must match the closed form of the open assembly (closed_forms.h, sign +1),
+ * on which row 0 is started (the guesses are set 2 deg from it for each
+ * start). In the twin both dyads jump together and det J keeps its sign:
+ * no warning either, a silent jump, which only the guard sees. */
+static void check_coarse(const char *path, int twin)
 {
     static const double starts[] = {195, 210, 225, 240, 255};
     fourbar g = {0.020, 0.060, 0.050, 0.070, 0, 0, +1};
-    static const char *const names[] = {"A.x", "A.y", "A.vx", "A.vy", "A.ax", "A.ay",
-                                        "B.x", "B.y", "B.vx", "B.vy", "B.ax", "B.ay",
-                                        "crank.angle", "crank.omega", "crank.alpha",
-                                        "coupler.angle", "coupler.omega", "coupler.alpha",
-                                        "rocker.angle", "rocker.omega", "rocker.alpha"};
-    enum { N = sizeof names / sizeof *names };
-    mech_model *m = load_path("tests/truths/fourbar-coarse.yaml");
-    cr_assert_eq(m->nguesses, 2);
+    /* table column, and the closed form's column it must equal */
+    static const char *const names[][2] = {
+        {"A.x", "A.x"}, {"A.y", "A.y"}, {"A.vx", "A.vx"}, {"A.vy", "A.vy"}, {"A.ax", "A.ax"},
+        {"A.ay", "A.ay"}, {"B.x", "B.x"}, {"B.y", "B.y"}, {"B.vx", "B.vx"}, {"B.vy", "B.vy"},
+        {"B.ax", "B.ax"}, {"B.ay", "B.ay"}, {"crank.angle", "crank.angle"},
+        {"crank.omega", "crank.omega"}, {"crank.alpha", "crank.alpha"},
+        {"coupler.angle", "coupler.angle"}, {"coupler.omega", "coupler.omega"},
+        {"coupler.alpha", "coupler.alpha"}, {"rocker.angle", "rocker.angle"},
+        {"rocker.omega", "rocker.omega"}, {"rocker.alpha", "rocker.alpha"},
+        /* the twin's second dyad */
+        {"E.x", "B.x"}, {"E.y", "B.y"}, {"E.vx", "B.vx"}, {"E.vy", "B.vy"}, {"E.ax", "B.ax"},
+        {"E.ay", "B.ay"}, {"coupler2.angle", "coupler.angle"},
+        {"coupler2.omega", "coupler.omega"}, {"coupler2.alpha", "coupler.alpha"},
+        {"rocker2.angle", "rocker.angle"}, {"rocker2.omega", "rocker.omega"},
+        {"rocker2.alpha", "rocker.alpha"}};
+    int n = twin ? 33 : 21;
+    const char *cols[33];
+    int ref_col[33];
+    for (int c = 0; c < n; c++) {
+        cols[c] = names[c][0];
+        ref_col[c] = -1;
+        for (int f = 0; f < NFOURBAR; f++)
+            if (strcmp(FOURBAR_COLS[f], names[c][1]) == 0)
+                ref_col[c] = f;
+        cr_assert_geq(ref_col[c], 0);
+    }
+    mech_model *m = load_path(path);
+    cr_assert_eq(m->nguesses, twin ? 4 : 2);
     for (int k = 0; k < (int)(sizeof starts / sizeof *starts); k++) {
         double q0 = starts[k] * DEG, ref[NFOURBAR];
         fourbar_ref(&g, q0, 10, 0, ref);
-        for (int i = 0; i < m->nguesses; i++)  /* coupler, rocker, 2 deg off */
-            m->guesses[i].value = ref[i == 0 ? 21 : 24] + 2 * DEG;
-        cr_assert_eq(strcmp(m->links[m->guesses[0].index].name, "coupler"), 0);
+        for (int i = 0; i < m->nguesses; i++) {  /* coupler(2), rocker(2): 2 deg off */
+            const char *link = m->links[m->guesses[i].index].name;
+            cr_assert(!m->guesses[i].is_slider);
+            m->guesses[i].value = ref[strncmp(link, "coupler", 7) == 0 ? 21 : 24] + 2 * DEG;
+        }
         mech_solve_options o;
         mech_solve_options_default(&o);
         o.has_range = 1;
@@ -517,19 +544,20 @@ Test(truths, branch_jump_guard)
         o.steps = 2;
         mech_table t = solve_ok(m, &o);
         cr_assert_eq(t.nrows, 3);
-        double want[3 * N];
+        double want[3 * 33];
         for (int r = 0; r < t.nrows; r++) {
             double full[NFOURBAR];
             fourbar_ref(&g, at(&t, r, "q"), 10, 0, full);
-            for (int c = 0; c < N; c++)
-                for (int f = 0; f < NFOURBAR; f++)
-                    if (strcmp(FOURBAR_COLS[f], names[c]) == 0)
-                        want[r * N + c] = full[f];
+            for (int c = 0; c < n; c++)
+                want[r * n + c] = full[ref_col[c]];
         }
-        char what[128];
-        snprintf(what, sizeof what, "four-bar every 180 deg from %g deg", starts[k]);
-        compare_rows(&t, names, N, want, 1e-12, 1e-10, what);
+        char what[160];
+        snprintf(what, sizeof what, "%s every 180 deg from %g deg", path, starts[k]);
+        compare_rows(&t, cols, n, want, 1e-12, 1e-10, what);
         mech_table_free(&t);
     }
     mech_model_free(&m);
 }
+
+Test(truths, branch_jump_guard) { check_coarse("tests/truths/fourbar-coarse.yaml", 0); }
+Test(truths, branch_jump_guard_twin) { check_coarse("tests/truths/fourbar-twin-coarse.yaml", 1); }
