@@ -351,8 +351,10 @@ static void run_variant(const sweep_run *r, variant *var)
         rc = mech_solve(m, &o, &t, NULL, &d);
     }
     int singular = 0, locking = 0;
-    for (size_t i = 0; i < d.count; i++) {
+    for (size_t i = 0; i < d.count; i++) {  /* the errors say what failed, not the notes */
         const char *msgtext = d.entries[i].message ? d.entries[i].message : "";
+        if (d.entries[i].severity != MECH_SEV_ERROR)
+            continue;
         singular |= strstr(msgtext, "singular") != NULL;
         locking |= strstr(msgtext, "friction does not converge") != NULL;
     }

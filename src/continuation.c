@@ -9,6 +9,12 @@
 
 static const double PI = 3.14159265358979323846;
 
+/* The largest move of the unknowns (rad, or lref for slides) a step may
+ * predict: over a longer one the Taylor prediction says little, and Newton
+ * from it may land on another assembly without either check (correction
+ * against the move, det J's sign) noticing, when two loops jump at once. */
+static const double MAX_PREDICTED_MOVE = 0.25;
+
 /* Scattered starts tried for the unknowns without a guess at row 0. */
 enum { START_ATTEMPTS = 48 };
 
@@ -161,6 +167,14 @@ step_status cont_try(cont *c, double qn, int continuing)
             sv->dx[i] = c->xpred[i] - c->xc[i];
         if (corr > 0.5 * solver_step_size(sv->p, sv->dx) + 0.05)
             return STEP_JUMP;
+        /* det J changed sign: a singular position was crossed, or Newton
+           fell onto another assembly that the test above let pass (a long
+           step, whose prediction means little). Shorten the step: a change
+           point is still crossed at a short one, a jump is not. */
+        int sign = solver_det_sign(sv);
+        if (sign != 0 && c->det_sign != 0 && sign != c->det_sign &&
+            fabs(qn - c->qc) > c->hcross)
+            return STEP_JUMP;
     }
     solver_rates(sv);
     int b;
@@ -173,15 +187,30 @@ step_status cont_try(cont *c, double qn, int continuing)
 }
 
 /* From the base c->qc to q by continuation, halving rejected steps. */
+/* How far the prediction moves the unknowns from the base (angles in rad,
+ * slides in lref). */
+static double predicted_move(cont *c)
+{
+    solver *sv = &c->sv;
+    for (int i = 0; i < sv->p->ns; i++)
+        sv->dx[i] = c->xpred[i] - c->xc[i];
+    return solver_step_size(sv->p, sv->dx);
+}
+
 step_status cont_advance(cont *c, double q, double hmin)
 {
     double h = q - c->qc;
     step_status s = STEP_OK;
     c->fail_status = STEP_OK;
+    c->hcross = 1e6 * hmin;  /* 1e-3 of the row spacing */
     while (c->qc != q) {
         double remaining = q - c->qc;
         double qn = fabs(remaining) <= fabs(h) * (1.0 + 1e-12) ? q : c->qc + h;
         predict(c, qn);
+        if (fabs(h) > c->hcross && predicted_move(c) > MAX_PREDICTED_MOVE) {
+            h *= 0.5;  /* beyond the predictor's reach: shorten before solving */
+            continue;
+        }
         s = cont_try(c, qn, 1);
         if (s == STEP_OK) {
             note_stats(c, qn);

@@ -34,6 +34,8 @@ typedef struct cont {
     int row_iters;             /* Newton iterations spent on the current row */
     int row_substeps;          /* extra continuation steps the row needed (refinement) */
     int det_sign;              /* sign of det J at the base (0: unknown) */
+    double hcross;             /* a longer step may not change det J's sign: it is
+                                  shortened (cont_try) */
     int crossings;             /* sign changes reported */
     int searching;             /* looking for assembly limits: no crossing reports */
     double fail_q;             /* where the last rejected attempt was */
