@@ -1,6 +1,6 @@
 /* src/cmd_plot.c: `mech plot` (SVG figures of the sweep) and `mech animate`
  * (an animated SVG of the mechanism). Option parsing and the solve; the
- * drawing is src/plot.c (docs/plots.md). */
+ * drawing is src/plot.c and src/plot_anim.c (docs/plots.md). */
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>

@@ -1,5 +1,5 @@
 /* src/cmd_plot.h: the `mech plot` and `mech animate` commands (src/cmd_plot.c;
- * the drawing itself is src/plot.c, docs/plots.md). */
+ * the drawing itself is src/plot.c and src/plot_anim.c, docs/plots.md). */
 #ifndef MECH_CMD_PLOT_H
 #define MECH_CMD_PLOT_H
 

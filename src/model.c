@@ -171,23 +171,25 @@ static void note_triangle(const mech_model *m, const link_pair *e[3], mech_diag 
               m->joints[j[1]].name, m->joints[j[2]].name);
 }
 
-/* Rigid sub-structures that explain an over-constraint: two links joined by
- * joints that leave them no relative motion, or three links pinned to each
- * other in a triangle. Notes name at most three; O(J log J + J^1.5). */
-/* Notes on rigid sub-structures (links joined twice, pinned triangles);
- * returns how many were found (d may be NULL: count only). */
-static int report_rigid(const mech_model *m, mech_diag *d)
+/* The workspace of report_rigid: the pairs of links joined by some joint,
+ * and the pairs pinned once as edges directed from their lower-ranked end
+ * (degree, then index) in compressed rows. */
+typedef struct rigid_work {
+    link_pair *pairs;  /* [njoints] pairs of links; the first np are distinct */
+    int np;
+    int *deg;          /* [nlinks] pairs pinned once at each link */
+    int *start;        /* [nlinks + 1] out[start[u] .. start[u+1]-1]: edges from u */
+    int *out;          /* [njoints] pair index, by lower-ranked end */
+    int *mark;         /* [nlinks] u + 1 when adjacent to u */
+    int *via;          /* [nlinks] that pair's index */
+} rigid_work;
+
+/* One entry per pair of links, with the freedoms its joints remove, sorted
+ * by link indices; sets w->np. */
+static void rigid_pairs(const mech_model *m, rigid_work *w)
 {
-    int nj = m->njoints, np = 0, found = 0;
-    link_pair *pairs = xcalloc((size_t)nj, sizeof *pairs);
-    int *deg = xcalloc((size_t)m->nlinks, sizeof *deg);
-    int *start = xcalloc((size_t)m->nlinks + 1, sizeof *start);
-    int *out = xcalloc((size_t)nj, sizeof *out);      /* pair index, by lower-ranked end */
-    int *mark = xcalloc((size_t)m->nlinks, sizeof *mark);  /* u + 1 when adjacent to u */
-    int *via = xcalloc((size_t)m->nlinks, sizeof *via);    /* that pair's index */
-    if (!pairs || !deg || !start || !out || !mark || !via)
-        goto done;
-    /* one entry per pair of links, with the freedoms its joints remove */
+    int nj = m->njoints, np = 0;
+    link_pair *pairs = w->pairs;
     for (int i = 0; i < nj; i++) {
         const mech_joint *jt = &m->joints[i];
         int a = jt->link[0] < jt->link[1] ? jt->link[0] : jt->link[1];
@@ -205,8 +207,16 @@ static int report_rigid(const mech_model *m, mech_diag *d)
             pairs[np++] = pairs[i];
         }
     }
-    for (int i = 0; i < np && found < 3; i++) {
-        const link_pair *p = &pairs[i];
+    w->np = np;
+}
+
+/* Notes on pairs joined twice with no relative motion left, while found < 3;
+ * returns the new count. */
+static int report_joined_twice(const mech_model *m, const rigid_work *w, int found,
+                               mech_diag *d)
+{
+    for (int i = 0; i < w->np && found < 3; i++) {
+        const link_pair *p = &w->pairs[i];
         if (p->second < 0 || p->cons < 3)
             continue;
         const mech_joint *ja = &m->joints[p->joint], *jb = &m->joints[p->second];
@@ -216,26 +226,46 @@ static int report_rigid(const mech_model *m, mech_diag *d)
                   jb->name);
         found++;
     }
-    /* triangles of pairs that are each pinned once: list them with every
-     * edge directed from the lower-ranked end (degree, then index) */
+    return found;
+}
+
+/* Link u ranks lower than link v: fewer pins, or as many and a lower index. */
+static int ranks_lower(const int *deg, int u, int v)
+{
+    return deg[u] < deg[v] || (deg[u] == deg[v] && u < v);
+}
+
+/* The pairs that are each pinned once, as edges directed from the
+ * lower-ranked end: w->deg, w->start, w->out (w->mark is left zero). */
+static void direct_pins(const mech_model *m, rigid_work *w)
+{
+    const link_pair *pairs = w->pairs;
+    int np = w->np, *deg = w->deg, *start = w->start;
     for (int i = 0; i < np; i++)
         if (pairs[i].cons == 2)
             deg[pairs[i].a]++, deg[pairs[i].b]++;
-#define LOWER(u, v) (deg[u] < deg[v] || (deg[u] == deg[v] && (u) < (v)))
     for (int i = 0; i < np; i++)
         if (pairs[i].cons == 2)
-            start[(LOWER(pairs[i].a, pairs[i].b) ? pairs[i].a : pairs[i].b) + 1]++;
+            start[(ranks_lower(deg, pairs[i].a, pairs[i].b) ? pairs[i].a : pairs[i].b) + 1]++;
     for (int v = 0; v < m->nlinks; v++)
         start[v + 1] += start[v];
-    {
-        int *fill = mark;  /* borrowed, reset below */
-        for (int i = 0; i < np; i++)
-            if (pairs[i].cons == 2) {
-                int u = LOWER(pairs[i].a, pairs[i].b) ? pairs[i].a : pairs[i].b;
-                out[start[u] + fill[u]++] = i;
-            }
-        memset(mark, 0, (size_t)m->nlinks * sizeof *mark);
-    }
+    int *fill = w->mark;  /* borrowed, reset below */
+    for (int i = 0; i < np; i++)
+        if (pairs[i].cons == 2) {
+            int u = ranks_lower(deg, pairs[i].a, pairs[i].b) ? pairs[i].a : pairs[i].b;
+            w->out[start[u] + fill[u]++] = i;
+        }
+    memset(w->mark, 0, (size_t)m->nlinks * sizeof *w->mark);
+}
+
+/* Notes on triangles of pairs that are each pinned once, while found < 3
+ * (each triangle is found once, from its lowest-ranked link); returns the
+ * new count. */
+static int report_triangles(const mech_model *m, rigid_work *w, int found, mech_diag *d)
+{
+    const link_pair *pairs = w->pairs;
+    const int *start = w->start, *out = w->out;
+    int *mark = w->mark, *via = w->via;
     for (int u = 0; u < m->nlinks && found < 3; u++) {
         for (int k = start[u]; k < start[u + 1]; k++) {
             const link_pair *e = &pairs[out[k]];
@@ -248,23 +278,44 @@ static int report_rigid(const mech_model *m, mech_diag *d)
             int v = e->a == u ? e->b : e->a;
             for (int t = start[v]; t < start[v + 1] && found < 3; t++) {
                 const link_pair *f = &pairs[out[t]];
-                int w = f->a == v ? f->b : f->a;
-                if (mark[w] == u + 1) {
-                    const link_pair *tri[3] = {e, f, &pairs[via[w]]};
+                int x = f->a == v ? f->b : f->a;
+                if (mark[x] == u + 1) {
+                    const link_pair *tri[3] = {e, f, &pairs[via[x]]};
                     note_triangle(m, tri, d);
                     found++;
                 }
             }
         }
     }
-#undef LOWER
-done:
-    free(pairs);
-    free(deg);
-    free(start);
-    free(out);
-    free(mark);
-    free(via);
+    return found;
+}
+
+/* Rigid sub-structures that explain an over-constraint: two links joined by
+ * joints that leave them no relative motion, or three links pinned to each
+ * other in a triangle. Notes name at most three; O(J log J + J^1.5).
+ * Returns how many were found (d may be NULL: count only). */
+static int report_rigid(const mech_model *m, mech_diag *d)
+{
+    int nj = m->njoints, found = 0;
+    rigid_work w = {0};
+    w.pairs = xcalloc((size_t)nj, sizeof *w.pairs);
+    w.deg = xcalloc((size_t)m->nlinks, sizeof *w.deg);
+    w.start = xcalloc((size_t)m->nlinks + 1, sizeof *w.start);
+    w.out = xcalloc((size_t)nj, sizeof *w.out);
+    w.mark = xcalloc((size_t)m->nlinks, sizeof *w.mark);
+    w.via = xcalloc((size_t)m->nlinks, sizeof *w.via);
+    if (w.pairs && w.deg && w.start && w.out && w.mark && w.via) {
+        rigid_pairs(m, &w);
+        found = report_joined_twice(m, &w, found, d);
+        direct_pins(m, &w);
+        found = report_triangles(m, &w, found, d);
+    }
+    free(w.pairs);
+    free(w.deg);
+    free(w.start);
+    free(w.out);
+    free(w.mark);
+    free(w.via);
     return found;
 }
 

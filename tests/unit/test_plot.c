@@ -1,4 +1,4 @@
-/* tests/unit/test_plot.c: the pieces of src/plot.c a reader of the figures
+/* tests/unit/test_plot.c: the pieces of src/plot*.c a reader of the figures
  * relies on: tick steps are 1, 2 or 5 x 10^k, numbers are printed without
  * noise, the figures follow the outputs, and every file is written whole.
  * (Rendering is checked in a browser by tests/browser/run.sh.) */
