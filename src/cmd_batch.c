@@ -289,114 +289,134 @@ static void print_table(const batch *b, FILE *out)
     }
 }
 
+/* The command line of mech batch: the options into b and *opt, the file
+ * names into files (room for argc). -1 when fine, else the exit status
+ * (the problem printed). */
+typedef struct batch_opts {
+    int nthreads, quiet, shard_k, shard_m;
+} batch_opts;
+
+static int batch_option(batch *b, batch_opts *bo, const char *a, const char *v)
+{
+    char *end;
+    if (!strcmp(a, "-j") || !strcmp(a, "--jobs")) {
+        long n = strtol(v, &end, 10);
+        if (*end || n < 1 || n > 1024)
+            return cmd_usage_error("batch", "-j needs a number of workers from 1 to 1024, not '%s'", v);
+        bo->nthreads = (int)n;
+    } else if (!strcmp(a, "--out-dir")) {
+        b->out_dir = v;
+    } else if (!strcmp(a, "--golden")) {
+        b->golden_dir = v;
+    } else if (!strcmp(a, "--rtol") || !strcmp(a, "--atol")) {
+        double x = strtod(v, &end);
+        if (*end || !(x >= 0))
+            return cmd_usage_error("batch", "a tolerance must be a number >= 0, not '%s'", v);
+        *(a[2] == 'r' ? &b->cmp.rtol : &b->cmp.atol) = x;
+    } else if (!strcmp(a, "--shard")) {
+        if (cmd_parse_shard(v, &bo->shard_k, &bo->shard_m) < 0)
+            return cmd_usage_error("batch", "--shard needs K/M with 0 <= K < M, not '%s'", v);
+    }
+    return -1;
+}
+
+static int parse_batch_args(int argc, char **argv, batch *b, batch_opts *bo, const char **files,
+                            int *nfiles)
+{
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
+        int takes = !strcmp(a, "-j") || !strcmp(a, "--jobs") || !strcmp(a, "--out-dir") ||
+                    !strcmp(a, "--golden") || !strcmp(a, "--shard") || !strcmp(a, "--rtol") ||
+                    !strcmp(a, "--atol");
+        int code = -1;
+        if (cmd_wants_help(a))
+            return fputs(cmd_batch_help, stdout), MECH_EXIT_OK;
+        if (takes && !v)
+            return cmd_usage_error("batch", "option '%s' needs a value", a);
+        if (takes)
+            code = batch_option(b, bo, a, v);
+        else if (!strcmp(a, "--forces"))
+            b->forces = 1;
+        else if (!strcmp(a, "-q") || !strcmp(a, "--quiet"))
+            bo->quiet = 1;
+        else if (a[0] == '-' && a[1])
+            code = cmd_usage_error("batch", "unknown option '%s'", a);
+        else
+            files[(*nfiles)++] = a;
+        if (code >= 0)
+            return code;
+        if (takes)
+            i++;
+    }
+    if (*nfiles == 0)
+        return cmd_usage_error("batch", "%s", "no files given (usage: mech batch FILE... [-j N])");
+    return -1;
+}
+
+/* The jobs of every file given; their outputs checked over all of them, so
+ * that shards merged later cannot collide either; then only this shard's
+ * jobs are kept. -1 when fine, else the exit status. */
+static int make_jobs(batch *b, const batch_opts *bo, const char **files, int nfiles)
+{
+    b->jobs = calloc((size_t)nfiles, sizeof *b->jobs);
+    if (!b->jobs)
+        return fprintf(stderr, "mech batch: out of memory\n"), MECH_EXIT_IO;
+    for (int i = 0; i < nfiles; i++) {
+        job *jb = &b->jobs[b->njobs++];
+        jb->path = files[i];
+        base_name(files[i], jb->name, sizeof jb->name);
+    }
+    int code = prepare_outputs(b), kept = 0;
+    for (int i = 0; i < b->njobs; i++)
+        if (code < 0 && i % bo->shard_m == bo->shard_k) {
+            b->jobs[kept++] = b->jobs[i];
+        } else {
+            free(b->jobs[i].csv);
+            free(b->jobs[i].golden_path);
+        }
+    b->njobs = kept;
+    return code;
+}
+
+/* Each job's messages, then the summary table; the worst outcome: a failed
+ * solve or differing golden (1) outranks invalid input (2) and unreadable
+ * files (3), then success. */
+static int report_jobs(batch *b, int quiet)
+{
+    int code = MECH_EXIT_OK;
+    for (int i = 0; i < b->njobs; i++) {
+        job *jb = &b->jobs[i];
+        if (!quiet && jb->messages && jb->msize)
+            fputs(jb->messages, stderr);
+        free(jb->messages);
+        free(jb->csv);
+        free(jb->golden_path);
+        if (jb->code == MECH_EXIT_SOLVE || (code == MECH_EXIT_OK && jb->code != MECH_EXIT_OK))
+            code = jb->code;
+    }
+    print_table(b, stdout);
+    return code;
+}
+
 int cmd_batch(int argc, char **argv)
 {
     batch b;
     memset(&b, 0, sizeof b);
     compare_options_default(&b.cmp);
     b.cmp.table = 0;
-    int nthreads = cmd_default_jobs(), quiet = 0, shard_k = 0, shard_m = 1;
+    batch_opts bo = {cmd_default_jobs(), 0, 0, 1};
     const char **files = calloc((size_t)argc + 1, sizeof *files);
     int nfiles = 0;
     if (!files)
-        return MECH_EXIT_INPUT;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
-        int takes = !strcmp(a, "-j") || !strcmp(a, "--jobs") || !strcmp(a, "--out-dir") ||
-                    !strcmp(a, "--golden") || !strcmp(a, "--shard") || !strcmp(a, "--rtol") ||
-                    !strcmp(a, "--atol");
-        if (cmd_wants_help(a)) {
-            fputs(cmd_batch_help, stdout);
-            free(files);
-            return MECH_EXIT_OK;
-        }
-        if (takes && !v) {
-            free(files);
-            return cmd_usage_error("batch", "option '%s' needs a value", a);
-        }
-        char *end;
-        if (!strcmp(a, "-j") || !strcmp(a, "--jobs")) {
-            long n = strtol(v, &end, 10);
-            if (*end || n < 1 || n > 1024) {
-                free(files);
-                return cmd_usage_error("batch", "-j needs a number of workers from 1 to 1024, not '%s'", v);
-            }
-            nthreads = (int)n;
-        } else if (!strcmp(a, "--out-dir")) {
-            b.out_dir = v;
-        } else if (!strcmp(a, "--golden")) {
-            b.golden_dir = v;
-        } else if (!strcmp(a, "--rtol") || !strcmp(a, "--atol")) {
-            double x = strtod(v, &end);
-            if (*end || !(x >= 0)) {
-                free(files);
-                return cmd_usage_error("batch", "a tolerance must be a number >= 0, not '%s'", v);
-            }
-            *(a[2] == 'r' ? &b.cmp.rtol : &b.cmp.atol) = x;
-        } else if (!strcmp(a, "--shard")) {
-            if (cmd_parse_shard(v, &shard_k, &shard_m) < 0) {
-                free(files);
-                return cmd_usage_error("batch", "--shard needs K/M with 0 <= K < M, not '%s'", v);
-            }
-        } else if (!strcmp(a, "--forces")) {
-            b.forces = 1;
-        } else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
-            quiet = 1;
-        } else if (a[0] == '-' && a[1]) {
-            free(files);
-            return cmd_usage_error("batch", "unknown option '%s'", a);
-        } else {
-            files[nfiles++] = a;
-        }
-        if (takes)
-            i++;
+        return fprintf(stderr, "mech batch: out of memory\n"), MECH_EXIT_IO;
+    int code = parse_batch_args(argc, argv, &b, &bo, files, &nfiles);
+    if (code < 0)
+        code = make_jobs(&b, &bo, files, nfiles);
+    if (code < 0) {
+        b.progress = !bo.quiet && isatty(STDERR_FILENO);
+        cmd_run_parallel(b.njobs, bo.nthreads, batch_job, &b);
+        code = report_jobs(&b, bo.quiet);
     }
-    if (nfiles == 0) {
-        free(files);
-        return cmd_usage_error("batch", "%s", "no files given (usage: mech batch FILE... [-j N])");
-    }
-    b.jobs = calloc((size_t)nfiles, sizeof *b.jobs);
-    if (!b.jobs) {
-        free(files);
-        return MECH_EXIT_INPUT;
-    }
-    for (int i = 0; i < nfiles; i++) {
-        job *jb = &b.jobs[b.njobs++];
-        jb->path = files[i];
-        base_name(files[i], jb->name, sizeof jb->name);
-    }
-    /* outputs checked over every file, so that shards merged later cannot
-       collide either; then only this shard's files are kept */
-    int code = prepare_outputs(&b), kept = 0;
-    for (int i = 0; i < b.njobs; i++)
-        if (code < 0 && i % shard_m == shard_k) {
-            b.jobs[kept++] = b.jobs[i];
-        } else {
-            free(b.jobs[i].csv);
-            free(b.jobs[i].golden_path);
-        }
-    b.njobs = kept;
-    if (code >= 0) {
-        free(b.jobs);
-        free(files);
-        return code;
-    }
-    b.progress = !quiet && isatty(STDERR_FILENO);
-    cmd_run_parallel(b.njobs, nthreads, batch_job, &b);
-    code = MECH_EXIT_OK;
-    for (int i = 0; i < b.njobs; i++) {
-        job *jb = &b.jobs[i];
-        if (!quiet && jb->messages && jb->msize)
-            fputs(jb->messages, stderr);
-        free(jb->messages);
-        free(jb->csv);
-        free(jb->golden_path);
-        /* worst outcome: a failed solve or differing golden (1) outranks
-           invalid input (2) and unreadable files (3), then success */
-        if (jb->code == MECH_EXIT_SOLVE || (code == MECH_EXIT_OK && jb->code != MECH_EXIT_OK))
-            code = jb->code;
-    }
-    print_table(&b, stdout);
     free(b.jobs);
     free(files);
     return code;
