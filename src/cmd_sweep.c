@@ -455,103 +455,125 @@ static void free_run(sweep_run *r)
     free(r->vars);
 }
 
-int cmd_sweep(int argc, char **argv)
+/* The command line of mech sweep into r (and *out, *sh). -1 when fine,
+ * else the exit status (the problem printed). */
+typedef struct sweep_opts {
+    const char *out;
+    long nthreads;
+    int shard_k, shard_m;
+} sweep_opts;
+
+static int sweep_option(sweep_run *r, sweep_opts *so, const char *a, const char *v)
 {
-    sweep_run r;
-    memset(&r, 0, sizeof r);
-    const char *out = NULL;
-    long nthreads = cmd_default_jobs();
-    int shard_k = 0, shard_m = 1, code = -1;
+    char *end;
+    if (!strcmp(a, "--vary") || !strcmp(a, "--list"))
+        return parse_vary(r, v, a[2] == 'l');
+    if (!strcmp(a, "--metric"))
+        return parse_metric(r, v);
+    if (!strcmp(a, "-o")) {
+        so->out = v;
+    } else if (!strcmp(a, "-j") || !strcmp(a, "--jobs")) {
+        so->nthreads = strtol(v, &end, 10);
+        if (*end || so->nthreads < 1 || so->nthreads > 1024)
+            return cmd_usage_error("sweep", "-j needs a number of workers from 1 to 1024, not '%s'", v);
+    } else if (!strcmp(a, "--shard")) {
+        if (cmd_parse_shard(v, &so->shard_k, &so->shard_m) < 0)
+            return cmd_usage_error("sweep", "--shard needs K/M with 0 <= K < M, not '%s'", v);
+    }
+    return -1;
+}
+
+static int parse_sweep_args(int argc, char **argv, sweep_run *r, sweep_opts *so)
+{
+    int code = -1;
     for (int i = 1; i < argc && code < 0; i++) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
         int takes = !strcmp(a, "--vary") || !strcmp(a, "--list") || !strcmp(a, "--metric") ||
                     !strcmp(a, "-o") || !strcmp(a, "-j") || !strcmp(a, "--jobs") ||
                     !strcmp(a, "--shard");
-        if (cmd_wants_help(a)) {
-            fputs(cmd_sweep_help, stdout);
-            free_run(&r);
-            return MECH_EXIT_OK;
-        }
-        if (takes && !v) {
-            code = cmd_usage_error("sweep", "option '%s' needs a value", a);
-            break;
-        }
-        char *end;
-        if (!strcmp(a, "--vary") || !strcmp(a, "--list"))
-            code = parse_vary(&r, v, a[2] == 'l');
-        else if (!strcmp(a, "--metric"))
-            code = parse_metric(&r, v);
-        else if (!strcmp(a, "-o"))
-            out = v;
-        else if (!strcmp(a, "-j") || !strcmp(a, "--jobs")) {
-            nthreads = strtol(v, &end, 10);
-            if (*end || nthreads < 1 || nthreads > 1024)
-                code = cmd_usage_error("sweep", "-j needs a number of workers from 1 to 1024, not '%s'", v);
-        } else if (!strcmp(a, "--shard")) {
-            if (cmd_parse_shard(v, &shard_k, &shard_m) < 0)
-                code = cmd_usage_error("sweep", "--shard needs K/M with 0 <= K < M, not '%s'", v);
-        } else if (!strcmp(a, "--forces"))
-            r.forces = 1;
+        if (cmd_wants_help(a))
+            return fputs(cmd_sweep_help, stdout), MECH_EXIT_OK;
+        if (takes && !v)
+            return cmd_usage_error("sweep", "option '%s' needs a value", a);
+        if (takes)
+            code = sweep_option(r, so, a, v);
+        else if (!strcmp(a, "--forces"))
+            r->forces = 1;
         else if (a[0] == '-' && a[1])
             code = cmd_usage_error("sweep", "unknown option '%s'", a);
-        else if (r.file)
+        else if (r->file)
             code = cmd_usage_error("sweep", "one file at a time ('%s' is a second file)", a);
         else
-            r.file = a;
+            r->file = a;
         if (takes)
             i++;
     }
-    if (code < 0 && !r.file)
+    if (code < 0 && !r->file)
         code = cmd_usage_error("sweep", "%s", "no file given (usage: mech sweep FILE --vary NAME=FROM:TO:COUNT)");
-    if (code < 0 && r.naxes == 0)
+    if (code < 0 && r->naxes == 0)
         code = cmd_usage_error("sweep", "%s", "nothing to vary: give --vary NAME=FROM:TO:COUNT or --list");
     if (code < 0)
-        code = cmd_refuse_input("sweep", out, &r.file, 1);
+        code = cmd_refuse_input("sweep", so->out, &r->file, 1);
+    return code;
+}
+
+/* The file and the parameter names, checked once before the grid (the
+ * first variant loads, the metrics name columns it has). -1 when fine. */
+static int check_base(sweep_run *r)
+{
+    mech_override ov[MAX_VARY];
+    variant_overrides(r, 0, ov);
+    mech_diag d;
+    mech_diag_init(&d);
+    mech_model *m = NULL;
+    int rc = mech_load_file_with(r->file, ov, r->naxes, &m, &d);
+    mech_diag_print(&d, stderr);
+    mech_diag_free(&d);
+    int code = rc == MECH_OK ? check_metrics(r, m) : cmd_exit_status(rc);
+    mech_model_free(&m);
+    return code;
+}
+
+/* This shard's variants of the grid, solved on worker threads; the rows
+ * written; exit 1 when none was solved. */
+static int run_variants(sweep_run *r, const sweep_opts *so, long total)
+{
+    r->vars = calloc((size_t)total, sizeof *r->vars);
+    if (!r->vars)
+        return fprintf(stderr, "mech sweep: out of memory\n"), MECH_EXIT_IO;
+    for (long i = 0; i < total; i++)
+        if (i % so->shard_m == so->shard_k)
+            r->vars[r->nvars++].index = (int)i;
+    cmd_run_parallel(r->nvars, (int)so->nthreads, sweep_job, r);
+    int nok = 0;
+    for (int i = 0; i < r->nvars; i++) {
+        if (strcmp(r->vars[i].status, "ok") == 0)
+            nok++;
+        else if (r->vars[i].messages)
+            fputs(r->vars[i].messages, stderr);
+    }
+    int code = write_file(r, so->out);
+    if (code == MECH_EXIT_OK && r->nvars > 0 && nok == 0) {
+        fprintf(stderr, "mech sweep: none of the %d variants could be solved\n", r->nvars);
+        code = MECH_EXIT_SOLVE;
+    }
+    return code;
+}
+
+int cmd_sweep(int argc, char **argv)
+{
+    sweep_run r;
+    memset(&r, 0, sizeof r);
+    sweep_opts so = {NULL, cmd_default_jobs(), 0, 1};
+    int code = parse_sweep_args(argc, argv, &r, &so);
     long total = 1;
     for (int k = 0; code < 0 && k < r.naxes; k++)
         if ((total *= r.axes[k].count) > 10000000)
             code = cmd_usage_error("sweep", "%s", "more than 10^7 variants");
-    if (code >= 0) {
-        free_run(&r);
-        return code;
-    }
-    /* the file and the parameter names, checked once before the grid */
-    mech_override ov[MAX_VARY];
-    variant_overrides(&r, 0, ov);
-    mech_diag d;
-    mech_diag_init(&d);
-    mech_model *m = NULL;
-    int rc = mech_load_file_with(r.file, ov, r.naxes, &m, &d);
-    mech_diag_print(&d, stderr);
-    mech_diag_free(&d);
-    code = rc == MECH_OK ? check_metrics(&r, m) : cmd_exit_status(rc);
-    mech_model_free(&m);
-    if (code >= 0) {
-        free_run(&r);
-        return code;
-    }
-    r.vars = calloc((size_t)total, sizeof *r.vars);
-    if (!r.vars) {
-        fprintf(stderr, "mech sweep: out of memory\n");
-        free_run(&r);
-        return MECH_EXIT_IO;
-    }
-    for (long i = 0; i < total; i++)
-        if (i % shard_m == shard_k)
-            r.vars[r.nvars++].index = (int)i;
-    cmd_run_parallel(r.nvars, (int)nthreads, sweep_job, &r);
-    int nok = 0;
-    for (int i = 0; i < r.nvars; i++) {
-        if (strcmp(r.vars[i].status, "ok") == 0)
-            nok++;
-        else if (r.vars[i].messages)
-            fputs(r.vars[i].messages, stderr);
-    }
-    code = write_file(&r, out);
-    if (code == MECH_EXIT_OK && r.nvars > 0 && nok == 0) {
-        fprintf(stderr, "mech sweep: none of the %d variants could be solved\n", r.nvars);
-        code = MECH_EXIT_SOLVE;
-    }
+    if (code < 0)
+        code = check_base(&r);
+    if (code < 0)
+        code = run_variants(&r, &so, total);
     free_run(&r);
     return code;
 }
