@@ -372,8 +372,11 @@ typedef struct mech_analysis mech_analysis;
 int mech_analysis_new(const mech_model *m, const mech_solve_options *o, mech_analysis **out,
                       mech_diag *d);
 void mech_analysis_free(mech_analysis **a);
-/* Columns of the tables the analysis produces. */
+/* Columns of the tables the analysis produces; mech_analysis_header gives
+ * their names and units in a table with no rows (free it with
+ * mech_table_free). MECH_OK or MECH_ENOMEM. */
 int mech_analysis_columns(const mech_analysis *a);
+int mech_analysis_header(const mech_analysis *a, mech_table *out);
 /* Solve the driver positions q[0..nq-1] (in order: each row continues from
  * the one before), or the analysis's own when q is NULL. Results, failures
  * and stats as mech_solve. */

@@ -239,9 +239,8 @@ static int check_column(const metric *mt, const char *col, const mech_table *t, 
 
 /* Every metric names columns the variants' tables will have: those of the
  * base model m (the file with the first variant's values; parameters change
- * numbers, not names). mech_solve makes its table's columns before it
- * solves any position, so a solve over the first two driver positions gives
- * them even when the base variant cannot assemble. The note that forces
+ * numbers, not names), which its analysis knows without solving anything
+ * (mech_analysis_header), even when the base variant cannot assemble. The note that forces
  * are all zero (no mass, no load) is printed here, once for the grid.
  * Returns -1 when all are there (or the columns cannot be known: the base
  * does not even build, and every variant will say why), else the exit
@@ -253,18 +252,15 @@ static int check_metrics(const sweep_run *r, const mech_model *m)
     mech_summary sum;
     int rc = mech_check(m, &sum, &d);
     mech_table t = {0};
-    if (rc == MECH_OK && (r->nmetrics > 0 || r->forces) && m->has_driver &&
-        m->driver.nvalues > 0) {
+    if (rc == MECH_OK && (r->nmetrics > 0 || r->forces) && m->has_driver) {
         mech_solve_options o;
         mech_solve_options_default(&o);
         o.forces = r->forces;
-        if (m->driver.nvalues > 1) {
-            o.has_range = 1;
-            o.from = m->driver.values[0];
-            o.to = m->driver.values[1];
-            o.steps = 1;
-        }
-        rc = mech_solve(m, &o, &t, NULL, &d);
+        mech_analysis *a = NULL;
+        rc = mech_analysis_new(m, &o, &a, &d);
+        if (rc == MECH_OK)
+            rc = mech_analysis_header(a, &t);
+        mech_analysis_free(&a);
     }
     for (size_t i = 0; i < d.count; i++)
         if (d.entries[i].severity == MECH_SEV_NOTE &&

@@ -181,6 +181,11 @@ void mech_analysis_free(mech_analysis **pa)
 
 int mech_analysis_columns(const mech_analysis *a) { return a->cols.ncols; }
 
+int mech_analysis_header(const mech_analysis *a, mech_table *out)
+{
+    return columns_make_table(&a->cols, out, 0);
+}
+
 /* ---- one sweep -------------------------------------------------------------- */
 
 /* One call's state: the continuation, the forces, and where rows go. */
