@@ -8,7 +8,8 @@
 #   make bench      optimised benchmarks, printed as tables
 #   make golden     regenerate tests/golden/*.csv (review the diff by hand)
 #   make install PREFIX=/usr/local   mech, libmech.so/.a, mech.h, mech.pc, mech.1,
-#                   the Python module mech (docs/api.md); DESTDIR is honoured
+#                   the Python module mech (docs/api.md; WITH_PYTHON=0 leaves it
+#                   out, and with it python3-dev and numpy); DESTDIR is honoured
 #   make python     build the Python extension only (build/python/mech)
 #   make test-python   pytest on the Python module, installed in a temporary prefix
 #   make clean
@@ -31,6 +32,7 @@ PY_CFLAGS    = $(shell $(PYTHON)-config --includes 2>/dev/null) \
                -I$(shell $(PYTHON) -c 'import numpy; print(numpy.get_include())' 2>/dev/null)
 PY_EXT      := $(shell $(PYTHON)-config --extension-suffix 2>/dev/null || echo .so)
 PYDIR        = lib/python3/dist-packages
+WITH_PYTHON ?= 1
 
 # The library's version is MECH_VERSION in mech.h; the soname carries its
 # first number (the ABI: bumped when a struct or signature changes).
@@ -130,21 +132,17 @@ test: deps
 # built with pkg-config alone (shared and --static), its numbers against
 # mech solve's CSV, and the man page rendered.
 test-install: lib python $(BUILD)/mech
-	BUILD=$(BUILD) CC="$(CC)" SAN="$(SAN)" MAKE="$(MAKE)" sh tests/install.sh
+	BUILD=$(BUILD) CC="$(CC)" OPT="$(OPT)" SAN="$(SAN)" MAKE="$(MAKE)" sh tests/install.sh
 
 # pytest on the Python module installed into a temporary prefix. Under the
 # sanitizers the extension and the library are instrumented and python3 is
-# not: then the module is tested by the plain build only.
+# not: the sanitizers' run-time libraries are preloaded (leak detection off:
+# the interpreter keeps its memory at exit).
+SAN_PRELOAD = $(if $(findstring address,$(SAN)),$(shell $(CC) -print-file-name=libasan.so)) \
+              $(if $(findstring undefined,$(SAN)),$(shell $(CC) -print-file-name=libubsan.so))
 test-python: lib python $(BUILD)/mech
-ifeq ($(SAN),)
-	BUILD=$(BUILD) PYTHON=$(PYTHON) MAKE="$(MAKE)" sh tests/python/run.sh
-else
-	@echo "test-python: skipped under sanitizers (python3 is not instrumented; make test runs it)"
-endif
-
-test-san:
-	@$(MAKE) --no-print-directory test BUILD=build/san OPT="-O1 -g -fno-omit-frame-pointer" \
-	    SAN="-fsanitize=address,undefined -fno-sanitize-recover=all"
+	BUILD=$(BUILD) PYTHON=$(PYTHON) MAKE="$(MAKE)" OPT="$(OPT)" SAN="$(SAN)" \
+	    SAN_PRELOAD="$(strip $(if $(SAN),$(SAN_PRELOAD)))" sh tests/python/run.sh
 
 # Fuzzing with clang's libFuzzer (tests/fuzz/README.md): fuzz runs
 # FUZZ_SECONDS (default 60); fuzz-replay only the regression inputs.
@@ -206,10 +204,9 @@ golden: all
 	    $(BUILD)/mech solve $$f -o tests/golden/$$n.csv || exit 1; \
 	done
 
-install: all python
+install: all $(if $(filter 1,$(WITH_PYTHON)),python)
 	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib/pkgconfig \
-	    $(DESTDIR)$(PREFIX)/include $(DESTDIR)$(PREFIX)/share/man/man1 \
-	    $(DESTDIR)$(PREFIX)/$(PYDIR)/mech
+	    $(DESTDIR)$(PREFIX)/include $(DESTDIR)$(PREFIX)/share/man/man1
 	install -m 755 $(BUILD)/mech $(DESTDIR)$(PREFIX)/bin/mech
 	install -m 644 $(BUILD)/libmech.a $(DESTDIR)$(PREFIX)/lib/libmech.a
 	install -m 755 $(BUILD)/libmech.so.$(VERSION) $(DESTDIR)$(PREFIX)/lib/libmech.so.$(VERSION)
@@ -219,8 +216,11 @@ install: all python
 	    mech.pc.in >$(DESTDIR)$(PREFIX)/lib/pkgconfig/mech.pc
 	install -m 644 include/mech.h $(DESTDIR)$(PREFIX)/include/mech.h
 	install -m 644 docs/mech.1 $(DESTDIR)$(PREFIX)/share/man/man1/mech.1
+ifeq ($(WITH_PYTHON),1)
+	install -d $(DESTDIR)$(PREFIX)/$(PYDIR)/mech
 	install -m 644 python/mech/__init__.py $(DESTDIR)$(PREFIX)/$(PYDIR)/mech/__init__.py
 	install -m 755 $(BUILD)/python/mech/_mech$(PY_EXT) $(DESTDIR)$(PREFIX)/$(PYDIR)/mech/_mech$(PY_EXT)
+endif
 
 clean:
 	rm -rf build

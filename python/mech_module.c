@@ -227,64 +227,81 @@ static int put(PyObject *d, const char *key, PyObject *value)
     return rc;
 }
 
+/* [name of link 0, ...] or [point name 0, ...] */
+static PyObject *all_names(const mech_model *m, int points)
+{
+    int n = points ? m->npoint_names : m->nlinks;
+    PyObject *list = PyList_New(n);
+    for (int i = 0; list && i < n; i++) {
+        PyObject *s = PyUnicode_FromString(points ? m->point_names[i] : m->links[i].name);
+        if (!s) {
+            Py_CLEAR(list);
+            break;
+        }
+        PyList_SET_ITEM(list, i, s);
+    }
+    return list;
+}
+
+static PyObject *params_dict(const mech_model *m)
+{
+    PyObject *d = PyDict_New();
+    for (int i = 0; d && i < m->nparams; i++) {
+        PyObject *v = PyFloat_FromDouble(m->params[i].value);
+        if (!v || PyDict_SetItemString(d, m->params[i].name, v) < 0)
+            Py_CLEAR(d);
+        Py_XDECREF(v);
+    }
+    return d;
+}
+
+static PyObject *joints_list(const mech_model *m)
+{
+    PyObject *list = PyList_New(m->njoints);
+    for (int i = 0; list && i < m->njoints; i++) {
+        const mech_joint *j = &m->joints[i];
+        const char *kind = j->kind == MECH_JOINT_REVOLUTE ? "revolute"
+                           : j->locked ? "prismatic" : "pin-in-slot";
+        PyObject *item = Py_BuildValue("{s:s,s:s,s:(ss)}", "name", j->name, "kind", kind, "links",
+                                       m->links[j->link[0]].name, m->links[j->link[1]].name);
+        if (!item) {
+            Py_CLEAR(list);
+            break;
+        }
+        PyList_SET_ITEM(list, i, item);
+    }
+    return list;
+}
+
+static PyObject *driver_dict(const mech_model *m)
+{
+    const mech_driver *dr = &m->driver;
+    int angle = dr->kind == MECH_DRIVE_ANGLE;
+    if (!m->has_driver)
+        return Py_NewRef(Py_None);
+    return Py_BuildValue("{s:s,s:s,s:i,s:d,s:d,s:d,s:d}", "kind", angle ? "angle" : "slider",
+                         angle ? "link" : "joint",
+                         angle ? m->links[dr->index].name : m->joints[dr->index].name,
+                         "positions", dr->nvalues, "from", dr->values[0], "to",
+                         dr->values[dr->nvalues - 1], "speed", dr->speed, "accel", dr->accel);
+}
+
 /* The model as a dict (SI units). */
 static PyObject *model_dict(const mech_model *m)
 {
-    PyObject *d = PyDict_New(), *x;
+    const mech_outputs *o = &m->outputs;
+    PyObject *d = PyDict_New();
     int ok = d != NULL;
     ok = ok && put(d, "file", PyUnicode_FromString(m->file)) == 0;
     ok = ok && put(d, "name", PyUnicode_FromString(m->name)) == 0;
     ok = ok && put(d, "description", m->description ? PyUnicode_FromString(m->description)
                                                     : Py_NewRef(Py_None)) == 0;
     ok = ok && put(d, "gravity", Py_BuildValue("(dd)", m->gravity[0], m->gravity[1])) == 0;
-    ok = ok && (x = PyDict_New()) != NULL;
-    for (int i = 0; ok && i < m->nparams; i++) {
-        PyObject *v = PyFloat_FromDouble(m->params[i].value);
-        ok = v && PyDict_SetItemString(x, m->params[i].name, v) == 0;
-        Py_XDECREF(v);
-    }
-    ok = ok && put(d, "parameters", x) == 0;
-    ok = ok && (x = PyList_New(m->nlinks)) != NULL;
-    for (int i = 0; ok && i < m->nlinks; i++) {
-        PyObject *s = PyUnicode_FromString(m->links[i].name);
-        ok = s != NULL;
-        if (ok)
-            PyList_SET_ITEM(x, i, s);
-    }
-    ok = ok && put(d, "links", x) == 0;
-    ok = ok && (x = PyList_New(m->npoint_names)) != NULL;
-    for (int i = 0; ok && i < m->npoint_names; i++) {
-        PyObject *s = PyUnicode_FromString(m->point_names[i]);
-        ok = s != NULL;
-        if (ok)
-            PyList_SET_ITEM(x, i, s);
-    }
-    ok = ok && put(d, "points", x) == 0;
-    ok = ok && (x = PyList_New(m->njoints)) != NULL;
-    for (int i = 0; ok && i < m->njoints; i++) {
-        const mech_joint *j = &m->joints[i];
-        const char *kind = j->kind == MECH_JOINT_REVOLUTE ? "revolute"
-                           : j->locked ? "prismatic" : "pin-in-slot";
-        PyObject *item = Py_BuildValue("{s:s,s:s,s:(ss)}", "name", j->name, "kind", kind, "links",
-                                       m->links[j->link[0]].name, m->links[j->link[1]].name);
-        ok = item != NULL;
-        if (ok)
-            PyList_SET_ITEM(x, i, item);
-    }
-    ok = ok && put(d, "joints", x) == 0;
-    if (ok && m->has_driver) {
-        const mech_driver *dr = &m->driver;
-        int angle = dr->kind == MECH_DRIVE_ANGLE;
-        x = Py_BuildValue("{s:s,s:s,s:i,s:d,s:d,s:d,s:d}", "kind", angle ? "angle" : "slider",
-                          angle ? "link" : "joint",
-                          angle ? m->links[dr->index].name : m->joints[dr->index].name,
-                          "positions", dr->nvalues, "from", dr->values[0], "to",
-                          dr->values[dr->nvalues - 1], "speed", dr->speed, "accel", dr->accel);
-        ok = put(d, "driver", x) == 0;
-    } else if (ok) {
-        ok = put(d, "driver", Py_NewRef(Py_None)) == 0;
-    }
-    const mech_outputs *o = &m->outputs;
+    ok = ok && put(d, "parameters", params_dict(m)) == 0;
+    ok = ok && put(d, "links", all_names(m, 0)) == 0;
+    ok = ok && put(d, "points", all_names(m, 1)) == 0;
+    ok = ok && put(d, "joints", joints_list(m)) == 0;
+    ok = ok && put(d, "driver", driver_dict(m)) == 0;
     ok = ok && put(d, "outputs",
                    Py_BuildValue("{s:N,s:N,s:N,s:O}", "points",
                                  names_list(m, o->points, o->npoints, 0), "links",
