@@ -144,6 +144,10 @@ test-python: lib python $(BUILD)/mech
 	BUILD=$(BUILD) PYTHON=$(PYTHON) MAKE="$(MAKE)" OPT="$(OPT)" SAN="$(SAN)" \
 	    SAN_PRELOAD="$(strip $(if $(SAN),$(SAN_PRELOAD)))" sh tests/python/run.sh
 
+test-san:
+	@$(MAKE) --no-print-directory test BUILD=build/san OPT="-O1 -g -fno-omit-frame-pointer" \
+	    SAN="-fsanitize=address,undefined -fno-sanitize-recover=all"
+
 # Fuzzing with clang's libFuzzer (tests/fuzz/README.md): fuzz runs
 # FUZZ_SECONDS (default 60); fuzz-replay only the regression inputs.
 fuzz:
