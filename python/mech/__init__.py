@@ -115,7 +115,9 @@ def solve(path, set=None, from_=None, to=None, steps=None, outputs=None, forces=
     friction    'on' (default), 'off' or 'both'
     diagnostics True: add the columns iterations, residual, rcond, substeps
     all         True: solve every unknown, also those no output needs
-    set         {'parameter': '45 mm'}: replace the file's parameters
+    set         {'parameter': '45 mm'}: replace the file's parameters (a
+                number is a bare number of the file: {'r': 45} is 45 mm in a
+                file with units: {length: mm})
 
     Returns a Result. Raises MechError (with .partial, a Result of the rows
     solved before the failure, when the mechanism cannot be solved), ValueError
@@ -133,7 +135,8 @@ def solve(path, set=None, from_=None, to=None, steps=None, outputs=None, forces=
 
 def sweep(path, vary, jobs=None, **options):
     """Solve every combination of parameter values: vary={'r': ['30 mm',
-    '40 mm'], 'l': [0.1, 0.12]} (texts as in the file, or numbers in SI).
+    '40 mm'], 'l': [100, 120]} (texts as in the file; a number is a bare
+    number of the file, which takes the file's unit where it is used).
     options are solve()'s (set= gives fixed overrides). Returns one dict per
     variant, in the order of the grid (the last name varies fastest):
     {'set': {...}, 'ok': bool, 'result': Result or None, 'error': MechError
