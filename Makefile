@@ -7,7 +7,11 @@
 #   make test-browser  figures and animation rendered by headless chromium
 #   make bench      optimised benchmarks, printed as tables
 #   make golden     regenerate tests/golden/*.csv (review the diff by hand)
-#   make install PREFIX=/usr/local
+#   make install PREFIX=/usr/local   mech, libmech.so/.a, mech.h, mech.pc, mech.1,
+#                   the Python module mech (docs/api.md; WITH_PYTHON=0 leaves it
+#                   out, and with it python3-dev and numpy); DESTDIR is honoured
+#   make python     build the Python extension only (build/python/mech)
+#   make test-python   pytest on the Python module, installed in a temporary prefix
 #   make clean
 CC      ?= cc
 PREFIX  ?= /usr/local
@@ -22,6 +26,19 @@ KLU_LIBS   := $(shell pkg-config --libs klu 2>/dev/null || echo -lklu -lbtf -lam
 YAML_CFLAGS := $(shell pkg-config --cflags yaml-0.1 2>/dev/null)
 YAML_LIBS   := $(shell pkg-config --libs yaml-0.1 2>/dev/null || echo -lyaml)
 CRIT_LIBS   := $(shell pkg-config --libs criterion 2>/dev/null || echo -lcriterion)
+# Debian's Python (python3-dev, python3-numpy), not a python3 earlier in PATH
+PYTHON      ?= $(shell test -x /usr/bin/python3 && echo /usr/bin/python3 || echo python3)
+PY_CFLAGS    = $(shell $(PYTHON)-config --includes 2>/dev/null) \
+               -I$(shell $(PYTHON) -c 'import numpy; print(numpy.get_include())' 2>/dev/null)
+PY_EXT      := $(shell $(PYTHON)-config --extension-suffix 2>/dev/null || echo .so)
+PYDIR        = lib/python3/dist-packages
+WITH_PYTHON ?= 1
+
+# The library's version is MECH_VERSION in mech.h; the soname carries its
+# first number (the ABI: bumped when a struct or signature changes).
+VERSION := $(shell sed -n 's/^\#define MECH_VERSION "\(.*\)"/\1/p' include/mech.h)
+SOMAJOR := $(firstword $(subst ., ,$(VERSION)))
+SONAME   = libmech.so.$(SOMAJOR)
 
 CFLAGS  = $(CFLAGS_BASE) $(OPT) $(SAN) -Iinclude $(YAML_CFLAGS) $(KLU_CFLAGS)
 LDLIBS  = $(YAML_LIBS) $(KLU_LIBS) -lm -pthread
@@ -30,22 +47,54 @@ LDFLAGS = $(SAN) -pthread
 CMD_SRC  = src/main.c $(wildcard src/cmd_*.c)
 CMD_OBJ  = $(CMD_SRC:src/%.c=$(BUILD)/obj/%.o)
 LIB_SRC  = $(filter-out $(CMD_SRC),$(wildcard src/*.c))
-LIB_OBJ  = $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o)
+LIB_OBJ  = $(LIB_SRC:src/%.c=$(BUILD)/pic/%.o)
 TEST_SRC = $(wildcard tests/unit/*.c)
 TEST_OBJ = $(TEST_SRC:tests/unit/%.c=$(BUILD)/tests/%.o)
 
-.PHONY: all deps run test test-san test-valgrind test-browser fuzz fuzz-replay bench golden install clean
+.PHONY: all lib python deps run test test-san test-valgrind test-browser test-install test-python \
+        fuzz fuzz-replay bench golden install clean
 
-all: $(BUILD)/mech
+all: $(BUILD)/mech lib
+
+lib: $(BUILD)/libmech.a $(BUILD)/libmech.so
 
 HEADERS = include/mech.h $(wildcard src/*.h)
 
 $(BUILD)/obj/%.o: src/%.c $(HEADERS) | $(BUILD)/obj
 	$(CC) $(CFLAGS) -c $< -o $@
 
+# Library objects are position independent (their own directory, so a tree
+# built before is not mixed in): the same objects make the static library
+# and the shared one, which Python's extension (or ctypes) loads.
+$(BUILD)/pic/%.o: src/%.c $(HEADERS) | $(BUILD)/pic
+	$(CC) $(CFLAGS) -fPIC -c $< -o $@
+
 $(BUILD)/libmech.a: $(LIB_OBJ)
 	rm -f $@
 	ar rcs $@ $^
+
+# libmech.so -> libmech.so.0 -> libmech.so.0.1.0; only the mech_* names are
+# exported (libmech.map), the modules' internal functions stay local.
+$(BUILD)/libmech.so.$(VERSION): $(LIB_OBJ) libmech.map
+	$(CC) $(LDFLAGS) -shared -Wl,-soname,$(SONAME) -Wl,--version-script=libmech.map \
+	    -Wl,--no-undefined -o $@ $(LIB_OBJ) $(LDLIBS)
+
+$(BUILD)/libmech.so: $(BUILD)/libmech.so.$(VERSION)
+	ln -sf libmech.so.$(VERSION) $(BUILD)/$(SONAME)
+	ln -sf $(SONAME) $@
+
+# The Python extension mech._mech (python/mech_module.c), linked with the
+# shared library; its run path finds libmech.so.0 from P/lib/python3/dist-packages/mech.
+python: $(BUILD)/python/mech/_mech$(PY_EXT) $(BUILD)/python/mech/__init__.py
+
+$(BUILD)/python/mech/_mech$(PY_EXT): python/mech_module.c include/mech.h $(BUILD)/libmech.so
+	@mkdir -p $(@D)
+	$(CC) $(CFLAGS_BASE) -Wno-missing-prototypes $(OPT) $(SAN) -fPIC -shared -Iinclude \
+	    $(PY_CFLAGS) -o $@ $< -L$(BUILD) -lmech -Wl,-rpath,'$$ORIGIN/../../..'
+
+$(BUILD)/python/mech/__init__.py: python/mech/__init__.py
+	@mkdir -p $(@D)
+	cp $< $@
 
 $(BUILD)/mech: $(CMD_OBJ) $(BUILD)/libmech.a
 	$(CC) $(LDFLAGS) -o $@ $^ $(LDLIBS)
@@ -62,7 +111,7 @@ $(BUILD)/unit-tests: $(TEST_OBJ) $(BUILD)/obj/cmd_compare.o $(BUILD)/libmech.a
 $(BUILD)/pool-fail: tests/pool/pool_fail.c $(BUILD)/obj/cmd_common.o $(BUILD)/libmech.a $(HEADERS)
 	$(CC) $(CFLAGS) -Isrc -o $@ $< $(BUILD)/obj/cmd_common.o $(BUILD)/libmech.a $(LDLIBS)
 
-$(BUILD)/obj $(BUILD)/tests:
+$(BUILD)/obj $(BUILD)/pic $(BUILD)/tests:
 	mkdir -p $@
 
 deps:
@@ -86,6 +135,23 @@ test: deps
 	MECH=$(BUILD)/mech sh tests/files.sh
 	MECH=$(BUILD)/mech sh tests/golden.sh
 	MECH=$(BUILD)/mech MECH_SANITIZE=$(if $(SAN),1,) sh tests/sweep.sh
+	@$(MAKE) --no-print-directory test-install test-python
+
+# make install into a temporary prefix, then the example of docs/api.md
+# built with pkg-config alone (shared and --static), its numbers against
+# mech solve's CSV, and the man page rendered.
+test-install: lib python $(BUILD)/mech
+	BUILD=$(BUILD) CC="$(CC)" OPT="$(OPT)" SAN="$(SAN)" MAKE="$(MAKE)" sh tests/install.sh
+
+# pytest on the Python module installed into a temporary prefix. Under the
+# sanitizers the extension and the library are instrumented and python3 is
+# not: the sanitizers' run-time libraries are preloaded (leak detection off:
+# the interpreter keeps its memory at exit).
+SAN_PRELOAD = $(if $(findstring address,$(SAN)),$(shell $(CC) -print-file-name=libasan.so)) \
+              $(if $(findstring undefined,$(SAN)),$(shell $(CC) -print-file-name=libubsan.so))
+test-python: lib python $(BUILD)/mech
+	BUILD=$(BUILD) PYTHON=$(PYTHON) MAKE="$(MAKE)" OPT="$(OPT)" SAN="$(SAN)" \
+	    SAN_PRELOAD="$(strip $(if $(SAN),$(SAN_PRELOAD)))" sh tests/python/run.sh
 
 test-san:
 	@$(MAKE) --no-print-directory test BUILD=build/san OPT="-O1 -g -fno-omit-frame-pointer" \
@@ -151,11 +217,23 @@ golden: all
 	    $(BUILD)/mech solve $$f -o tests/golden/$$n.csv || exit 1; \
 	done
 
-install: all
-	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib $(DESTDIR)$(PREFIX)/include
+install: all $(if $(filter 1,$(WITH_PYTHON)),python)
+	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib/pkgconfig \
+	    $(DESTDIR)$(PREFIX)/include $(DESTDIR)$(PREFIX)/share/man/man1
 	install -m 755 $(BUILD)/mech $(DESTDIR)$(PREFIX)/bin/mech
 	install -m 644 $(BUILD)/libmech.a $(DESTDIR)$(PREFIX)/lib/libmech.a
+	install -m 755 $(BUILD)/libmech.so.$(VERSION) $(DESTDIR)$(PREFIX)/lib/libmech.so.$(VERSION)
+	ln -sf libmech.so.$(VERSION) $(DESTDIR)$(PREFIX)/lib/$(SONAME)
+	ln -sf $(SONAME) $(DESTDIR)$(PREFIX)/lib/libmech.so
+	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@VERSION@|$(VERSION)|' -e 's|@KLU_LIBS@|$(KLU_LIBS)|' \
+	    mech.pc.in >$(DESTDIR)$(PREFIX)/lib/pkgconfig/mech.pc
 	install -m 644 include/mech.h $(DESTDIR)$(PREFIX)/include/mech.h
+	install -m 644 docs/mech.1 $(DESTDIR)$(PREFIX)/share/man/man1/mech.1
+ifeq ($(WITH_PYTHON),1)
+	install -d $(DESTDIR)$(PREFIX)/$(PYDIR)/mech
+	install -m 644 python/mech/__init__.py $(DESTDIR)$(PREFIX)/$(PYDIR)/mech/__init__.py
+	install -m 755 $(BUILD)/python/mech/_mech$(PY_EXT) $(DESTDIR)$(PREFIX)/$(PYDIR)/mech/_mech$(PY_EXT)
+endif
 
 clean:
 	rm -rf build

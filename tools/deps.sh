@@ -2,7 +2,7 @@
 # tools/deps.sh: install the Debian packages libmech needs, only those missing.
 # Runs apt-get as root, or through sudo when not root.
 set -e
-PKGS="make gcc libc6-dev pkg-config libyaml-dev libsuitesparse-dev libcriterion-dev"
+PKGS="make gcc libc6-dev pkg-config libyaml-dev libsuitesparse-dev libcriterion-dev python3-dev python3-numpy python3-pytest"
 missing=""
 for p in $PKGS; do
     if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then

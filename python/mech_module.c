@@ -1,0 +1,618 @@
+/* python/mech_module.c: mech._mech, the C half of the Python module `mech`
+ * (python/mech/__init__.py is the other half; docs/api.md, "Python").
+ *
+ * A thin layer over libmech's public API (include/mech.h): it loads and
+ * checks a file with parameter overrides, solves it with the options of
+ * `mech solve`, and hands back the columns as numpy arrays (copied from the
+ * table: the same doubles `mech solve` prints with %.17g). The GIL is
+ * released while a file is loaded and solved: each call has its own model,
+ * analysis and table, so threads may solve at once. Errors raise
+ * mech.MechError with the library's diagnostics (file:line:column). */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+#define NPY_NO_DEPRECATED_API NPY_1_7_API_VERSION
+#include <numpy/arrayobject.h>
+
+#include <math.h>
+#include <string.h>
+
+#include <mech.h>
+
+#define MAX_SET 64 /* as mech solve --set */
+
+static PyObject *MechError;
+
+/* ---- errors ---------------------------------------------------------- */
+
+static const char *severity_name(mech_severity s)
+{
+    return s == MECH_SEV_ERROR ? "error" : s == MECH_SEV_WARNING ? "warning" : "note";
+}
+
+/* One diagnostic as mech_diag_print writes it (without the newline). */
+static PyObject *diag_line(const mech_diag_entry *e)
+{
+    if (e->mark.line > 0)
+        return PyUnicode_FromFormat("%s:%d:%d: %s: %s", e->file, e->mark.line, e->mark.col,
+                                    severity_name(e->severity), e->message);
+    return PyUnicode_FromFormat("%s: %s: %s", e->file, severity_name(e->severity), e->message);
+}
+
+/* [{'file', 'line', 'column', 'severity', 'message'}, ...] */
+static PyObject *diag_list(const mech_diag *d)
+{
+    PyObject *list = PyList_New(0);
+    for (size_t i = 0; list && i < d->count; i++) {
+        const mech_diag_entry *e = &d->entries[i];
+        PyObject *item = Py_BuildValue("{s:s,s:i,s:i,s:s,s:s}", "file", e->file, "line",
+                                       e->mark.line, "column", e->mark.col, "severity",
+                                       severity_name(e->severity), "message", e->message);
+        if (!item || PyList_Append(list, item) < 0) {
+            Py_XDECREF(item);
+            Py_CLEAR(list);
+            break;
+        }
+        Py_DECREF(item);
+    }
+    return list;
+}
+
+/* The diagnostics as lines of text, joined by newlines. */
+static PyObject *diag_text(const mech_diag *d)
+{
+    PyObject *lines = PyList_New(0), *sep = NULL, *text = NULL;
+    if (!lines)
+        return NULL;
+    for (size_t i = 0; i < d->count; i++) {
+        PyObject *line = diag_line(&d->entries[i]);
+        if (!line || PyList_Append(lines, line) < 0) {
+            Py_XDECREF(line);
+            goto out;
+        }
+        Py_DECREF(line);
+    }
+    if (d->truncated) {
+        PyObject *line = PyUnicode_FromFormat("(%zu errors in all; only the first %zu are shown)",
+                                              d->nerrors, d->max_errors ? d->max_errors : (size_t)100);
+        if (!line || PyList_Append(lines, line) < 0) {
+            Py_XDECREF(line);
+            goto out;
+        }
+        Py_DECREF(line);
+    }
+    if ((sep = PyUnicode_FromString("\n")))
+        text = PyUnicode_Join(sep, lines);
+out:
+    Py_XDECREF(sep);
+    Py_DECREF(lines);
+    return text;
+}
+
+/* Raise MechError(message) with .status, .diagnostics and, when partial is
+ * not NULL, .partial (the pieces of the rows solved before a failure).
+ * message NULL: the diagnostics' text. Returns NULL. */
+static PyObject *raise_mech(int status, const mech_diag *d, const char *message, PyObject *partial)
+{
+    PyObject *msg = NULL, *exc = NULL, *list = NULL, *st = NULL;
+    if (PyErr_Occurred())
+        return NULL;
+    msg = message ? PyUnicode_FromString(message) : diag_text(d);
+    if (!msg)
+        return NULL;
+    if (!message && PyUnicode_GetLength(msg) == 0) {
+        Py_DECREF(msg);
+        msg = PyUnicode_FromFormat("libmech failed with status %d", status);
+        if (!msg)
+            return NULL;
+    }
+    exc = PyObject_CallOneArg(MechError, msg);
+    list = d ? diag_list(d) : PyList_New(0);
+    st = PyLong_FromLong(status);
+    if (exc && list && st && PyObject_SetAttrString(exc, "status", st) == 0 &&
+        PyObject_SetAttrString(exc, "diagnostics", list) == 0 &&
+        PyObject_SetAttrString(exc, "partial", partial ? partial : Py_None) == 0)
+        PyErr_SetObject(MechError, exc);
+    Py_XDECREF(st);
+    Py_XDECREF(list);
+    Py_XDECREF(exc);
+    Py_DECREF(msg);
+    return NULL;
+}
+
+/* ---- loading --------------------------------------------------------- */
+
+/* Parameter overrides from a dict {name: text or number}; the texts are
+ * UTF-8 buffers of the str objects kept in *keep (released by the caller). */
+static int get_overrides(PyObject *set, mech_override *ov, int *nov, PyObject **keep)
+{
+    *nov = 0;
+    *keep = PyList_New(0);
+    if (!*keep)
+        return -1;
+    if (set == NULL || set == Py_None)
+        return 0;
+    if (!PyDict_Check(set)) {
+        PyErr_SetString(PyExc_TypeError, "set must be a dict {parameter: value}");
+        return -1;
+    }
+    PyObject *key, *value;
+    Py_ssize_t pos = 0;
+    while (PyDict_Next(set, &pos, &key, &value)) {
+        if (*nov == MAX_SET) {
+            PyErr_SetString(PyExc_ValueError, "set: at most 64 parameters");
+            return -1;
+        }
+        if (!PyUnicode_Check(key)) {
+            PyErr_SetString(PyExc_TypeError, "set: parameter names must be str");
+            return -1;
+        }
+        PyObject *text;
+        if (PyUnicode_Check(value)) {
+            text = value;
+            Py_INCREF(text);
+        } else if (PyFloat_Check(value) || PyLong_Check(value)) {
+            text = PyObject_Repr(value); /* the shortest text that reads back the same */
+        } else {
+            PyErr_Format(PyExc_TypeError, "set: the value of '%U' must be a str like '45 mm' "
+                         "or a number", key);
+            return -1;
+        }
+        if (!text)
+            return -1;
+        int rc = PyList_Append(*keep, text);
+        Py_DECREF(text);
+        if (rc < 0)
+            return -1;
+        ov[*nov].name = PyUnicode_AsUTF8(key);
+        ov[*nov].text = PyUnicode_AsUTF8(text);
+        if (!ov[*nov].name || !ov[*nov].text)
+            return -1;
+        (*nov)++;
+    }
+    return 0;
+}
+
+/* Load path with the overrides and, when check, run mech_check into *s.
+ * Returns the model, or NULL with MechError (or another exception) set. */
+static mech_model *load_model(PyObject *path, PyObject *set, int check, mech_summary *s)
+{
+    mech_override ov[MAX_SET];
+    int nov, rc;
+    PyObject *keep = NULL, *bytes = NULL;
+    mech_model *m = NULL;
+    mech_diag d;
+    mech_diag_init(&d);
+    if (!PyUnicode_FSConverter(path, &bytes))
+        return NULL;
+    if (get_overrides(set, ov, &nov, &keep) < 0)
+        goto out;
+    const char *file = PyBytes_AS_STRING(bytes);
+    Py_BEGIN_ALLOW_THREADS
+    rc = mech_load_file_with(file, ov, nov, &m, &d);
+    if (rc == MECH_OK && check && (rc = mech_check(m, s, &d)) != MECH_OK)
+        mech_model_free(&m);
+    Py_END_ALLOW_THREADS
+    if (rc != MECH_OK)
+        raise_mech(rc, &d, NULL, NULL);
+out:
+    mech_diag_free(&d);
+    Py_XDECREF(keep);
+    Py_DECREF(bytes);
+    return m;
+}
+
+static PyObject *names_list(const mech_model *m, const int *ids, int n, int kind)
+{
+    PyObject *list = PyList_New(n);
+    for (int i = 0; list && i < n; i++) {
+        const char *name = kind == 0 ? m->point_names[ids[i]]
+                           : kind == 1 ? m->links[ids[i]].name : m->joints[ids[i]].name;
+        PyObject *s = PyUnicode_FromString(name);
+        if (!s) {
+            Py_CLEAR(list);
+            break;
+        }
+        PyList_SET_ITEM(list, i, s);
+    }
+    return list;
+}
+
+/* Set d[key] = value and drop the reference to value; -1 on failure. */
+static int put(PyObject *d, const char *key, PyObject *value)
+{
+    if (!value)
+        return -1;
+    int rc = PyDict_SetItemString(d, key, value);
+    Py_DECREF(value);
+    return rc;
+}
+
+/* [name of link 0, ...] or [point name 0, ...] */
+static PyObject *all_names(const mech_model *m, int points)
+{
+    int n = points ? m->npoint_names : m->nlinks;
+    PyObject *list = PyList_New(n);
+    for (int i = 0; list && i < n; i++) {
+        PyObject *s = PyUnicode_FromString(points ? m->point_names[i] : m->links[i].name);
+        if (!s) {
+            Py_CLEAR(list);
+            break;
+        }
+        PyList_SET_ITEM(list, i, s);
+    }
+    return list;
+}
+
+static PyObject *params_dict(const mech_model *m)
+{
+    PyObject *d = PyDict_New();
+    for (int i = 0; d && i < m->nparams; i++) {
+        PyObject *v = PyFloat_FromDouble(m->params[i].value);
+        if (!v || PyDict_SetItemString(d, m->params[i].name, v) < 0)
+            Py_CLEAR(d);
+        Py_XDECREF(v);
+    }
+    return d;
+}
+
+static PyObject *joints_list(const mech_model *m)
+{
+    PyObject *list = PyList_New(m->njoints);
+    for (int i = 0; list && i < m->njoints; i++) {
+        const mech_joint *j = &m->joints[i];
+        const char *kind = j->kind == MECH_JOINT_REVOLUTE ? "revolute"
+                           : j->locked ? "prismatic" : "pin-in-slot";
+        PyObject *item = Py_BuildValue("{s:s,s:s,s:(ss)}", "name", j->name, "kind", kind, "links",
+                                       m->links[j->link[0]].name, m->links[j->link[1]].name);
+        if (!item) {
+            Py_CLEAR(list);
+            break;
+        }
+        PyList_SET_ITEM(list, i, item);
+    }
+    return list;
+}
+
+static PyObject *driver_dict(const mech_model *m)
+{
+    const mech_driver *dr = &m->driver;
+    int angle = dr->kind == MECH_DRIVE_ANGLE;
+    if (!m->has_driver)
+        return Py_NewRef(Py_None);
+    return Py_BuildValue("{s:s,s:s,s:i,s:d,s:d,s:d,s:d}", "kind", angle ? "angle" : "slider",
+                         angle ? "link" : "joint",
+                         angle ? m->links[dr->index].name : m->joints[dr->index].name,
+                         "positions", dr->nvalues, "from", dr->values[0], "to",
+                         dr->values[dr->nvalues - 1], "speed", dr->speed, "accel", dr->accel);
+}
+
+/* The model as a dict (SI units). */
+static PyObject *model_dict(const mech_model *m)
+{
+    const mech_outputs *o = &m->outputs;
+    PyObject *d = PyDict_New();
+    int ok = d != NULL;
+    ok = ok && put(d, "file", PyUnicode_FromString(m->file)) == 0;
+    ok = ok && put(d, "name", PyUnicode_FromString(m->name)) == 0;
+    ok = ok && put(d, "description", m->description ? PyUnicode_FromString(m->description)
+                                                    : Py_NewRef(Py_None)) == 0;
+    ok = ok && put(d, "gravity", Py_BuildValue("(dd)", m->gravity[0], m->gravity[1])) == 0;
+    ok = ok && put(d, "parameters", params_dict(m)) == 0;
+    ok = ok && put(d, "links", all_names(m, 0)) == 0;
+    ok = ok && put(d, "points", all_names(m, 1)) == 0;
+    ok = ok && put(d, "joints", joints_list(m)) == 0;
+    ok = ok && put(d, "driver", driver_dict(m)) == 0;
+    ok = ok && put(d, "outputs",
+                   Py_BuildValue("{s:N,s:N,s:N,s:O}", "points",
+                                 names_list(m, o->points, o->npoints, 0), "links",
+                                 names_list(m, o->links, o->nlinks, 1), "sliders",
+                                 names_list(m, o->sliders, o->nsliders, 2), "forces",
+                                 o->forces ? Py_True : Py_False)) == 0;
+    if (!ok)
+        Py_CLEAR(d);
+    return d;
+}
+
+static PyObject *summary_dict(const mech_summary *s)
+{
+    return Py_BuildValue("{s:i,s:i,s:i,s:i,s:i,s:i,s:i,s:i,s:i}", "links", s->nlinks,
+                         "revolute", s->nrevolute, "prismatic", s->nprismatic, "pin_in_slot",
+                         s->npin_in_slot, "unknowns", s->nunknowns, "loops", s->nloops,
+                         "equations", s->nequations, "mobility", s->mobility, "drivers",
+                         s->ndrivers);
+}
+
+/* _mech.load(path, set=None, check=False) -> dict */
+static PyObject *py_load(PyObject *self, PyObject *args, PyObject *kw)
+{
+    static char *kwlist[] = {"path", "set", "check", NULL};
+    PyObject *path, *set = Py_None;
+    int check = 0;
+    (void)self;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "O|Op", kwlist, &path, &set, &check))
+        return NULL;
+    mech_summary s;
+    mech_model *m = load_model(path, set, check, &s);
+    if (!m)
+        return NULL;
+    PyObject *d = model_dict(m);
+    if (d && check && put(d, "structure", summary_dict(&s)) < 0)
+        Py_CLEAR(d);
+    mech_model_free(&m);
+    return d;
+}
+
+/* ---- solving --------------------------------------------------------- */
+
+/* A driver position: a number (SI) or a text for mech_parse_value. */
+static int driver_value(PyObject *v, const char *what, int is_angle, double *si)
+{
+    if (PyUnicode_Check(v)) {
+        char err[256];
+        const char *text = PyUnicode_AsUTF8(v);
+        if (!text)
+            return -1;
+        if (mech_parse_value(text, is_angle, si, err, sizeof err) != MECH_OK) {
+            PyErr_Format(PyExc_ValueError, "%s '%s': %s", what, text, err);
+            return -1;
+        }
+    } else {
+        *si = PyFloat_AsDouble(v);
+        if (*si == -1.0 && PyErr_Occurred())
+            return -1;
+    }
+    if (!(fabs(*si) <= 1e6)) {
+        PyErr_Format(PyExc_ValueError, "%s: a driver position must be finite and within +-1e6 "
+                     "(rad or m)", what);
+        return -1;
+    }
+    return 0;
+}
+
+/* Choice among names: returns the index in names, or -1 with ValueError. */
+static int choice(PyObject *v, const char *what, const char *const *names, int n)
+{
+    const char *text = PyUnicode_Check(v) ? PyUnicode_AsUTF8(v) : NULL;
+    for (int i = 0; text && i < n; i++)
+        if (strcmp(text, names[i]) == 0)
+            return i;
+    if (!PyErr_Occurred())
+        PyErr_Format(PyExc_ValueError, "%s must be one of '%s', '%s', '%s', not %R", what,
+                     names[0], names[1], names[2], v);
+    return -1;
+}
+
+typedef struct solve_request {
+    PyObject *from, *to, *steps, *outputs, *forces, *tol, *level, *friction;
+    int diagnostics, all_blocks;
+} solve_request;
+
+/* The request's options into *o (and *sel for outputs; *has_sel says to free
+ * it). Returns 0, or -1 with an exception set. */
+static int solve_options(const mech_model *m, const solve_request *r, mech_solve_options *o,
+                         mech_outputs *sel, int *has_sel)
+{
+    int is_angle = m->driver.kind == MECH_DRIVE_ANGLE;
+    long steps = 0;
+    mech_solve_options_default(o);
+    *has_sel = 0;
+    if (r->steps != Py_None) {
+        steps = PyLong_AsLong(r->steps);
+        if (steps == -1 && PyErr_Occurred())
+            return -1;
+        if (steps < 1 || steps > 1000000) {
+            PyErr_SetString(PyExc_ValueError, "steps must be a whole number from 1 to 1000000");
+            return -1;
+        }
+    }
+    if ((r->from == Py_None) != (r->to == Py_None)) {
+        PyErr_SetString(PyExc_ValueError, "from_ and to go together");
+        return -1;
+    }
+    if (r->from != Py_None) {
+        if (driver_value(r->from, "from_", is_angle, &o->from) < 0 ||
+            driver_value(r->to, "to", is_angle, &o->to) < 0)
+            return -1;
+        o->has_range = 1;
+        o->steps = steps > 0 ? (int)steps : 360;
+    } else if (steps > 0) {
+        o->has_range = 1;
+        o->from = m->driver.values[0];
+        o->to = m->driver.values[m->driver.nvalues - 1];
+        o->steps = (int)steps;
+    }
+    if (r->tol != Py_None) {
+        o->tol = PyFloat_AsDouble(r->tol);
+        if (o->tol == -1.0 && PyErr_Occurred())
+            return -1;
+        if (!(o->tol >= 1e-15 && o->tol < 1)) {
+            PyErr_SetString(PyExc_ValueError, "tol must be from 1e-15 to below 1");
+            return -1;
+        }
+    }
+    if (r->forces != Py_None) {
+        int t = PyObject_IsTrue(r->forces);
+        if (t < 0)
+            return -1;
+        o->forces = t ? 1 : -1;
+    }
+    if (r->level != Py_None) {
+        static const char *const levels[] = {"positions", "velocities", "accelerations"};
+        static const int want[] = {MECH_WANT_POSITION, MECH_WANT_POSITION | MECH_WANT_VELOCITY,
+                                   MECH_WANT_ALL};
+        int i = choice(r->level, "level", levels, 3);
+        if (i < 0)
+            return -1;
+        o->want = want[i];
+    }
+    if (r->friction != Py_None) {
+        static const char *const modes[] = {"on", "off", "both"};
+        static const int value[] = {MECH_FRICTION_ON, MECH_FRICTION_OFF, MECH_FRICTION_BOTH};
+        int i = choice(r->friction, "friction", modes, 3);
+        if (i < 0)
+            return -1;
+        o->friction = value[i];
+    }
+    o->diagnostics = r->diagnostics;
+    o->all_blocks = r->all_blocks;
+    if (r->outputs != Py_None) {
+        PyObject *list = r->outputs;
+        char err[256];
+        if (!PyUnicode_Check(list)) { /* a sequence of names: join them */
+            PyObject *comma = PyUnicode_FromString(",");
+            list = comma ? PyUnicode_Join(comma, r->outputs) : NULL;
+            Py_XDECREF(comma);
+            if (!list)
+                return -1;
+        } else {
+            Py_INCREF(list);
+        }
+        const char *text = PyUnicode_AsUTF8(list);
+        int rc = text ? mech_outputs_parse(m, text, sel, err, sizeof err) : MECH_EINPUT;
+        Py_DECREF(list);
+        if (!text)
+            return -1;
+        if (rc != MECH_OK) {
+            char msg[300];
+            snprintf(msg, sizeof msg, "%s: error: outputs: %s", m->file, err);
+            raise_mech(rc, NULL, msg, NULL);
+            return -1;
+        }
+        *has_sel = 1;
+        o->outputs = sel;
+    }
+    return 0;
+}
+
+static PyObject *stats_dict(const mech_solve_stats *s)
+{
+    return Py_BuildValue(
+        "{s:i,s:l,s:i,s:d,s:d,s:d,s:i,s:i,s:i,s:i,s:i,s:i,s:d,s:i,s:d,s:d}", "steps", s->steps,
+        "iterations", s->iterations, "max_iterations", s->max_iterations, "worst_residual",
+        s->worst_residual, "min_rcond", s->min_rcond, "worst_rcond_q", s->worst_rcond_q,
+        "factorizations", s->factorizations, "refactorizations", s->refactorizations,
+        "nunknowns", s->nunknowns, "nsolved", s->nsolved, "nblocks", s->nblocks,
+        "nblocks_solved", s->nblocks_solved, "worst_power_residual", s->worst_power_residual,
+        "max_friction_iterations", s->max_friction_iterations, "setup_seconds",
+        s->setup_seconds, "seconds", s->seconds);
+}
+
+/* (names, units, arrays, stats, messages): one contiguous float64 array of
+ * nrows per column, the table's doubles copied as they are. */
+static PyObject *table_tuple(const mech_table *t, const mech_solve_stats *s, const mech_diag *d)
+{
+    PyObject *names = PyList_New(t->ncolumns), *units = PyList_New(t->ncolumns);
+    PyObject *arrays = PyList_New(t->ncolumns);
+    if (!names || !units || !arrays)
+        goto fail;
+    for (int c = 0; c < t->ncolumns; c++) {
+        PyObject *n = PyUnicode_FromString(t->columns[c].name);
+        PyObject *u = PyUnicode_FromString(t->columns[c].unit);
+        npy_intp dims[1] = {t->nrows};
+        PyObject *a = PyArray_SimpleNew(1, dims, NPY_DOUBLE);
+        if (!n || !u || !a) {
+            Py_XDECREF(n);
+            Py_XDECREF(u);
+            Py_XDECREF(a);
+            goto fail;
+        }
+        double *col = (double *)PyArray_DATA((PyArrayObject *)a);
+        for (int r = 0; r < t->nrows; r++)
+            col[r] = mech_table_get(t, r, c);
+        PyList_SET_ITEM(names, c, n);
+        PyList_SET_ITEM(units, c, u);
+        PyList_SET_ITEM(arrays, c, a);
+    }
+    return Py_BuildValue("(NNNNN)", names, units, arrays, stats_dict(s), diag_list(d));
+fail:
+    Py_XDECREF(names);
+    Py_XDECREF(units);
+    Py_XDECREF(arrays);
+    return NULL;
+}
+
+/* _mech.solve(path, set=None, from_=None, to=None, steps=None, outputs=None,
+ *             forces=None, tol=None, level=None, friction=None,
+ *             diagnostics=False, all=False) -> (names, units, arrays, stats, messages) */
+static PyObject *py_solve(PyObject *self, PyObject *args, PyObject *kw)
+{
+    static char *kwlist[] = {"path", "set", "from_", "to", "steps", "outputs", "forces", "tol",
+                             "level", "friction", "diagnostics", "all", NULL};
+    PyObject *path, *set = Py_None;
+    solve_request r = {Py_None, Py_None, Py_None, Py_None, Py_None, Py_None, Py_None, Py_None, 0, 0};
+    (void)self;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "O|OOOOOOOOOpp", kwlist, &path, &set, &r.from,
+                                     &r.to, &r.steps, &r.outputs, &r.forces, &r.tol, &r.level,
+                                     &r.friction, &r.diagnostics, &r.all_blocks))
+        return NULL;
+    mech_summary s;
+    mech_model *m = load_model(path, set, 1, &s);
+    if (!m)
+        return NULL;
+    mech_solve_options o;
+    mech_outputs sel = {0};
+    int has_sel = 0, rc;
+    PyObject *result = NULL;
+    if (solve_options(m, &r, &o, &sel, &has_sel) == 0) {
+        mech_table t = {0};
+        mech_solve_stats st;
+        mech_diag d;
+        memset(&st, 0, sizeof st);
+        mech_diag_init(&d);
+        Py_BEGIN_ALLOW_THREADS
+        rc = mech_solve(m, &o, &t, &st, &d);
+        Py_END_ALLOW_THREADS
+        result = table_tuple(&t, &st, &d);
+        if (result && rc != MECH_OK) {
+            raise_mech(rc, &d, NULL, result);
+            Py_CLEAR(result);
+        }
+        mech_table_free(&t);
+        mech_diag_free(&d);
+    }
+    if (has_sel)
+        mech_outputs_free(&sel);
+    mech_model_free(&m);
+    return result;
+}
+
+static PyMethodDef methods[] = {
+    {"load", (PyCFunction)(void (*)(void))py_load, METH_VARARGS | METH_KEYWORDS,
+     "load(path, set=None, check=False) -> dict: the model (SI units); with check, "
+     "also its structure (mech check)"},
+    {"solve", (PyCFunction)(void (*)(void))py_solve, METH_VARARGS | METH_KEYWORDS,
+     "solve(path, set=None, from_=None, to=None, steps=None, outputs=None, forces=None, "
+     "tol=None, level=None, friction=None, diagnostics=False, all=False) -> "
+     "(names, units, arrays, stats, messages)"},
+    {NULL, NULL, 0, NULL}};
+
+static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "mech._mech",
+                                    "libmech for Python (use the package mech)", -1, methods,
+                                    NULL, NULL, NULL, NULL};
+
+PyMODINIT_FUNC PyInit__mech(void);
+
+PyMODINIT_FUNC PyInit__mech(void)
+{
+    import_array();
+    PyObject *mod = PyModule_Create(&module);
+    if (!mod)
+        return NULL;
+    MechError = PyErr_NewExceptionWithDoc(
+        "mech.MechError",
+        "A mechanism file that does not load or check, or a solve that fails. str(e) holds "
+        "the library's messages, one 'file:line:column: error: message' per line; e.status "
+        "is the libmech status (EINPUT, ENOMEM, EIO, ESOLVE), e.diagnostics the messages as "
+        "dicts, e.partial the rows solved before a failed solve (or None).",
+        NULL, NULL);
+    if (!MechError || PyModule_AddObjectRef(mod, "MechError", MechError) < 0 ||
+        PyModule_AddStringConstant(mod, "VERSION", MECH_VERSION) < 0 ||
+        PyModule_AddIntConstant(mod, "EINPUT", MECH_EINPUT) < 0 ||
+        PyModule_AddIntConstant(mod, "ENOMEM", MECH_ENOMEM) < 0 ||
+        PyModule_AddIntConstant(mod, "EIO", MECH_EIO) < 0 ||
+        PyModule_AddIntConstant(mod, "ESOLVE", MECH_ESOLVE) < 0) {
+        Py_DECREF(mod);
+        return NULL;
+    }
+    return mod;
+}

@@ -1,0 +1,245 @@
+"""tests/python/test_mech.py: the Python module `mech` against the `mech`
+command (docs/api.md, "Python"). Run by tests/python/run.sh (make test),
+which installs into a temporary prefix and sets PYTHONPATH, MECH (the
+installed command) and MECH_PREFIX; run from the repository root."""
+import glob
+import math
+import os
+import re
+import subprocess
+import threading
+
+import numpy as np
+import pytest
+
+import mech
+
+MECH = os.environ.get('MECH', 'build/mech')
+MECHANISMS = sorted(glob.glob('mechanisms/*.yaml'))
+BAD = sorted(glob.glob('tests/bad/*.yaml'))
+
+
+def cli_csv(path, *args):
+    """`mech solve path args` as (names, units, {name: array}) from its CSV."""
+    out = subprocess.run([MECH, 'solve', path, *args], check=True, capture_output=True,
+                         text=True).stdout
+    lines = [l for l in out.splitlines() if l and not l.startswith('#')]
+    header = lines[0].split(',')
+    names = [h[:h.index(' [')] for h in header]
+    units = [h[h.index(' [') + 2:-1] for h in header]
+    rows = [[float(x) for x in l.split(',')] for l in lines[1:]]
+    data = np.array(rows, dtype=np.float64).reshape(len(rows), len(names))
+    return names, units, {n: data[:, i].copy() for i, n in enumerate(names)}
+
+
+def assert_bits_equal(a, b, what):
+    """Equal bit for bit (so nan equals nan, and -0.0 differs from 0.0)."""
+    a = np.ascontiguousarray(a, dtype=np.float64)
+    b = np.ascontiguousarray(b, dtype=np.float64)
+    assert a.shape == b.shape, what
+    same = a.view(np.uint64) == b.view(np.uint64)
+    # the CSV prints every nan as 'nan' or '-nan': compare nans by being nan
+    same |= np.isnan(a) & np.isnan(b)
+    assert same.all(), '%s: first difference at row %d: %r vs %r' % (
+        what, int(np.argmin(same)), a[~same][0], b[~same][0])
+
+
+def assert_same_as_cli(r, path, *args):
+    names, units, data = cli_csv(path, *args)
+    assert r.columns == names
+    assert [r.units[n] for n in names] == units
+    assert r.nrows == len(data[names[0]])
+    for n in names:
+        assert r[n].dtype == np.float64
+        assert_bits_equal(r[n], data[n], '%s %s' % (path, n))
+
+
+def test_imported_from_the_install_prefix():
+    prefix = os.environ.get('MECH_PREFIX')
+    if prefix:
+        assert os.path.realpath(mech.__file__).startswith(
+            os.path.realpath(os.path.join(prefix, 'lib/python3/dist-packages/mech')))
+    assert re.fullmatch(r'\d+\.\d+\.\d+', mech.__version__)
+
+
+@pytest.mark.parametrize('path', MECHANISMS)
+def test_solve_equals_the_csv_bit_for_bit(path):
+    r = mech.solve(path)
+    assert_same_as_cli(r, path)
+    assert r.stats['steps'] == r.nrows
+    assert r.stats['iterations'] >= r.nrows
+    assert r.stats['worst_residual'] < 1e-9
+
+
+def test_options_as_the_command_line():
+    path = 'mechanisms/fourbar.yaml'
+    r = mech.solve(path, from_='30 deg', to='90 deg', steps=12, outputs=['B', 'coupler'])
+    assert_same_as_cli(r, path, '--from', '30deg', '--to', '90deg', '--steps', '12',
+                       '--outputs', 'B,coupler')
+    assert r.columns[:3] == ['q', 'B.x', 'B.y']
+    assert r.nrows == 13
+    assert r['q'][0] == math.radians(30) or abs(r['q'][0] - math.radians(30)) < 1e-15
+    # numbers are SI
+    r2 = mech.solve(path, from_=math.radians(30), to=math.radians(90), steps=12,
+                    outputs='B,coupler')
+    assert_same_as_cli(r2, path, '--from', repr(math.radians(30)) + 'rad', '--to',
+                       repr(math.radians(90)) + 'rad', '--steps', '12', '--outputs', 'B,coupler')
+    # steps alone: a new spacing of the file's range
+    r3 = mech.solve(path, steps=10)
+    assert_same_as_cli(r3, path, '--steps', '10')
+
+
+def test_tol_level_diagnostics():
+    path = 'mechanisms/stirling.yaml'
+    r = mech.solve(path, tol=1e-10, level='velocities', diagnostics=True)
+    assert_same_as_cli(r, path, '--tol', '1e-10', '--level', 'velocities', '--diagnostics')
+    assert 'rcond' in r and not any(c.endswith('.ax') for c in r.columns)
+
+
+def test_forces():
+    path = 'mechanisms/slider-crank.yaml'
+    r = mech.solve(path, forces=True)
+    assert_same_as_cli(r, path, '--forces')
+    assert any(c.startswith('driver.') for c in r.columns)
+    # forces=False: not even when the file asks
+    plain = mech.solve(path, forces=False)
+    assert not any(c.startswith('driver.') for c in plain.columns)
+
+
+def test_parameter_overrides():
+    path = 'mechanisms/slider-crank.yaml'
+    r = mech.solve(path, set={'r': '45 mm'})
+    assert_same_as_cli(r, path, '--set', 'r=45 mm')
+    assert mech.load(path, set={'r': '45 mm'})['parameters']['r'] == pytest.approx(0.045)
+    # a number is a bare number of the file (here: mm, the file's length unit)
+    assert_bits_equal(mech.solve(path, set={'r': 45})['B.x'], r['B.x'], 'set r=45')
+    with pytest.raises(mech.MechError) as e:
+        mech.solve(path, set={'nosuch': '1 mm'})
+    assert 'nosuch' in str(e.value) and e.value.status == mech.EINPUT
+
+
+def test_load_and_check():
+    m = mech.load('mechanisms/fourbar.yaml')
+    assert m['name'] == 'Crank-rocker four-bar'
+    assert m['links'][0] == 'ground' and 'coupler' in m['links']
+    assert m['driver']['kind'] == 'angle' and m['driver']['link'] == 'crank'
+    assert m['driver']['to'] == pytest.approx(2 * math.pi)
+    assert 'structure' not in m
+    c = mech.check('mechanisms/fourbar.yaml')
+    assert c['structure'] == {'links': 4, 'revolute': 4, 'prismatic': 0, 'pin_in_slot': 0,
+                              'unknowns': 2, 'loops': 1, 'equations': 2, 'mobility': 1,
+                              'drivers': 1}
+    for path in MECHANISMS:
+        s = mech.check(path)['structure']
+        assert s['mobility'] == s['drivers'], path
+
+
+@pytest.mark.parametrize('path', BAD)
+def test_errors_carry_file_line_column(path):
+    cli = subprocess.run([MECH, 'solve', path, '-o', os.devnull], capture_output=True, text=True)
+    assert cli.returncode == 2
+    with pytest.raises(mech.MechError) as e:
+        mech.solve(path)
+    # the same messages as the command prints, file:line:column first
+    assert str(e.value) + '\n' == cli.stderr
+    assert e.value.status == mech.EINPUT
+    assert e.value.diagnostics and e.value.diagnostics[0]['file'] == path
+    first = str(e.value).splitlines()[0]
+    assert re.match(re.escape(path) + r'(:\d+:\d+)?: error: ', first), first
+    with pytest.raises(mech.MechError):
+        mech.check(path)
+
+
+def test_error_line_and_column():
+    with pytest.raises(mech.MechError) as e:
+        mech.load('tests/bad/09-unknown-link-key-typo.yaml')
+    assert re.match(r"tests/bad/09-unknown-link-key-typo\.yaml:\d+:\d+: error: unknown key 'mas'",
+                    str(e.value))
+    d = e.value.diagnostics[0]
+    assert d['line'] > 0 and d['column'] > 0 and d['severity'] == 'error'
+    assert "did you mean 'mass'" in d['message']
+
+
+def test_missing_file():
+    with pytest.raises(mech.MechError) as e:
+        mech.load('tests/no-such-file.yaml')
+    assert e.value.status == mech.EIO and 'no-such-file.yaml' in str(e.value)
+
+
+def test_solve_failure_keeps_the_rows_solved():
+    path = 'tests/solve/non-grashof.yaml'
+    with pytest.raises(mech.MechError) as e:
+        mech.solve(path)
+    assert e.value.status == mech.ESOLVE
+    assert re.match(re.escape(path) + r':\d+:\d+: error: cannot assemble', str(e.value))
+    partial = e.value.partial
+    assert isinstance(partial, mech.Result) and 0 < partial.nrows < 361
+
+
+def test_bad_options():
+    path = 'mechanisms/fourbar.yaml'
+    with pytest.raises(ValueError):
+        mech.solve(path, from_='0 deg')
+    with pytest.raises(ValueError):
+        mech.solve(path, steps=0)
+    with pytest.raises(ValueError):
+        mech.solve(path, from_='0 parsec', to='1 deg')
+    with pytest.raises(ValueError):
+        mech.solve(path, level='jerk')
+    with pytest.raises(ValueError):
+        mech.solve(path, tol=2.0)
+    with pytest.raises(TypeError):
+        mech.solve(path, set={'r': [1]})
+    with pytest.raises(mech.MechError) as e:
+        mech.solve(path, outputs=['Bee'])
+    assert "'Bee'" in str(e.value) and e.value.status == mech.EINPUT
+
+
+def test_result_mapping():
+    r = mech.solve('mechanisms/fourbar.yaml', outputs='B')
+    assert list(r) == r.columns == r.keys() and len(r) == len(r.columns)
+    assert 'B.vx' in r and 'C.vx' not in r
+    with pytest.raises(KeyError, match="did you mean 'B.vx'"):
+        r['B.vxx']
+    a = r.to_array()
+    assert a.shape == (r.nrows, len(r.columns))
+    assert_bits_equal(a[:, r.columns.index('B.x')], r['B.x'], 'to_array')
+    assert 'rows' in repr(r)
+
+
+def test_sweep_equals_solve_with_set():
+    path = 'mechanisms/slider-crank.yaml'
+    variants = mech.sweep(path, {'r': ['30 mm', '40 mm', '50 mm']}, outputs='B', jobs=3)
+    assert [v['set'] for v in variants] == [{'r': '30 mm'}, {'r': '40 mm'}, {'r': '50 mm'}]
+    for v in variants:
+        assert v['ok'] and v['error'] is None
+        one = mech.solve(path, set=v['set'], outputs='B')
+        assert_bits_equal(v['result']['B.x'], one['B.x'], str(v['set']))
+    stroke = [np.ptp(v['result']['B.x']) for v in variants]
+    assert stroke == pytest.approx([0.06, 0.08, 0.10])
+
+
+def test_sweep_reports_variants_that_cannot_be_solved():
+    # a crank longer than the connecting rod (140 mm) cannot turn
+    variants = mech.sweep('mechanisms/slider-crank.yaml', {'r': ['40 mm', '150 mm']}, jobs=1)
+    assert [v['ok'] for v in variants] == [True, False]
+    assert variants[1]['result'] is None
+    assert variants[1]['error'].status == mech.ESOLVE
+
+
+def test_threads_give_the_same_numbers():
+    path = 'mechanisms/stirling.yaml'
+    want = mech.solve(path)
+    got = [None] * 4
+
+    def work(i):
+        got[i] = mech.solve(path)
+
+    threads = [threading.Thread(target=work, args=(i,)) for i in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    for r in got:
+        for n in want.columns:
+            assert_bits_equal(r[n], want[n], n)
