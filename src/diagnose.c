@@ -332,37 +332,73 @@ static int other_interval(cont *c, double lo, double hi, double h, double *lo2, 
     return 0;
 }
 
+/* At the singular position the sweep stopped at, can the driver not move
+ * on (a limit position: the solution curve turns back, as against a change
+ * point, where another crosses it)? 0 when unknown (a large system). */
+static int at_limit(cont *c)
+{
+    solver *sv = &c->sv;
+    double *right = xcalloc((size_t)sv->p->ns + 1, sizeof *right);
+    double *left = xcalloc((size_t)sv->p->nr + 1, sizeof *left);
+    int limit = right && left && dense_null(sv, right, left) == 0 && !is_change_point(sv, left);
+    free(right);
+    free(left);
+    return limit;
+}
+
+/* The interval(s) where the mechanism assembles, from row 0 and the last
+ * position reached: "from A to B[ and from C to D] (limit positions...)". */
+static void assembly_range(cont *c, double q_row, double hrow, char *buf, size_t size)
+{
+    const mech_model *m = c->m;
+    char qb[64], qc[64], qd[64], qe[64], more[200] = "";
+    double upper = c->qc;
+    c->searching = 1;
+    double span = is_angle_driver(m) ? 2.0 * PI : fabs(q_row - c->q0) * 4.0 + c->sv.p->lref;
+    int found;
+    double lower = lower_limit(c, span, hrow, &found);
+    double lo = fmin(lower, upper), hi = fmax(lower, upper), lo2, hi2;
+    if (found && is_angle_driver(m) && other_interval(c, lo, hi, fabs(hrow), &lo2, &hi2))
+        snprintf(more, sizeof more, " and from %s to %s", diagnose_q_text(m, lo2, qd, sizeof qd),
+                 diagnose_q_text(m, hi2, qe, sizeof qe));
+    snprintf(buf, size, "the mechanism assembles for %s from %s%s to %s%s (limit positions%s)",
+             diagnose_driver_word(m), found || lo == lower ? "" : "at most ",
+             diagnose_q_text(m, lo, qb, sizeof qb), diagnose_q_text(m, hi, qc, sizeof qc), more,
+             found ? "" : "; the other side was not searched past one range");
+}
+
 void diagnose_failure(cont *c, double q_row, double hrow)
 {
     const mech_model *m = c->m;
     solver *sv = &c->sv;
-    char qa[64], qb[64], qc[64], lb[256];
+    char qa[64], qb[64], lb[256], range[600];
     double upper = c->qc, fq = c->fail_q;
     step_status s = c->fail_status;
     int loop = c->fail_loop;
     double resid = c->fail_resid;
+    /* stuck at a limit short of the row: the row itself cannot assemble
+       (a row on the limit itself is a singular position, below) */
+    if (s == STEP_SINGULAR && fabs(q_row - fq) > 1e-6 * fabs(hrow) && at_limit(c)) {
+        double rcond = sv->rcond;
+        assembly_range(c, q_row, hrow, range, sizeof range);
+        diag_error(c->d, m->file, m->driver.mark,
+                   "cannot assemble at %s = %s: the sweep reached a limit position at %s "
+                   "(reciprocal condition %.2g), past which %s does not close; %s",
+                   diagnose_driver_word(m), diagnose_q_text(m, q_row, qa, sizeof qa),
+                   diagnose_q_text(m, fq, qb, sizeof qb), rcond,
+                   diagnose_loop_label(sv, loop, lb, sizeof lb), range);
+        return;
+    }
     if (s == STEP_SINGULAR) {
         diagnose_singular(c, fq);
         return;
     }
     if (s == STEP_NO_ASSEMBLY) {
-        c->searching = 1;
-        double span = is_angle_driver(m) ? 2.0 * PI : fabs(q_row - c->q0) * 4.0 + sv->p->lref;
-        int found;
-        double lower = lower_limit(c, span, hrow, &found);
-        double lo = fmin(lower, upper), hi = fmax(lower, upper), lo2, hi2;
-        char more[200] = "", qd[64], qe[64];
-        if (found && is_angle_driver(m) && other_interval(c, lo, hi, fabs(hrow), &lo2, &hi2))
-            snprintf(more, sizeof more, " and from %s to %s", diagnose_q_text(m, lo2, qd, sizeof qd),
-                     diagnose_q_text(m, hi2, qe, sizeof qe));
+        assembly_range(c, q_row, hrow, range, sizeof range);
         diag_error(c->d, m->file, m->driver.mark,
-                   "cannot assemble at %s = %s: %s does not close (residual %.3g m); the "
-                   "mechanism assembles for %s from %s%s to %s%s (limit positions%s)",
+                   "cannot assemble at %s = %s: %s does not close (residual %.3g m); %s",
                    diagnose_driver_word(m), diagnose_q_text(m, q_row, qa, sizeof qa),
-                   diagnose_loop_label(sv, loop, lb, sizeof lb), resid, diagnose_driver_word(m),
-                   found || lo == lower ? "" : "at most ", diagnose_q_text(m, lo, qb, sizeof qb),
-                   diagnose_q_text(m, hi, qc, sizeof qc), more,
-                   found ? "" : "; the other side was not searched past one range");
+                   diagnose_loop_label(sv, loop, lb, sizeof lb), resid, range);
         return;
     }
     if (s == STEP_JUMP)

@@ -1299,3 +1299,40 @@ Test(hard, chain_10000_from_rough_guesses, .disabled = true)
     chain_run r = run_chain(n, 2, 1.0);
     cr_assert_eq(r.rc, MECH_OK, "N = %d, guesses 1 deg off: %s", n, r.msg);
 }
+
+/* Issue 16 item 10: a crank longer than a full turn allows (45 mm with
+ * coupler 60, rocker 50, ground 70) reaches the limit where coupler and
+ * rocker are in line, |CA| = 110 mm: cos q = (45^2 + 70^2 - 110^2) / (2 45 70).
+ * The sweep creeps up to it and stops at a singular position short of the
+ * next row; that row cannot assemble, and the message says so (it said
+ * "singular position ... dead point" before), with the range to the limits. */
+Test(hard, crank_past_its_limit_cannot_assemble)
+{
+    mech_model *m = load_text(
+        "name: long crank\nunits: {length: mm, angle: deg}\n"
+        "ground: {O: [0, 0], C: [70, 0]}\n"
+        "links:\n  crank: {points: {O: [0, 0], A: [45, 0]}}\n"
+        "  coupler: {points: {A: [0, 0], B: [60, 0]}}\n"
+        "  rocker: {points: {C: [0, 0], B: [50, 0]}}\n"
+        "driver: {link: crank, angle: {from: 0, to: 360, steps: 360}, speed: 10 rad/s}\n"
+        "initial: {coupler: 40, rocker: 100}\n"
+        "branch: [{points: [A, B, C], turn: cw}]\n");
+    mech_solve_options o;
+    mech_solve_options_default(&o);
+    mech_diag d;
+    mech_diag_init(&d);
+    mech_table t = {0};
+    cr_assert_eq(mech_solve(m, &o, &t, NULL, &d), MECH_ESOLVE);
+    const char *msg = first_message(&d);
+    double limit = acos((45.0 * 45 + 70.0 * 70 - 110.0 * 110) / (2.0 * 45 * 70)) * 180 / PI;
+    cr_assert_eq(t.nrows, (int)floor(limit) + 1, "%d rows: %s", t.nrows, msg);
+    cr_assert(strstr(msg, "cannot assemble at driver angle = 146 deg"), "%s", msg);
+    cr_assert(!strstr(msg, "singular position"), "%s", msg);
+    double lo, hi;
+    cr_assert(assembly_interval(msg, "deg", &lo, &hi), "no range: %s", msg);
+    cr_assert(fabs(hi - limit) <= 1e-3 && fabs(lo + limit) <= 1e-3,
+              "range [%g, %g] deg, limits +-%.6f by the law of cosines: %s", lo, hi, limit, msg);
+    mech_table_free(&t);
+    mech_diag_free(&d);
+    mech_model_free(&m);
+}
