@@ -242,6 +242,28 @@ static void note_refined(run *r, double q)
               r->c.row_substeps + 1, r->c.sv.rcond);
 }
 
+/* A value that is not a finite number is never passed off as a result:
+ * an error naming the column and the driver position (extreme data, such
+ * as a driver speed of 1e160 rad/s, overflow the rates). */
+static int check_finite(run *r, double q, const double *out)
+{
+    const column_layout *cl = &r->a->cols;
+    int c = 0;
+    while (c < cl->ncols && isfinite(out[c]))
+        c++;
+    if (c == cl->ncols)
+        return MECH_OK;
+    const mech_model *m = r->a->m;
+    char qb[64];
+    return diag_error(r->d, m->file, m->driver.mark,
+                      "at %s = %s the column %s is %s, not a finite number: the data overflow "
+                      "double precision (check the driver's speed and acceleration, the "
+                      "masses and loads, and their units)",
+                      diagnose_driver_word(m), diagnose_q_text(m, q, qb, sizeof qb),
+                      cl->cols[c].name, isnan(out[c]) ? "NaN" : out[c] > 0 ? "+inf" : "-inf"),
+           MECH_ESOLVE;
+}
+
 /* Row `row` at driver position q: reach it, publish it, its forces, fill it. */
 static int solve_row(run *r, const double *q, int row, double *out)
 {
@@ -265,6 +287,8 @@ static int solve_row(run *r, const double *q, int row, double *out)
         return rc;
     row_sources rs = {&c->sv, r->a->want_forces ? &r->fc : NULL, c->row_iters, c->row_substeps};
     columns_fill(&r->a->cols, &rs, out);
+    if ((rc = check_finite(r, q[row], out)) != MECH_OK)
+        return rc;
     r->st->iterations += c->row_iters;
     if (c->row_iters > r->st->max_iterations)
         r->st->max_iterations = c->row_iters;

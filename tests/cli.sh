@@ -369,4 +369,14 @@ for f in mechanisms/*.yaml; do
     fi
 done
 
+# issue 16 item 7: a result that is not a finite number is an error (it wrote
+# 4332 nan/inf cells and exited 0): exit 1, the column and the position named,
+# no file written
+sed 's|speed: 10 rad/s|speed: 1e160 rad/s|' mechanisms/fourbar.yaml > "$tmp/fast.yaml"
+if run "mech solve, speed 1e160 rad/s" 1 "$MECH" solve "$tmp/fast.yaml" -o "$tmp/fast.csv"; then
+    has_line "$tmp/err" "at driver angle = 0 deg the column A.ax is NaN, not a finite number" \
+        "solve: non-finite result named"
+    [ -e "$tmp/fast.csv" ] && fail "solve: non-finite result: a file was written" || pass
+fi
+
 summary
