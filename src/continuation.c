@@ -108,7 +108,7 @@ int cont_branches_hold(cont *c, int *which)
  * crossed (a change point); the sweep may have passed to another assembly. */
 static void note_crossing(cont *c, double qn)
 {
-    int sign = solver_det_sign(&c->sv);
+    int sign = c->try_sign;  /* of the step being accepted (cont_try) */
     if (sign != 0 && c->det_sign != 0 && sign != c->det_sign && !c->searching &&
         c->crossings++ < 10) {
         char qa[64], qb[64];
@@ -163,18 +163,18 @@ step_status cont_try(cont *c, double qn, int continuing)
         for (int i = 0; i < sv->p->ns; i++)
             sv->dx[i] = sv->x[i] - c->xpred[i];
         double corr = solver_step_size(sv->p, sv->dx);
-        for (int i = 0; i < sv->p->ns; i++)
-            sv->dx[i] = c->xpred[i] - c->xc[i];
-        if (corr > 0.5 * solver_step_size(sv->p, sv->dx) + 0.05)
+        if (corr > 0.5 * c->pred_move + 0.05)
             return STEP_JUMP;
         /* det J changed sign: a singular position was crossed, or Newton
            fell onto another assembly that the test above let pass (a long
            step, whose prediction means little). Shorten the step: a change
            point is still crossed at a short one, a jump is not. */
-        int sign = solver_det_sign(sv);
-        if (sign != 0 && c->det_sign != 0 && sign != c->det_sign &&
+        c->try_sign = solver_det_sign(sv);
+        if (c->try_sign != 0 && c->det_sign != 0 && c->try_sign != c->det_sign &&
             fabs(qn - c->qc) > c->hcross)
             return STEP_JUMP;
+    } else {
+        c->try_sign = solver_det_sign(sv);
     }
     solver_rates(sv);
     int b;
@@ -207,7 +207,8 @@ step_status cont_advance(cont *c, double q, double hmin)
         double remaining = q - c->qc;
         double qn = fabs(remaining) <= fabs(h) * (1.0 + 1e-12) ? q : c->qc + h;
         predict(c, qn);
-        if (fabs(h) > c->hcross && predicted_move(c) > MAX_PREDICTED_MOVE) {
+        c->pred_move = predicted_move(c);
+        if (fabs(h) > c->hcross && c->pred_move > MAX_PREDICTED_MOVE) {
             h *= 0.5;  /* beyond the predictor's reach: shorten before solving */
             continue;
         }

@@ -28,6 +28,8 @@ typedef struct cont {
     double q_prev;
     int have_prev;
     double *xpred;             /* [ns] */
+    double pred_move;          /* size of xpred - xc (solver_step_size) */
+    int try_sign;              /* sign of det J at the last converged attempt */
     /* row 0, kept to look for the assembly range after a failure */
     double q0, *x0, *xq0, *xqq0;
     double *guess;             /* [n] the file's guess of each unknown, NAN if none */
