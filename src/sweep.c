@@ -248,10 +248,15 @@ static void note_refined(run *r, double q)
 static int check_finite(run *r, double q, const double *out)
 {
     const column_layout *cl = &r->a->cols;
-    double z = 0.0;  /* x * 0 is NaN for an infinite or NaN x, else 0: one sum */
-    for (int k = 0; k < cl->ncols; k++)
-        z += out[k] * 0.0;
-    if (z == 0.0)
+    /* x - x is NaN for an infinite or NaN x, else 0: four independent sums */
+    double z[4] = {0.0, 0.0, 0.0, 0.0};
+    int k = 0;
+    for (; k + 4 <= cl->ncols; k += 4)
+        for (int i = 0; i < 4; i++)
+            z[i] += out[k + i] - out[k + i];
+    for (; k < cl->ncols; k++)
+        z[0] += out[k] - out[k];
+    if (z[0] + z[1] + z[2] + z[3] == 0.0)
         return MECH_OK;
     int c = 0;
     while (c < cl->ncols && isfinite(out[c]))
