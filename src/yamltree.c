@@ -8,7 +8,9 @@
 #include "internal.h"
 
 const yaml_limits yaml_default_limits = {
-    .max_bytes = 64u << 20,   /* 64 MiB: a chain of 100 000 loops is ~20 MiB */
+    .max_bytes = 32u << 20,   /* 32 MiB: a chain of 100 000 loops is ~16 MiB; a larger
+                                 file is refused from its size, before the seconds and
+                                 the gigabyte its tree would take */
     .max_depth = 32,
     .max_nodes = 8u << 20,
     .max_scalar = 4096,

@@ -82,10 +82,10 @@ fi
 if run "mech solve directory" 3 "$MECH" solve "$tmp/dir.yaml" -o "$tmp/dir.csv"; then
     has_line "$tmp/err" "dir.yaml: error: cannot read: a directory, not a regular file" "solve: directory refused"
 fi
-# one byte over 64 MiB, sparse: refused from its size, not after reading it
-if truncate -s 67108865 "$tmp/big.yaml" 2>/dev/null; then
-    if run "mech check 64 MiB + 1" 2 "$MECH" check "$tmp/big.yaml"; then
-        has_line "$tmp/err" "big.yaml: error: file too large (67108865 bytes; at most 67108864)" "check: size from fstat"
+# one byte over 32 MiB, sparse: refused from its size, not after reading it
+if truncate -s 33554433 "$tmp/big.yaml" 2>/dev/null; then
+    if run "mech check 32 MiB + 1" 2 "$MECH" check "$tmp/big.yaml"; then
+        has_line "$tmp/err" "big.yaml: error: file too large (33554433 bytes; at most 33554432)" "check: size from fstat"
     fi
     rm -f "$tmp/big.yaml"
 fi

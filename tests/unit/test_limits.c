@@ -63,14 +63,14 @@ static void expect_refused(const buf *b, int line, int col, const char *want)
     mech_diag_free(&d);
 }
 
-Test(limits, file_larger_than_64_mib)
+Test(limits, file_larger_than_32_mib)
 {
     buf b = {0};
-    b.len = (64u << 20) + 1;
+    b.len = (32u << 20) + 1;
     b.s = malloc(b.len);
     cr_assert_not_null(b.s);
     memset(b.s, ' ', b.len);
-    expect_refused(&b, 0, 0, "file too large (67108865 bytes; at most 67108864)");
+    expect_refused(&b, 0, 0, "file too large (33554433 bytes; at most 33554432)");
     free(b.s);
 }
 
