@@ -65,4 +65,33 @@ static inline int column_kind(const char *name)
     return -1;
 }
 
+/* Solve with options o (NULL: the defaults); the solve must succeed. */
+static inline mech_table must_solve(const mech_model *m, const mech_solve_options *o)
+{
+    mech_solve_options def;
+    mech_solve_options_default(&def);
+    mech_diag d;
+    mech_diag_init(&d);
+    mech_table t = {0};
+    int rc = mech_solve(m, o ? o : &def, &t, NULL, &d);
+    if (rc != MECH_OK)
+        mech_diag_print(&d, stderr);
+    mech_diag_free(&d);
+    cr_assert_eq(rc, MECH_OK, "mech_solve failed (%d) on %s", rc, m->name);
+    return t;
+}
+
+/* The column called name (it must exist), and its value in a row. */
+static inline int table_col(const mech_table *t, const char *name)
+{
+    int c = mech_table_column(t, name);
+    cr_assert_geq(c, 0, "no column '%s' in the table", name);
+    return c;
+}
+
+static inline double table_at(const mech_table *t, int row, const char *name)
+{
+    return mech_table_get(t, row, table_col(t, name));
+}
+
 #endif

@@ -27,18 +27,6 @@ static void solve(const mech_model *m, int friction, mech_table *t)
     cr_assert_eq(rc, MECH_OK);
 }
 
-static int col(const mech_table *t, const char *name)
-{
-    int c = mech_table_column(t, name);
-    cr_assert_geq(c, 0, "no column '%s'", name);
-    return c;
-}
-
-static double at(const mech_table *t, int row, const char *name)
-{
-    return mech_table_get(t, row, col(t, name));
-}
-
 /* ---- a driven physical pendulum ---------------------------------------- */
 
 static const char PENDULUM[] =
@@ -75,22 +63,22 @@ Test(forces, pendulum_newton_euler)
     solve(m, MECH_FRICTION_BOTH, &t);
     cr_assert_eq(t.nrows, 73);
     for (int r = 0; r < t.nrows; r++) {
-        double q = at(&t, r, "q"), fx, fy, tq;
+        double q = table_at(&t, r, "q"), fx, fy, tq;
         pendulum_truth(q, &fx, &fy, &tq);
         double scale = 20.0;  /* N; |F| ~ m (g + w^2 r) */
-        cr_assert(fabs(at(&t, r, "O.Fx.nofriction") - fx) < 1e-12 * scale, "row %d Fx", r);
-        cr_assert(fabs(at(&t, r, "O.Fy.nofriction") - fy) < 1e-12 * scale, "row %d Fy", r);
-        cr_assert(fabs(at(&t, r, "driver.torque.nofriction") - tq) < 1e-12 * scale,
-                  "row %d torque %.17g, expected %.17g", r, at(&t, r, "driver.torque.nofriction"), tq);
+        cr_assert(fabs(table_at(&t, r, "O.Fx.nofriction") - fx) < 1e-12 * scale, "row %d Fx", r);
+        cr_assert(fabs(table_at(&t, r, "O.Fy.nofriction") - fy) < 1e-12 * scale, "row %d Fy", r);
+        cr_assert(fabs(table_at(&t, r, "driver.torque.nofriction") - tq) < 1e-12 * scale,
+                  "row %d torque %.17g, expected %.17g", r, table_at(&t, r, "driver.torque.nofriction"), tq);
         /* friction: the pin's reaction is the same (one moving link), the
            driver supplies the friction moment mu r |F| against w > 0 */
-        cr_assert(fabs(at(&t, r, "O.Fx") - fx) < 1e-12 * scale);
+        cr_assert(fabs(table_at(&t, r, "O.Fx") - fx) < 1e-12 * scale);
         double tf = tq + 0.2 * 0.01 * hypot(fx, fy);
-        cr_assert(fabs(at(&t, r, "driver.torque") - tf) < 1e-11 * scale,
-                  "row %d torque with friction %.17g, expected %.17g", r, at(&t, r, "driver.torque"), tf);
-        cr_assert(fabs(at(&t, r, "friction.power") - 0.2 * 0.01 * hypot(fx, fy) * 3) < 1e-10);
-        cr_assert(fabs(at(&t, r, "power.residual")) < 1e-12);
-        cr_assert(fabs(at(&t, r, "power.residual.nofriction")) < 1e-12);
+        cr_assert(fabs(table_at(&t, r, "driver.torque") - tf) < 1e-11 * scale,
+                  "row %d torque with friction %.17g, expected %.17g", r, table_at(&t, r, "driver.torque"), tf);
+        cr_assert(fabs(table_at(&t, r, "friction.power") - 0.2 * 0.01 * hypot(fx, fy) * 3) < 1e-10);
+        cr_assert(fabs(table_at(&t, r, "power.residual")) < 1e-12);
+        cr_assert(fabs(table_at(&t, r, "power.residual.nofriction")) < 1e-12);
     }
     mech_table_free(&t);
     mech_model_free(&m);
@@ -117,20 +105,20 @@ Test(forces, slider_crank_virtual_work)
     solve(m, MECH_FRICTION_ON, &t);
     const double r = 0.04, l = 0.14, P = -1000;
     for (int k = 0; k < t.nrows; k++) {
-        double q = at(&t, k, "q"), s = sin(q), c = cos(q);
+        double q = table_at(&t, k, "q"), s = sin(q), c = cos(q);
         double dxdq = -r * s - r * r * s * c / sqrt(l * l - r * r * s * s);
         /* virtual work: T dq + P dx = 0 */
         double T = -P * dxdq;
-        cr_assert(fabs(at(&t, k, "driver.torque") - T) < 1e-10 * 50.0,
-                  "row %d: torque %.17g, expected %.17g", k, at(&t, k, "driver.torque"), T);
+        cr_assert(fabs(table_at(&t, k, "driver.torque") - T) < 1e-10 * 50.0,
+                  "row %d: torque %.17g, expected %.17g", k, table_at(&t, k, "driver.torque"), T);
         /* the massless rod is a two-force member: the crank pin's force on
            the rod is along the rod */
-        double ax = at(&t, k, "A.Fx"), ay = at(&t, k, "A.Fy");
-        double phi = at(&t, k, "rod.angle");
+        double ax = table_at(&t, k, "A.Fx"), ay = table_at(&t, k, "A.Fy");
+        double phi = table_at(&t, k, "rod.angle");
         cr_assert(fabs(ax * sin(phi) - ay * cos(phi)) < 1e-9 * hypot(ax, ay),
                   "row %d: force at A not along the rod", k);
         /* the guide carries the rod force's y component */
-        cr_assert(fabs(at(&t, k, "x_B.Fx")) < 1e-12 * 1000);
+        cr_assert(fabs(table_at(&t, k, "x_B.Fx")) < 1e-12 * 1000);
     }
     mech_table_free(&t);
     mech_model_free(&m);
@@ -145,16 +133,16 @@ static void check_coupler_equilibrium(const mech_table *t)
 {
     const double m = 0.3, I = 1e-4, g = -9.81, q = 100.0;  /* N/m, at -60 deg */
     for (int r = 0; r < t->nrows; r++) {
-        double th = at(t, r, "coupler.angle"), w = at(t, r, "coupler.omega");
-        double al = at(t, r, "coupler.alpha"), c = cos(th), s = sin(th);
-        double Ax = at(t, r, "A.x"), Ay = at(t, r, "A.y"), Bx = at(t, r, "B.x"), By = at(t, r, "B.y");
-        double Px = at(t, r, "P.x"), Py = at(t, r, "P.y");
+        double th = table_at(t, r, "coupler.angle"), w = table_at(t, r, "coupler.omega");
+        double al = table_at(t, r, "coupler.alpha"), c = cos(th), s = sin(th);
+        double Ax = table_at(t, r, "A.x"), Ay = table_at(t, r, "A.y"), Bx = table_at(t, r, "B.x"), By = table_at(t, r, "B.y");
+        double Px = table_at(t, r, "P.x"), Py = table_at(t, r, "P.y");
         double rx = c * 0.030 - s * 0.005, ry = s * 0.030 + c * 0.005;  /* G - A */
         double Gx = Ax + rx, Gy = Ay + ry;
-        double agx = at(t, r, "A.ax") - al * ry - w * w * rx;
-        double agy = at(t, r, "A.ay") + al * rx - w * w * ry;
-        double fAx = at(t, r, "A.Fx.nofriction"), fAy = at(t, r, "A.Fy.nofriction");
-        double fBx = -at(t, r, "B.Fx.nofriction"), fBy = -at(t, r, "B.Fy.nofriction");
+        double agx = table_at(t, r, "A.ax") - al * ry - w * w * rx;
+        double agy = table_at(t, r, "A.ay") + al * rx - w * w * ry;
+        double fAx = table_at(t, r, "A.Fx.nofriction"), fAy = table_at(t, r, "A.Fy.nofriction");
+        double fBx = -table_at(t, r, "B.Fx.nofriction"), fBy = -table_at(t, r, "B.Fy.nofriction");
         double wl = q * 0.060, fdx = wl * cos(-PI / 3), fdy = wl * sin(-PI / 3);
         double Mx = 0.5 * (Ax + Bx), My = 0.5 * (Ay + By);
         double sx = fAx + fBx + 5 + fdx, sy = fAy + fBy - 20 + fdy + m * g;
@@ -193,18 +181,18 @@ Test(forces, fourbar_power_balance)
     solve(m, MECH_FRICTION_BOTH, &t);
     double worst = 0, worst_f = 0, loss = 0;
     for (int r = 0; r < t.nrows; r++) {
-        worst = fmax(worst, fabs(at(&t, r, "power.residual.nofriction")));
-        worst_f = fmax(worst_f, fabs(at(&t, r, "power.residual")));
-        cr_assert_geq(at(&t, r, "friction.power"), 0.0, "friction must dissipate");
-        loss += at(&t, r, "friction.power");
-        cr_assert_leq(at(&t, r, "friction.iterations"), 30);
+        worst = fmax(worst, fabs(table_at(&t, r, "power.residual.nofriction")));
+        worst_f = fmax(worst_f, fabs(table_at(&t, r, "power.residual")));
+        cr_assert_geq(table_at(&t, r, "friction.power"), 0.0, "friction must dissipate");
+        loss += table_at(&t, r, "friction.power");
+        cr_assert_leq(table_at(&t, r, "friction.iterations"), 30);
     }
     cr_assert_lt(worst, 1e-12, "power balance without friction: %g", worst);
     check_coupler_equilibrium(&t);
     cr_assert_lt(worst_f, 1e-12, "power balance with friction: %g", worst_f);
     cr_assert_gt(loss, 0.0);
     /* friction changes the torque */
-    cr_assert(fabs(at(&t, 10, "driver.torque") - at(&t, 10, "driver.torque.nofriction")) > 1e-4);
+    cr_assert(fabs(table_at(&t, 10, "driver.torque") - table_at(&t, 10, "driver.torque.nofriction")) > 1e-4);
     mech_table_free(&t);
     mech_model_free(&m);
 }
@@ -233,7 +221,7 @@ Test(forces, columns_only_when_asked)
     cr_assert_eq(mech_table_column(&t, "friction.power"), -1);
     cr_assert_eq(mech_table_column(&t, "driver.torque.nofriction"), -1);
     for (int r = 0; r < t.nrows; r++)
-        cr_assert(fabs(at(&t, r, "driver.torque")) < 1e-15, "massless, unloaded: no torque");
+        cr_assert(fabs(table_at(&t, r, "driver.torque")) < 1e-15, "massless, unloaded: no torque");
     mech_table_free(&t);
     mech_model_free(&m);
 }

@@ -40,29 +40,6 @@
 
 
 
-/* Solve with options o (NULL: the defaults); the solve must succeed. */
-static mech_table solve_ok(const mech_model *m, const mech_solve_options *o)
-{
-    mech_solve_options def;
-    mech_solve_options_default(&def);
-    mech_diag d;
-    mech_diag_init(&d);
-    mech_table t = {0};
-    int rc = mech_solve(m, o ? o : &def, &t, NULL, &d);
-    if (rc != MECH_OK)
-        mech_diag_print(&d, stderr);
-    mech_diag_free(&d);
-    cr_assert_eq(rc, MECH_OK, "mech_solve failed (%d) on %s", rc, m->name);
-    return t;
-}
-
-static int column(const mech_table *t, const char *name)
-{
-    int c = mech_table_column(t, name);
-    cr_assert_geq(c, 0, "no column '%s' in the table", name);
-    return c;
-}
-
 static char *format(const char *fmt, ...)
 {
     static char buf[4096];
@@ -88,13 +65,13 @@ static void check_sweep(const mech_table *t, const char *const *names, int ncol,
                         const void *geom, double w, double al, const double *q_expected,
                         double tol, int only_present)
 {
-    int nrows = t->nrows, qc = column(t, "q");
+    int nrows = t->nrows, qc = table_col(t, "q");
     int *col = malloc((size_t)ncol * sizeof *col);
     double *ref = malloc((size_t)nrows * (size_t)ncol * sizeof *ref);
     double *tmp = malloc((size_t)ncol * sizeof *tmp);
     double kind_max[6] = {0};
     for (int j = 0; j < ncol; j++)
-        col[j] = only_present ? mech_table_column(t, names[j]) : column(t, names[j]);
+        col[j] = only_present ? mech_table_column(t, names[j]) : table_col(t, names[j]);
     for (int i = 0; i < nrows; i++) {
         double q = mech_table_get(t, i, qc);
         if (q_expected)
@@ -284,7 +261,7 @@ Test(solve, closed_forms_are_consistent)
 Test(solve, crank_rocker_full_revolution)
 {
     mech_model *m = fourbar_model(&CRANK_ROCKER, 0, 360, 360, 7, -3);
-    mech_table t = solve_ok(m, NULL);
+    mech_table t = must_solve(m, NULL);
     cr_assert_eq(t.nrows, 361);
     double *q = range_deg(0, 360, 360);
     check_sweep(&t, FOURBAR_COLS, NFOURBAR, fourbar_ref, &CRANK_ROCKER, 7, -3, q, 1e-10, 0);
@@ -299,7 +276,7 @@ Test(solve, crank_rocker_full_revolution)
 Test(solve, double_crank_full_revolution)
 {
     mech_model *m = fourbar_model(&DOUBLE_CRANK, 0, -360, 360, 2, 0.5);
-    mech_table t = solve_ok(m, NULL);
+    mech_table t = must_solve(m, NULL);
     cr_assert_eq(t.nrows, 361);
     double *q = range_deg(0, -360, 360);
     check_sweep(&t, FOURBAR_COLS, NFOURBAR, fourbar_ref, &DOUBLE_CRANK, 2, 0.5, q, 1e-10, 0);
@@ -312,7 +289,7 @@ Test(solve, double_crank_full_revolution)
 Test(solve, offset_slider_crank_full_revolution)
 {
     mech_model *m = slider_model(&OFFSET_SLIDER, 30, 390, 360, 5, 2);
-    mech_table t = solve_ok(m, NULL);
+    mech_table t = must_solve(m, NULL);
     cr_assert_eq(t.nrows, 361);
     double *q = range_deg(30, 390, 360);
     check_sweep(&t, SLIDER_COLS, NSLIDER, slider_ref, &OFFSET_SLIDER, 5, 2, q, 1e-10, 0);
@@ -336,13 +313,13 @@ Test(solve, offset_slider_crank_full_revolution)
 static void check_differences(const mech_table *t, const char *const (*cols)[3], int n,
                               double w, double al, double tol)
 {
-    int qc = column(t, "q"), nrows = t->nrows;
+    int qc = table_col(t, "q"), nrows = t->nrows;
     cr_assert_geq(nrows, 5);
     double h = (mech_table_get(t, nrows - 1, qc) - mech_table_get(t, 0, qc)) / (nrows - 1);
     double vmax[2] = {0}, amax[2] = {0};  /* [0] linear, [1] angular */
     for (int k = 0; k < n; k++) {
-        int ang = column_kind(cols[k][0]) == 3, vc = column(t, cols[k][1]),
-            ac = column(t, cols[k][2]);
+        int ang = column_kind(cols[k][0]) == 3, vc = table_col(t, cols[k][1]),
+            ac = table_col(t, cols[k][2]);
         for (int i = 0; i < nrows; i++) {
             vmax[ang] = fmax(vmax[ang], fabs(mech_table_get(t, i, vc)));
             amax[ang] = fmax(amax[ang], fabs(mech_table_get(t, i, ac)));
@@ -350,7 +327,7 @@ static void check_differences(const mech_table *t, const char *const (*cols)[3],
     }
     for (int k = 0; k < n; k++) {
         int ang = column_kind(cols[k][0]) == 3;
-        int c[3] = {column(t, cols[k][0]), column(t, cols[k][1]), column(t, cols[k][2])};
+        int c[3] = {table_col(t, cols[k][0]), table_col(t, cols[k][1]), table_col(t, cols[k][2])};
         for (int i = 2; i < nrows - 2; i++) {
             double d[2];
             for (int j = 0; j < 2; j++)
@@ -378,7 +355,7 @@ Test(solve, fourbar_rates_match_differences)
         {"coupler.angle", "coupler.omega", "coupler.alpha"},
         {"rocker.angle", "rocker.omega", "rocker.alpha"}};
     mech_model *m = fourbar_model(&CRANK_ROCKER, 0, 360, 3600, 7, -3);
-    mech_table t = solve_ok(m, NULL);
+    mech_table t = must_solve(m, NULL);
     cr_assert_eq(t.nrows, 3601);
     check_differences(&t, cols, (int)(sizeof cols / sizeof *cols), 7, -3, 1e-8);
     mech_table_free(&t);
@@ -391,7 +368,7 @@ Test(solve, slider_crank_rates_match_differences)
         {"B.x", "B.vx", "B.ax"}, {"B.y", "B.vy", "B.ay"},
         {"rod.angle", "rod.omega", "rod.alpha"}, {"x_B.s", "x_B.v", "x_B.a"}};
     mech_model *m = slider_model(&OFFSET_SLIDER, 0, 360, 3600, 5, 2);
-    mech_table t = solve_ok(m, NULL);
+    mech_table t = must_solve(m, NULL);
     cr_assert_eq(t.nrows, 3601);
     check_differences(&t, cols, (int)(sizeof cols / sizeof *cols), 5, 2, 1e-8);
     mech_table_free(&t);
@@ -410,17 +387,17 @@ static void check_period(const fourbar *g, int turns_coupler_rocker)
     mech_solve_options o;
     mech_solve_options_default(&o);
     o.tol = 1e-14;
-    mech_table t = solve_ok(m, &o);
+    mech_table t = must_solve(m, &o);
     cr_assert_eq(t.nrows, 361);
     double kind_max[6] = {0};
     for (int j = 0; j < NFOURBAR; j++) {
-        int c = column(&t, FOURBAR_COLS[j]), k = column_kind(FOURBAR_COLS[j]);
+        int c = table_col(&t, FOURBAR_COLS[j]), k = column_kind(FOURBAR_COLS[j]);
         for (int i = 0; i < t.nrows; i++)
             kind_max[k] = fmax(kind_max[k], fabs(mech_table_get(&t, i, c)));
     }
     for (int j = 0; j < NFOURBAR; j++) {
         const char *name = FOURBAR_COLS[j];
-        int c = column(&t, name), k = column_kind(name);
+        int c = table_col(&t, name), k = column_kind(name);
         double first = mech_table_get(&t, 0, c), last = mech_table_get(&t, 360, c);
         double turns = k != 3 ? 0 : strcmp(name, "crank.angle") == 0 ? 1 : turns_coupler_rocker;
         cr_assert(fabs(last - first - TWO_PI * turns) <= 1e-12 * kind_max[k],
@@ -516,7 +493,7 @@ Test(solve, slider_through_dead_centre_is_singular)
                  first_message(&d));
     cr_assert(any_message_has(&d, "singular"), "no 'singular' message: %s", first_message(&d));
     /* the rows solved are right: crank angle by the law of cosines */
-    int qc = column(&t, "q"), cc = column(&t, "crank.angle");
+    int qc = table_col(&t, "q"), cc = table_col(&t, "crank.angle");
     for (int i = 0; i < t.nrows; i++) {
         double x = mech_table_get(&t, i, qc);
         double want = acos((0.25 * 0.25 + x * x - 0.75 * 0.75) / (2 * 0.25 * x));
@@ -541,7 +518,7 @@ Test(solve, positions_only_have_no_rate_columns)
     mech_solve_options o;
     mech_solve_options_default(&o);
     o.want = MECH_WANT_POSITION;
-    mech_table t = solve_ok(m, &o);
+    mech_table t = must_solve(m, &o);
     cr_assert_eq(t.nrows, 37);
     cr_assert_eq(t.ncolumns, 8, "q and 7 positions expected, got %d columns", t.ncolumns);
     for (int j = 0; j < t.ncolumns; j++) {
@@ -550,12 +527,12 @@ Test(solve, positions_only_have_no_rate_columns)
                   "column '%s' in a positions-only table", name);
     }
     for (int j = 0; j < 7; j++)
-        column(&t, pos[j]);
+        table_col(&t, pos[j]);
     check_sweep(&t, SLIDER_COLS, NSLIDER, slider_ref, &OFFSET_SLIDER, 5, 2, NULL, 1e-10, 1);
     mech_table_free(&t);
 
     o.want = MECH_WANT_POSITION | MECH_WANT_VELOCITY;
-    t = solve_ok(m, &o);
+    t = must_solve(m, &o);
     cr_assert_eq(t.ncolumns, 15, "q, 7 positions and 7 velocities expected, got %d columns",
                  t.ncolumns);
     for (int j = 0; j < t.ncolumns; j++)
@@ -575,7 +552,7 @@ Test(solve, file_fourbar_matches_closed_form)
     const fourbar g = {.a = 0.020, .b = 0.060, .c = 0.050, .d = 0.070,
                        .px = 0.040 * cos(30 * DEG), .py = 0.040 * sin(30 * DEG), .sign = +1};
     mech_model *m = load_path("mechanisms/fourbar.yaml");
-    mech_table t = solve_ok(m, NULL);
+    mech_table t = must_solve(m, NULL);
     cr_assert_eq(t.nrows, 361);
     double *q = range_deg(0, 360, 360);
     check_sweep(&t, FOURBAR_COLS, NFOURBAR, fourbar_ref, &g, 10, 0, q, 1e-10, 0);
@@ -590,7 +567,7 @@ Test(solve, file_slider_crank_matches_closed_form)
 {
     const slidercrank g = {.r = 0.040, .l = 0.140, .e = 0};
     mech_model *m = load_path("mechanisms/slider-crank.yaml");
-    mech_table t = solve_ok(m, NULL);
+    mech_table t = must_solve(m, NULL);
     cr_assert_eq(t.nrows, 73);
     double *q = range_deg(0, 360, 72);
     check_sweep(&t, SLIDER_COLS, NSLIDER, slider_ref, &g, 100 * PI, 0, q, 1e-10, 0);

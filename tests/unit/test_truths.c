@@ -36,33 +36,6 @@
 
 /* ---- helpers ----------------------------------------------------------- */
 
-static mech_table solve_ok(const mech_model *m, const mech_solve_options *o)
-{
-    mech_solve_options def;
-    mech_solve_options_default(&def);
-    mech_diag d;
-    mech_diag_init(&d);
-    mech_table t = {0};
-    int rc = mech_solve(m, o ? o : &def, &t, NULL, &d);
-    if (rc != MECH_OK)
-        mech_diag_print(&d, stderr);
-    mech_diag_free(&d);
-    cr_assert_eq(rc, MECH_OK, "mech_solve failed (%d) on %s", rc, m->name);
-    return t;
-}
-
-static int col(const mech_table *t, const char *name)
-{
-    int c = mech_table_column(t, name);
-    cr_assert_geq(c, 0, "no column '%s'", name);
-    return c;
-}
-
-static double at(const mech_table *t, int row, const char *name)
-{
-    return mech_table_get(t, row, col(t, name));
-}
-
 static double sgn(double v) { return v > 0.0 ? 1.0 : v < 0.0 ? -1.0 : 0.0; }
 
 /* Compare the columns names[0..n-1] of every row with want[row * n + k]:
@@ -82,13 +55,13 @@ static void compare_rows(const mech_table *t, const char *const *names, int n, c
     for (int r = 0; r < t->nrows; r++)
         for (int k = 0; k < n; k++) {
             int kind = column_kind(names[k]);
-            double got = at(t, r, names[k]), exp = want[r * n + k];
+            double got = table_at(t, r, names[k]), exp = want[r * n + k];
             double err = kind == 3 ? remainder(got - exp, 2 * PI) : got - exp;
             double tol = (kind == 0 || kind == 3 ? tol_pos : tol_rate) * scale[kind];
             cr_assert(fabs(err) <= tol,
                       "%s, row %d (q = %.6g deg), %s: %.17g, expected %.17g (error %.3g, "
                       "tolerance %.3g)",
-                      what, r, at(t, r, "q") / DEG, names[k], got, exp, err, tol);
+                      what, r, table_at(t, r, "q") / DEG, names[k], got, exp, err, tol);
         }
 }
 
@@ -178,12 +151,12 @@ static void check_cylinder(const char *path, const cylinder *g)
     for (int k = 0; k < (int)(sizeof runs / sizeof *runs); k++) {
         m->driver.speed = runs[k][0];
         m->driver.accel = runs[k][1];
-        mech_table t = solve_ok(m, NULL);
+        mech_table t = must_solve(m, NULL);
         cr_assert_eq(t.nrows, 73);
         double *want = malloc(sizeof(double) * (size_t)t.nrows * NCYL);
         cr_assert_not_null(want);
         for (int r = 0; r < t.nrows; r++)
-            cylinder_ref(g, at(&t, r, "q"), runs[k][0], runs[k][1], want + (size_t)r * NCYL);
+            cylinder_ref(g, table_at(&t, r, "q"), runs[k][0], runs[k][1], want + (size_t)r * NCYL);
         char what[256];
         snprintf(what, sizeof what, "%s at %g rad/s, %g rad/s^2", path, runs[k][0], runs[k][1]);
         compare_rows(&t, CYL_COLS, NCYL, want, 1e-12, 1e-10, what);
@@ -232,22 +205,22 @@ Test(truths, slider_friction_incline)
         double v = runs[k][0], a = runs[k][1];
         m->driver.speed = v;
         m->driver.accel = a;
-        mech_table t = solve_ok(m, &o);
+        mech_table t = must_solve(m, &o);
         double N = mass * g * cos(beta);
         double F0 = mass * a + mass * g * sin(beta);
         double F = F0 + mu * N * sgn(v);
         for (int r = 0; r < t.nrows; r++) {
-            cr_assert(fabs(at(&t, r, "x.N") - N) < 1e-12 * N, "v %g row %d: N %.17g, expected %.17g",
-                      v, r, at(&t, r, "x.N"), N);
-            cr_assert(fabs(at(&t, r, "driver.force.nofriction") - F0) < 1e-12 * 20,
+            cr_assert(fabs(table_at(&t, r, "x.N") - N) < 1e-12 * N, "v %g row %d: N %.17g, expected %.17g",
+                      v, r, table_at(&t, r, "x.N"), N);
+            cr_assert(fabs(table_at(&t, r, "driver.force.nofriction") - F0) < 1e-12 * 20,
                       "v %g row %d: force without friction %.17g, expected %.17g", v, r,
-                      at(&t, r, "driver.force.nofriction"), F0);
-            cr_assert(fabs(at(&t, r, "driver.force") - F) < 1e-10 * 20,
+                      table_at(&t, r, "driver.force.nofriction"), F0);
+            cr_assert(fabs(table_at(&t, r, "driver.force") - F) < 1e-10 * 20,
                       "v %g a %g row %d: driver force %.17g, expected %.17g", v, a, r,
-                      at(&t, r, "driver.force"), F);
-            cr_assert(fabs(at(&t, r, "friction.power") - mu * N * fabs(v)) < 1e-10 * 20,
+                      table_at(&t, r, "driver.force"), F);
+            cr_assert(fabs(table_at(&t, r, "friction.power") - mu * N * fabs(v)) < 1e-10 * 20,
                       "v %g row %d: friction power %.17g, expected %.17g", v, r,
-                      at(&t, r, "friction.power"), mu * N * fabs(v));
+                      table_at(&t, r, "friction.power"), mu * N * fabs(v));
         }
         mech_table_free(&t);
     }
@@ -279,10 +252,10 @@ Test(truths, slider_friction_moving_guide)
     const double w = 10, tau = 2, mu = 0.3;
     cylinder g = {0.05, 0.14, 0.03, -0.06, 0.015, -0.03, 0.012, 0};
     mech_model *m = load_path("tests/truths/oscillating-cylinder-friction.yaml");
-    mech_table t = solve_ok(m, NULL);
+    mech_table t = must_solve(m, NULL);
     int checked = 0;
     for (int row = 0; row < t.nrows; row++) {
-        double q = at(&t, row, "q"), k[NCYL];
+        double q = table_at(&t, row, "q"), k[NCYL];
         cylinder_ref(&g, q, w, 0, k);
         double phi = k[18], sl = k[24], sl1 = k[25];
         if (fabs(sl1) < 0.2 * g.r * w)
@@ -293,22 +266,22 @@ Test(truths, slider_friction_moving_guide)
         double FCx = N * nx - fr * ux, FCy = N * ny - fr * uy;
         double T = k[0] * FAy - k[1] * FAx;
         const double fs = 1e-9 * 25, ts = 1e-9 * 25 * 0.2;
-        cr_assert(fabs(at(&t, row, "s.N") - N) < fs, "q %g deg: N %.17g, expected %.17g", q / DEG,
-                  at(&t, row, "s.N"), N);
-        cr_assert(fabs(at(&t, row, "s.M")) < ts, "q %g deg: M %.17g, expected 0", q / DEG,
-                  at(&t, row, "s.M"));
-        cr_assert(fabs(at(&t, row, "A.Fx") - FAx) < fs && fabs(at(&t, row, "A.Fy") - FAy) < fs,
+        cr_assert(fabs(table_at(&t, row, "s.N") - N) < fs, "q %g deg: N %.17g, expected %.17g", q / DEG,
+                  table_at(&t, row, "s.N"), N);
+        cr_assert(fabs(table_at(&t, row, "s.M")) < ts, "q %g deg: M %.17g, expected 0", q / DEG,
+                  table_at(&t, row, "s.M"));
+        cr_assert(fabs(table_at(&t, row, "A.Fx") - FAx) < fs && fabs(table_at(&t, row, "A.Fy") - FAy) < fs,
                   "q %g deg: A (%.17g, %.17g), expected (%.17g, %.17g)", q / DEG,
-                  at(&t, row, "A.Fx"), at(&t, row, "A.Fy"), FAx, FAy);
-        cr_assert(fabs(at(&t, row, "C.Fx") - FCx) < fs && fabs(at(&t, row, "C.Fy") - FCy) < fs,
+                  table_at(&t, row, "A.Fx"), table_at(&t, row, "A.Fy"), FAx, FAy);
+        cr_assert(fabs(table_at(&t, row, "C.Fx") - FCx) < fs && fabs(table_at(&t, row, "C.Fy") - FCy) < fs,
                   "q %g deg: C (%.17g, %.17g), expected (%.17g, %.17g)", q / DEG,
-                  at(&t, row, "C.Fx"), at(&t, row, "C.Fy"), FCx, FCy);
-        cr_assert(fabs(at(&t, row, "driver.torque") - T) < ts,
+                  table_at(&t, row, "C.Fx"), table_at(&t, row, "C.Fy"), FCx, FCy);
+        cr_assert(fabs(table_at(&t, row, "driver.torque") - T) < ts,
                   "q %g deg: driver torque %.17g, expected %.17g", q / DEG,
-                  at(&t, row, "driver.torque"), T);
-        cr_assert(fabs(at(&t, row, "friction.power") - mu * fabs(N * sl1)) < 1e-9 * 25 * 0.5,
+                  table_at(&t, row, "driver.torque"), T);
+        cr_assert(fabs(table_at(&t, row, "friction.power") - mu * fabs(N * sl1)) < 1e-9 * 25 * 0.5,
                   "q %g deg: friction power %.17g, expected %.17g", q / DEG,
-                  at(&t, row, "friction.power"), mu * fabs(N * sl1));
+                  table_at(&t, row, "friction.power"), mu * fabs(N * sl1));
         checked++;
     }
     cr_assert_geq(checked, 20);
@@ -365,10 +338,10 @@ static void check_guide_friction(double w)
     mech_solve_options o;
     mech_solve_options_default(&o);
     o.friction = MECH_FRICTION_BOTH;
-    mech_table t = solve_ok(m, &o);
+    mech_table t = must_solve(m, &o);
     int checked = 0;
     for (int row = 0; row < t.nrows; row++) {
-        double q = at(&t, row, "q");
+        double q = table_at(&t, row, "q");
         if (fabs(sin(q)) < 0.25)
             continue;  /* near the dead centres x_B' ~ 0: sign(v) is smoothed there */
         sc_state k = slider_crank_at(r, l, q, w);
@@ -376,22 +349,22 @@ static void check_guide_friction(double w)
         double Gx = -P / (1 - mu * fabs(tanp) * sgn(k.vB)), Gy = Gx * tanp;
         double T = k.Ax * Gy - k.Ay * Gx, T0 = k.Ax * (-P * tanp) - k.Ay * (-P);
         const double fs = 1e-10 * 1000, ts = 1e-10 * 1000 * r;
-        cr_assert(fabs(at(&t, row, "driver.torque.nofriction") - T0) < ts,
+        cr_assert(fabs(table_at(&t, row, "driver.torque.nofriction") - T0) < ts,
                   "w %g q %g deg: torque without friction %.17g, expected %.17g", w, q / DEG,
-                  at(&t, row, "driver.torque.nofriction"), T0);
-        cr_assert(fabs(at(&t, row, "driver.torque") - T) < ts,
+                  table_at(&t, row, "driver.torque.nofriction"), T0);
+        cr_assert(fabs(table_at(&t, row, "driver.torque") - T) < ts,
                   "w %g q %g deg: driver torque %.17g, expected %.17g", w, q / DEG,
-                  at(&t, row, "driver.torque"), T);
-        cr_assert(fabs(at(&t, row, "x_B.N") + Gy) < fs, "w %g q %g deg: N %.17g, expected %.17g",
-                  w, q / DEG, at(&t, row, "x_B.N"), -Gy);
+                  table_at(&t, row, "driver.torque"), T);
+        cr_assert(fabs(table_at(&t, row, "x_B.N") + Gy) < fs, "w %g q %g deg: N %.17g, expected %.17g",
+                  w, q / DEG, table_at(&t, row, "x_B.N"), -Gy);
         /* the rod's force on the piston, at B (the piston is the later link) */
-        cr_assert(fabs(at(&t, row, "B.Fx") - Gx) < fs && fabs(at(&t, row, "B.Fy") - Gy) < fs,
+        cr_assert(fabs(table_at(&t, row, "B.Fx") - Gx) < fs && fabs(table_at(&t, row, "B.Fy") - Gy) < fs,
                   "w %g q %g deg: B (%.17g, %.17g), expected (%.17g, %.17g)", w, q / DEG,
-                  at(&t, row, "B.Fx"), at(&t, row, "B.Fy"), Gx, Gy);
+                  table_at(&t, row, "B.Fx"), table_at(&t, row, "B.Fy"), Gx, Gy);
         double pf = mu * fabs(Gy) * fabs(k.vB);
-        cr_assert(fabs(at(&t, row, "friction.power") - pf) < 1e-10 * 1000 * r * fabs(w),
+        cr_assert(fabs(table_at(&t, row, "friction.power") - pf) < 1e-10 * 1000 * r * fabs(w),
                   "w %g q %g deg: friction power %.17g, expected %.17g", w, q / DEG,
-                  at(&t, row, "friction.power"), pf);
+                  table_at(&t, row, "friction.power"), pf);
         checked++;
     }
     cr_assert_geq(checked, 16);
@@ -437,10 +410,10 @@ static void check_pin_friction(double w)
     mech_solve_options o;
     mech_solve_options_default(&o);
     o.friction = MECH_FRICTION_ON;
-    mech_table t = solve_ok(m, &o);
+    mech_table t = must_solve(m, &o);
     int checked = 0;
     for (int row = 0; row < t.nrows; row++) {
-        double q = at(&t, row, "q");
+        double q = table_at(&t, row, "q");
         if (fabs(cos(q)) < 0.25)
             continue;  /* near 90 and 270 deg phi' ~ 0: sign(phi') is smoothed there */
         sc_state k = slider_crank_at(r, l, q, w);
@@ -455,23 +428,23 @@ static void check_pin_friction(double w)
         double pf = G * (muO * rhoO * fabs(w) + muA * rhoA * fabs(k.phi1 - w) +
                          muB * rhoB * fabs(k.phi1));
         const double fs = 1e-10 * 1000, ts = 1e-10 * 1000 * r;
-        cr_assert(fabs(at(&t, row, "driver.torque") - T) < ts,
+        cr_assert(fabs(table_at(&t, row, "driver.torque") - T) < ts,
                   "w %g q %g deg: driver torque %.17g, expected %.17g", w, q / DEG,
-                  at(&t, row, "driver.torque"), T);
+                  table_at(&t, row, "driver.torque"), T);
         /* every pin carries G: on the crank from the ground (O), on the rod
            from the crank (A), on the piston from the rod (B) */
         static const char *const pins[][2] = {{"O.Fx", "O.Fy"}, {"A.Fx", "A.Fy"}, {"B.Fx", "B.Fy"}};
         for (int p = 0; p < 3; p++)
-            cr_assert(fabs(at(&t, row, pins[p][0]) - Gx) < fs &&
-                          fabs(at(&t, row, pins[p][1]) - Gy) < fs,
+            cr_assert(fabs(table_at(&t, row, pins[p][0]) - Gx) < fs &&
+                          fabs(table_at(&t, row, pins[p][1]) - Gy) < fs,
                       "w %g q %g deg: %s, %s = (%.17g, %.17g), expected (%.17g, %.17g)", w,
-                      q / DEG, pins[p][0], pins[p][1], at(&t, row, pins[p][0]),
-                      at(&t, row, pins[p][1]), Gx, Gy);
-        cr_assert(fabs(at(&t, row, "x_B.M") - MB) < ts, "w %g q %g deg: x_B.M %.17g, expected %.17g",
-                  w, q / DEG, at(&t, row, "x_B.M"), MB);
-        cr_assert(fabs(at(&t, row, "friction.power") - pf) < 1e-10 * 1000 * r * fabs(w),
+                      q / DEG, pins[p][0], pins[p][1], table_at(&t, row, pins[p][0]),
+                      table_at(&t, row, pins[p][1]), Gx, Gy);
+        cr_assert(fabs(table_at(&t, row, "x_B.M") - MB) < ts, "w %g q %g deg: x_B.M %.17g, expected %.17g",
+                  w, q / DEG, table_at(&t, row, "x_B.M"), MB);
+        cr_assert(fabs(table_at(&t, row, "friction.power") - pf) < 1e-10 * 1000 * r * fabs(w),
                   "w %g q %g deg: friction power %.17g, expected %.17g", w, q / DEG,
-                  at(&t, row, "friction.power"), pf);
+                  table_at(&t, row, "friction.power"), pf);
         checked++;
     }
     cr_assert_geq(checked, 16);
@@ -545,12 +518,12 @@ static void check_coarse(const char *path, int twin)
         o.from = q0;
         o.to = q0 + 2 * PI;
         o.steps = 2;
-        mech_table t = solve_ok(m, &o);
+        mech_table t = must_solve(m, &o);
         cr_assert_eq(t.nrows, 3);
         double want[3 * 33];
         for (int r = 0; r < t.nrows; r++) {
             double full[NFOURBAR];
-            fourbar_ref(&g, at(&t, r, "q"), 10, 0, full);
+            fourbar_ref(&g, table_at(&t, r, "q"), 10, 0, full);
             for (int c = 0; c < n; c++)
                 want[r * n + c] = full[ref_col[c]];
         }
