@@ -44,7 +44,7 @@ int cont_init(cont *c, const solver_plan *sp, mech_diag *d, mech_solve_stats *st
         return -1;
     size_t ns = (size_t)sp->ns + 1;
     double **arrays[] = {&c->xc, &c->xqc, &c->xqqc, &c->xqq_prev, &c->xpred,
-                         &c->x0, &c->xq0, &c->xqq0};
+                         &c->x0, &c->xq0, &c->xqq0, &c->xgap};
     for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
         if (!(*arrays[i] = xcalloc(ns, sizeof(double))))
             return -1;
@@ -54,7 +54,7 @@ int cont_init(cont *c, const solver_plan *sp, mech_diag *d, mech_solve_stats *st
 void cont_free(cont *c)
 {
     double *arrays[] = {c->xc, c->xqc, c->xqqc, c->xqq_prev, c->xpred, c->x0,
-                        c->xq0, c->xqq0, c->guess};
+                        c->xq0, c->xqq0, c->guess, c->xgap};
     for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
         free(arrays[i]);
     solver_free(&c->sv);
@@ -260,6 +260,7 @@ int cont_start(cont *c, double q)
             cont_branches_hold(c, &branch);
     }
     if (s != STEP_OK) {
+        c->fail_status = first == STEP_SINGULAR ? STEP_SINGULAR : s;
         diagnose_start(c, q, first, first_resid, first_loop, branch, attempts);
         return MECH_ESOLVE;
     }
@@ -274,6 +275,77 @@ int cont_start(cont *c, double q)
     memcpy(c->xq0, c->xqc, bytes);
     memcpy(c->xqq0, c->xqqc, bytes);
     return MECH_OK;
+}
+
+/* Keep the solved row at q as the base and as row 0's copy. */
+static void set_start(cont *c, double q)
+{
+    solver *sv = &c->sv;
+    note_stats(c, q);
+    c->qc = q;
+    c->det_sign = 0;  /* another interval may have the other sign */
+    accept(c, q);
+    c->have_prev = 0;
+    c->q0 = q;
+    size_t bytes = (size_t)sv->p->ns * sizeof(double);
+    memcpy(c->x0, c->xc, bytes);
+    memcpy(c->xq0, c->xqc, bytes);
+    memcpy(c->xqq0, c->xqqc, bytes);
+}
+
+/* Scattered starting values for every unknown, guessed or not. */
+static void scatter_all(cont *c, unsigned *rng)
+{
+    const solver_plan *sp = c->sv.p;
+    for (int i = 0; i < sp->ns; i++) {
+        double u = (double)(next_random(rng) & 0xffff) / 65536.0 - 0.5;
+        c->sv.x[i] = sp->sys->unk_kind[sp->col[i]] == UNK_ANGLE ? 2.0 * PI * u : 4.0 * sp->lref * u;
+    }
+}
+
+/* Scattered starts tried at each row of a gap. */
+enum { RESTART_ATTEMPTS = 16 };
+
+int cont_restart(cont *c, double q)
+{
+    solver *sv = &c->sv;
+    const solver_plan *sp = sv->p;
+    unsigned rng = 20261125u;
+    int attempts = sp->ns <= 50 ? RESTART_ATTEMPTS : 2;
+    for (int a = 0; a < attempts; a++) {
+        if (a == 0)
+            memcpy(sv->x, c->xgap, (size_t)sp->ns * sizeof *sv->x);
+        else if (a == 1)
+            cont_start_values(c, 0, &rng);
+        else
+            scatter_all(c, &rng);
+        if (cont_try(c, q, 0) != STEP_OK)
+            continue;
+        for (int i = 0; i < sp->ns; i++)  /* angles continuous across the gap */
+            if (sp->sys->unk_kind[sp->col[i]] == UNK_ANGLE)
+                sv->x[i] -= 2.0 * PI * nearbyint((sv->x[i] - c->xgap[i]) / (2.0 * PI));
+        c->searching = 0;
+        set_start(c, q);
+        return MECH_OK;
+    }
+    return MECH_ESOLVE;
+}
+
+double cont_limit_behind(cont *c, double qback, double hmin, int *found)
+{
+    solver *sv = &c->sv;
+    double q = c->q0, limit;
+    int searching = c->searching;
+    c->searching = 1;
+    *found = cont_advance(c, qback, hmin) != STEP_OK;
+    limit = c->qc;
+    c->searching = searching;
+    memcpy(sv->x, c->x0, (size_t)sv->p->ns * sizeof *sv->x);
+    if (cont_try(c, q, 0) != STEP_OK)  /* from its own solution: one iteration */
+        memcpy(sv->x, c->x0, (size_t)sv->p->ns * sizeof *sv->x);
+    cont_set_base(c, q, c->x0, c->xq0, c->xqq0);
+    c->det_sign = solver_det_sign(sv);
+    return limit;
 }
 
 /* Make (q, x, x_q, x_qq) the base of the continuation. */

@@ -194,8 +194,9 @@ void diagnose_singular(cont *c, double q)
     const char *kind = "a dead point, toggle or limit position";
     double *right = xcalloc((size_t)sv->p->ns + 1, sizeof *right);
     double *left = xcalloc((size_t)sv->p->nr + 1, sizeof *left);
+    c->fail_change_point = 0;
     if (right && left && dense_null(sv, right, left) == 0) {
-        if (is_change_point(sv, left))
+        if ((c->fail_change_point = is_change_point(sv, left)))
             kind = "a change point, where two assembly branches cross";
         snprintf(what, sizeof what, ": the unknowns ");
         list_large(sv, right, 0, what, sizeof what);

@@ -233,25 +233,14 @@ static void note_refined(run *r, double q)
               r->c.row_substeps + 1, r->c.sv.rcond);
 }
 
-/* Row `row` at driver position q: reach it, publish it, its forces, fill it. */
-static int solve_row(run *r, const double *q, int row, double *out)
+/* Publish the reached row at q, its forces, fill it: MECH_OK, or the
+ * force analysis's failure (which stops the sweep). */
+static int fill_row(run *r, double q, double *out)
 {
     cont *c = &r->c;
-    c->row_iters = 0;
-    c->row_substeps = 0;
-    if (row == 0) {
-        if (cont_start(c, q[0]) != MECH_OK)
-            return MECH_ESOLVE;
-    } else {
-        double hrow = q[row] - q[row - 1];
-        if (cont_advance(c, q[row], 1e-9 * fmax(fabs(hrow), 1e-12)) != STEP_OK) {
-            diagnose_failure(c, q[row], hrow);
-            return MECH_ESOLVE;
-        }
-    }
-    note_refined(r, q[row]);
-    solver_publish(&c->sv, q[row], c->qd, c->qdd);
-    int rc = r->a->want_forces ? solve_forces(r, q[row]) : MECH_OK;
+    note_refined(r, q);
+    solver_publish(&c->sv, q, c->qd, c->qdd);
+    int rc = r->a->want_forces ? solve_forces(r, q) : MECH_OK;
     if (rc != MECH_OK)
         return rc;
     row_sources rs = {&c->sv, r->a->want_forces ? &r->fc : NULL, c->row_iters, c->row_substeps};
@@ -260,6 +249,117 @@ static int solve_row(run *r, const double *q, int row, double *out)
     if (c->row_iters > r->st->max_iterations)
         r->st->max_iterations = c->row_iters;
     return MECH_OK;
+}
+
+static mech_gap_kind gap_kind(const cont *c, step_status s)
+{
+    switch (s) {
+    case STEP_SINGULAR:
+        return c->fail_change_point ? MECH_GAP_CHANGE_POINT : MECH_GAP_DEAD_POINT;
+    case STEP_BRANCH:
+        return MECH_GAP_BRANCH;
+    case STEP_JUMP:
+        return MECH_GAP_JUMP;
+    default:
+        return MECH_GAP_NO_ASSEMBLY;
+    }
+}
+
+/* The continuation failed before q[row]: the limit it reached, refined to
+ * 1e-12 of the row spacing (the failure kept for the diagnosis), the last
+ * position kept for restarts, and why. */
+static void failed_row(run *r, const double *q, int row, mech_gap *g)
+{
+    cont *c = &r->c;
+    double hrow = q[row] - q[row - 1], fq = c->fail_q, resid = c->fail_resid;
+    step_status s = c->fail_status;
+    int loop = c->fail_loop;
+    cont_advance(c, fq, 1e-12 * fmax(fabs(hrow), 1e-12));
+    c->fail_q = fq;
+    c->fail_status = s;
+    c->fail_resid = resid;
+    c->fail_loop = loop;
+    g->from = c->qc;
+    g->from_limit = 1;
+    memcpy(c->xgap, c->xc, (size_t)c->sv.p->ns * sizeof *c->xgap);
+    diagnose_failure(c, q[row], hrow);
+    g->kind = gap_kind(c, s);
+}
+
+/* Row `row`: reach it (row 0 from the guesses, after a gap by a restart,
+ * else by continuation) and fill it. MECH_ESOLVE when it cannot be reached
+ * (*g then describes the gap it opens or extends), else fill_row's status. */
+static int solve_row(run *r, const double *q, int row, double *out, mech_gap *g, int in_gap)
+{
+    cont *c = &r->c;
+    c->row_iters = 0;
+    c->row_substeps = 0;
+    if (in_gap) {
+        if (cont_restart(c, q[row]) != MECH_OK)
+            return MECH_ESOLVE;
+        int found = 0;
+        g->to = row > 0 ? cont_limit_behind(c, q[row - 1], 1e-12 * fmax(fabs(q[row] - q[row - 1]),
+                                                                            1e-12), &found)
+                        : q[row];
+        g->to_limit = found;
+        c->row_substeps = 0;  /* the search for the limit is not the row's refinement */
+    } else if (row == 0) {
+        if (cont_start(c, q[0]) != MECH_OK) {
+            unsigned rng = 0;
+            cont_start_values(c, 0, &rng);
+            memcpy(c->xgap, c->sv.x, (size_t)c->sv.p->ns * sizeof *c->xgap);
+            *g = (mech_gap){gap_kind(c, c->fail_status), 0, 0, q[0], q[0], 0, 0};
+            return MECH_ESOLVE;
+        }
+    } else if (cont_advance(c, q[row], 1e-9 * fmax(fabs(q[row] - q[row - 1]), 1e-12)) !=
+               STEP_OK) {
+        failed_row(r, q, row, g);
+        g->first_row = g->last_row = row;
+        return MECH_ESOLVE;
+    }
+    return fill_row(r, q[row], out);
+}
+
+/* Append *g to the table's gaps (allocated only when a gap closes). */
+static int add_gap(mech_table *t, const mech_gap *g)
+{
+    mech_gap *more = realloc(t->gaps, (size_t)(t->ngaps + 1) * sizeof *more);
+    if (!more)
+        return -1;
+    t->gaps = more;
+    t->gaps[t->ngaps++] = *g;
+    return 0;
+}
+
+/* Every requested row that can be reached; the others as gaps. */
+static int sweep_rows(run *r, const double *q, int nq, mech_table *out)
+{
+    int status = MECH_OK, in_gap = 0;
+    mech_gap g = {0};
+    for (int row = 0; row < nq; row++) {
+        double *dst = out->values + (size_t)out->nrows * (size_t)out->ncolumns;
+        int rc = solve_row(r, q, row, dst, &g, in_gap);
+        if (rc == MECH_OK) {
+            if (in_gap && add_gap(out, &g) != 0)
+                return no_memory(r->a->m, r->d);
+            in_gap = 0;
+            out->nrows++;
+            continue;
+        }
+        if (rc != MECH_ESOLVE || r->c.sv.p->ns == 0)
+            return rc;
+        status = MECH_ESOLVE;
+        if (in_gap)
+            g.last_row = row;
+        in_gap = 1;
+    }
+    if (in_gap) {
+        g.to = q[nq - 1];
+        g.to_limit = 0;
+        if (add_gap(out, &g) != 0)
+            return no_memory(r->a->m, r->d);
+    }
+    return status;
 }
 
 static void finish_stats(run *r, int rows, double t0)
@@ -306,13 +406,10 @@ int mech_analysis_solve(const mech_analysis *a, const double *q, int nq, mech_ta
     if (rc == MECH_OK && columns_make_table(&a->cols, out, nq) != MECH_OK)
         rc = no_memory(a->m, d);
     double t0 = now_seconds();
-    int row = 0;
-    for (; rc == MECH_OK && row < nq; row++)
-        if ((rc = solve_row(&r, q, row, out->values + (size_t)row * (size_t)out->ncolumns)) !=
-            MECH_OK)
-            break;
-    out->nrows = row;
-    finish_stats(&r, row, t0);
+    out->nrequested = nq;
+    if (rc == MECH_OK)
+        rc = sweep_rows(&r, q, nq, out);
+    finish_stats(&r, out->nrows, t0);
     forces_free(&r.fc);
     cont_free(&r.c);
     return rc;
