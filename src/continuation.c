@@ -333,19 +333,26 @@ int cont_restart(cont *c, double q)
 
 double cont_limit_behind(cont *c, double qback, double hmin, int *found)
 {
-    solver *sv = &c->sv;
-    double q = c->q0, limit;
     int searching = c->searching;
     c->searching = 1;
     *found = cont_advance(c, qback, hmin) != STEP_OK;
-    limit = c->qc;
     c->searching = searching;
-    memcpy(sv->x, c->x0, (size_t)sv->p->ns * sizeof *sv->x);
-    if (cont_try(c, q, 0) != STEP_OK)  /* from its own solution: one iteration */
+    return c->qc;
+}
+
+step_status cont_solve_at(cont *c, double q, const double *x)
+{
+    memcpy(c->sv.x, x, (size_t)c->sv.p->ns * sizeof *c->sv.x);
+    return cont_try(c, q, 0);
+}
+
+void cont_back_to_start(cont *c)
+{
+    solver *sv = &c->sv;
+    if (cont_solve_at(c, c->q0, c->x0) != STEP_OK)  /* from its own solution: one iteration */
         memcpy(sv->x, c->x0, (size_t)sv->p->ns * sizeof *sv->x);
-    cont_set_base(c, q, c->x0, c->xq0, c->xqq0);
+    cont_set_base(c, c->q0, c->x0, c->xq0, c->xqq0);
     c->det_sign = solver_det_sign(sv);
-    return limit;
 }
 
 /* Make (q, x, x_q, x_qq) the base of the continuation. */

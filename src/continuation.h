@@ -55,10 +55,14 @@ int cont_start(cont *c, double q);
  * success (MECH_OK) the row is solved and becomes the base and row 0's copy
  * (for later diagnoses); angles are taken nearest to those before the gap. */
 int cont_restart(cont *c, double q);
-/* From the base (just set by cont_restart at q) back toward qback: the limit
- * of assembly between them, to within hmin (*found: the march failed before
- * qback); then the row at q is solved again, as the base. */
+/* From the base (just set by cont_restart) back toward qback: the limit of
+ * assembly between them, to within hmin (*found: the march failed before
+ * qback); the base is left there. */
 double cont_limit_behind(cont *c, double qback, double hmin, int *found);
+/* Newton at q from x, with the checks of a first position (cont_try). */
+step_status cont_solve_at(cont *c, double q, const double *x);
+/* The row kept by cont_restart solved again and made the base. */
+void cont_back_to_start(cont *c);
 /* From the base to q by continuation, halving rejected steps down to hmin. */
 step_status cont_advance(cont *c, double q, double hmin);
 /* Make (q, x, x_q, x_qq) the base of the continuation. */

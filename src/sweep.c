@@ -190,6 +190,7 @@ typedef struct run {
     forces fc;
     mech_diag *d;
     mech_solve_stats *st;
+    mech_table *t;             /* rows are appended here */
     int refined_notes;         /* refinements reported so far */
 } run;
 
@@ -233,22 +234,38 @@ static void note_refined(run *r, double q)
               r->c.row_substeps + 1, r->c.sv.rcond);
 }
 
-/* Publish the reached row at q, its forces, fill it: MECH_OK, or the
- * force analysis's failure (which stops the sweep). */
-static int fill_row(run *r, double q, double *out)
+/* fill_row's status when the force analysis fails: the sweep stops there. */
+enum { ROW_STOP = 1 };
+
+/* Publish the reached row at q, its forces, append it to the table:
+ * MECH_OK, or ROW_STOP (the force analysis failed, reported). */
+static int fill_row(run *r, double q)
 {
     cont *c = &r->c;
+    double *out = r->t->values + (size_t)r->t->nrows * (size_t)r->t->ncolumns;
     note_refined(r, q);
     solver_publish(&c->sv, q, c->qd, c->qdd);
-    int rc = r->a->want_forces ? solve_forces(r, q) : MECH_OK;
-    if (rc != MECH_OK)
-        return rc;
+    if (r->a->want_forces && solve_forces(r, q) != MECH_OK)
+        return ROW_STOP;
     row_sources rs = {&c->sv, r->a->want_forces ? &r->fc : NULL, c->row_iters, c->row_substeps};
     columns_fill(&r->a->cols, &rs, out);
+    r->t->nrows++;
     r->st->iterations += c->row_iters;
     if (c->row_iters > r->st->max_iterations)
         r->st->max_iterations = c->row_iters;
     return MECH_OK;
+}
+
+/* With opt.limit_rows, a row at the limit q (solution near x) when the
+ * position is not singular there. */
+static int limit_row(run *r, double q, const double *x)
+{
+    cont *c = &r->c;
+    if (!r->a->opt.limit_rows)
+        return MECH_OK;
+    c->row_iters = 0;
+    c->row_substeps = 0;
+    return cont_solve_at(c, q, x) == STEP_OK ? fill_row(r, q) : MECH_OK;
 }
 
 static mech_gap_kind gap_kind(const cont *c, step_status s)
@@ -267,8 +284,8 @@ static mech_gap_kind gap_kind(const cont *c, step_status s)
 
 /* The continuation failed before q[row]: the limit it reached, refined to
  * 1e-12 of the row spacing (the failure kept for the diagnosis), the last
- * position kept for restarts, and why. */
-static void failed_row(run *r, const double *q, int row, mech_gap *g)
+ * position kept for restarts, why, and the row at the limit. */
+static int failed_row(run *r, const double *q, int row, mech_gap *g)
 {
     cont *c = &r->c;
     double hrow = q[row] - q[row - 1], fq = c->fail_q, resid = c->fail_resid;
@@ -279,31 +296,46 @@ static void failed_row(run *r, const double *q, int row, mech_gap *g)
     c->fail_status = s;
     c->fail_resid = resid;
     c->fail_loop = loop;
-    g->from = c->qc;
-    g->from_limit = 1;
+    *g = (mech_gap){MECH_GAP_NO_ASSEMBLY, row, row, c->qc, c->qc, 1, 0};
     memcpy(c->xgap, c->xc, (size_t)c->sv.p->ns * sizeof *c->xgap);
     diagnose_failure(c, q[row], hrow);
     g->kind = gap_kind(c, s);
+    return limit_row(r, g->from, c->xgap);
+}
+
+/* After a gap, the row at q[row]: re-assembly, the limit behind it (and its
+ * row), then the row itself. MECH_ESOLVE when it does not assemble. */
+static int restart_row(run *r, const double *q, int row, mech_gap *g)
+{
+    cont *c = &r->c;
+    if (cont_restart(c, q[row]) != MECH_OK)
+        return MECH_ESOLVE;
+    int found = 0, rc = MECH_OK;
+    g->to = q[row];
+    if (row > 0) {
+        double h = 1e-12 * fmax(fabs(q[row] - q[row - 1]), 1e-12);
+        g->to = cont_limit_behind(c, q[row - 1], h, &found);
+        if (found)
+            rc = limit_row(r, g->to, c->xc);
+        cont_back_to_start(c);
+    }
+    g->to_limit = found;
+    c->row_iters = 0;  /* the search is not the row's work */
+    c->row_substeps = 0;
+    return rc != MECH_OK ? rc : fill_row(r, q[row]);
 }
 
 /* Row `row`: reach it (row 0 from the guesses, after a gap by a restart,
- * else by continuation) and fill it. MECH_ESOLVE when it cannot be reached
- * (*g then describes the gap it opens or extends), else fill_row's status. */
-static int solve_row(run *r, const double *q, int row, double *out, mech_gap *g, int in_gap)
+ * else by continuation) and append it. MECH_ESOLVE when it cannot be
+ * reached (*g then describes the gap it opens), else fill_row's status. */
+static int solve_row(run *r, const double *q, int row, mech_gap *g, int in_gap)
 {
     cont *c = &r->c;
     c->row_iters = 0;
     c->row_substeps = 0;
-    if (in_gap) {
-        if (cont_restart(c, q[row]) != MECH_OK)
-            return MECH_ESOLVE;
-        int found = 0;
-        g->to = row > 0 ? cont_limit_behind(c, q[row - 1], 1e-12 * fmax(fabs(q[row] - q[row - 1]),
-                                                                            1e-12), &found)
-                        : q[row];
-        g->to_limit = found;
-        c->row_substeps = 0;  /* the search for the limit is not the row's refinement */
-    } else if (row == 0) {
+    if (in_gap)
+        return restart_row(r, q, row, g);
+    if (row == 0) {
         if (cont_start(c, q[0]) != MECH_OK) {
             unsigned rng = 0;
             cont_start_values(c, 0, &rng);
@@ -313,11 +345,10 @@ static int solve_row(run *r, const double *q, int row, double *out, mech_gap *g,
         }
     } else if (cont_advance(c, q[row], 1e-9 * fmax(fabs(q[row] - q[row - 1]), 1e-12)) !=
                STEP_OK) {
-        failed_row(r, q, row, g);
-        g->first_row = g->last_row = row;
-        return MECH_ESOLVE;
+        int rc = failed_row(r, q, row, g);
+        return rc != MECH_OK ? rc : MECH_ESOLVE;
     }
-    return fill_row(r, q[row], out);
+    return fill_row(r, q[row]);
 }
 
 /* Append *g to the table's gaps (allocated only when a gap closes). */
@@ -331,32 +362,30 @@ static int add_gap(mech_table *t, const mech_gap *g)
     return 0;
 }
 
-/* Every requested row that can be reached; the others as gaps. */
-static int sweep_rows(run *r, const double *q, int nq, mech_table *out)
+/* Every requested row that can be reached; the others as gaps. A failure
+ * of the forces stops the sweep (its status returned). */
+static int sweep_rows(run *r, const double *q, int nq)
 {
     int status = MECH_OK, in_gap = 0;
     mech_gap g = {0};
     for (int row = 0; row < nq; row++) {
-        double *dst = out->values + (size_t)out->nrows * (size_t)out->ncolumns;
-        int rc = solve_row(r, q, row, dst, &g, in_gap);
+        int rc = solve_row(r, q, row, &g, in_gap);
         if (rc == MECH_OK) {
-            if (in_gap && add_gap(out, &g) != 0)
+            if (in_gap && add_gap(r->t, &g) != 0)
                 return no_memory(r->a->m, r->d);
             in_gap = 0;
-            out->nrows++;
             continue;
         }
-        if (rc != MECH_ESOLVE || r->c.sv.p->ns == 0)
-            return rc;
+        if (rc != MECH_ESOLVE)
+            return rc == ROW_STOP ? MECH_ESOLVE : rc;
         status = MECH_ESOLVE;
-        if (in_gap)
-            g.last_row = row;
+        g.last_row = row;
         in_gap = 1;
     }
     if (in_gap) {
         g.to = q[nq - 1];
         g.to_limit = 0;
-        if (add_gap(out, &g) != 0)
+        if (add_gap(r->t, &g) != 0)
             return no_memory(r->a->m, r->d);
     }
     return status;
@@ -403,12 +432,15 @@ int mech_analysis_solve(const mech_analysis *a, const double *q, int nq, mech_ta
         nq = a->nvalues;
     }
     int rc = too_large(a, nq, d) ? MECH_EINPUT : run_init(&r, a, d);
-    if (rc == MECH_OK && columns_make_table(&a->cols, out, nq) != MECH_OK)
+    /* with limit rows, at most one more per requested row and one more */
+    int capacity = a->opt.limit_rows ? 2 * nq + 1 : nq;
+    if (rc == MECH_OK && columns_make_table(&a->cols, out, capacity) != MECH_OK)
         rc = no_memory(a->m, d);
     double t0 = now_seconds();
     out->nrequested = nq;
+    r.t = out;
     if (rc == MECH_OK)
-        rc = sweep_rows(&r, q, nq, out);
+        rc = sweep_rows(&r, q, nq);
     finish_stats(&r, out->nrows, t0);
     forces_free(&r.fc);
     cont_free(&r.c);
