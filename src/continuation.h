@@ -32,6 +32,7 @@ typedef struct cont {
     double q0, *x0, *xq0, *xqq0;
     double *guess;             /* [n] the file's guess of each unknown, NAN if none */
     double *xgap;              /* [ns] the last position before a gap (restarts) */
+    double *xqgap, *xqqgap;    /* [ns] its rates */
     int row_iters;             /* Newton iterations spent on the current row */
     int row_substeps;          /* extra continuation steps the row needed (refinement) */
     int det_sign;              /* sign of det J at the base (0: unknown) */

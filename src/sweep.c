@@ -282,24 +282,26 @@ static mech_gap_kind gap_kind(const cont *c, step_status s)
     }
 }
 
-/* The continuation failed before q[row]: the limit it reached, refined to
- * 1e-12 of the row spacing (the failure kept for the diagnosis), the last
- * position kept for restarts, why, and the row at the limit. */
+/* The continuation failed before q[row]: why (diagnosed from the state of
+ * the failure), then the limit it reached refined to 1e-12 of the row
+ * spacing from the position kept before the diagnosis, kept for restarts,
+ * and its row. */
 static int failed_row(run *r, const double *q, int row, mech_gap *g)
 {
     cont *c = &r->c;
-    double hrow = q[row] - q[row - 1], fq = c->fail_q, resid = c->fail_resid;
+    size_t bytes = (size_t)c->sv.p->ns * sizeof(double);
+    double hrow = q[row] - q[row - 1], fq = c->fail_q, qbase = c->qc;
     step_status s = c->fail_status;
-    int loop = c->fail_loop;
-    cont_advance(c, fq, 1e-12 * fmax(fabs(hrow), 1e-12));
-    c->fail_q = fq;
-    c->fail_status = s;
-    c->fail_resid = resid;
-    c->fail_loop = loop;
-    *g = (mech_gap){MECH_GAP_NO_ASSEMBLY, row, row, c->qc, c->qc, 1, 0};
-    memcpy(c->xgap, c->xc, (size_t)c->sv.p->ns * sizeof *c->xgap);
+    memcpy(c->xgap, c->xc, bytes);
+    memcpy(c->xqgap, c->xqc, bytes);
+    memcpy(c->xqqgap, c->xqqc, bytes);
     diagnose_failure(c, q[row], hrow);
-    g->kind = gap_kind(c, s);
+    *g = (mech_gap){gap_kind(c, s), row, row, qbase, qbase, 1, 0};
+    cont_set_base(c, qbase, c->xgap, c->xqgap, c->xqqgap);
+    c->searching = 1;
+    cont_advance(c, fq, 1e-12 * fmax(fabs(hrow), 1e-12));
+    g->from = c->qc;
+    memcpy(c->xgap, c->xc, bytes);
     return limit_row(r, g->from, c->xgap);
 }
 

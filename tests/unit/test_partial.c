@@ -1,0 +1,296 @@
+/* tests/unit/test_partial.c: partial sweeps (issue 17, item 1): every
+ * requested row where the mechanism assembles on its branch is solved, the
+ * missing ones are listed as gaps with their limits and kind.
+ *
+ * Truths are independent of the library: which rows exist follows from
+ * |CA| between |b - c| and b + c (law of cosines), the limits from
+ * cos q = (a^2 + d^2 - L^2) / (2 a d), the rows against the closed-form
+ * four-bar and slider-crank of closed_forms.h. Run from the repository root.
+ * Set MECH_HARD_VERBOSE=1 to print the measured numbers. */
+#include <criterion/criterion.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mech.h"
+#include "helpers.h"
+
+#define PI 3.14159265358979323846
+#define TWO_PI (2.0 * PI)
+#define DEG (PI / 180.0)
+
+#include "closed_forms.h"
+
+static void note(const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    note_tagged("partial", fmt, ap);
+    va_end(ap);
+}
+
+static double get(const mech_table *t, int row, const char *name)
+{
+    int c = mech_table_column(t, name);
+    cr_assert_geq(c, 0, "no column '%s'", name);
+    return mech_table_get(t, row, c);
+}
+
+/* Solve `path` over from..to (SI) in `steps` intervals; rc expected. */
+static mech_table sweep(const char *path, double from, double to, int steps, int limit_rows,
+                        int want_rc, mech_diag *d)
+{
+    mech_model *m = load_path(path);
+    mech_solve_options o;
+    mech_solve_options_default(&o);
+    o.has_range = 1, o.from = from, o.to = to, o.steps = steps;
+    o.limit_rows = limit_rows;
+    mech_table t = {0};
+    int rc = mech_solve(m, &o, &t, NULL, d);
+    cr_assert_eq(rc, want_rc, "%s: rc %d, expected %d: %s", path, rc, want_rc,
+                 d->count ? d->entries[0].message : "(no message)");
+    mech_model_free(&m);
+    return t;
+}
+
+/* Worst error of every four-bar column against the closed form, relative
+ * to the largest value of its kind (angles: absolute, rad); rows with
+ * |q - skip| < skip_width are left out (near a limit). */
+static double fourbar_worst(const mech_table *t, const fourbar *g, double skip, double width)
+{
+    double worst = 0.0, scale[6] = {0};
+    double v[NFOURBAR];
+    for (int pass = 0; pass < 2; pass++)
+        for (int i = 0; i < t->nrows; i++) {
+            double q = get(t, i, "q");
+            if (fabs(remainder(q - skip, TWO_PI)) < width || fabs(remainder(q + skip, TWO_PI)) < width)
+                continue;
+            fourbar_ref(g, q, 1, 0, v);
+            for (int j = 0; j < NFOURBAR; j++) {
+                int k = column_kind(FOURBAR_COLS[j]);
+                if (pass == 0) {
+                    scale[k] = k == 3 ? 1.0 : fmax(scale[k], fabs(v[j]));
+                    continue;
+                }
+                double e = get(t, i, FOURBAR_COLS[j]) - v[j];
+                if (k == 3)
+                    e = remainder(e, TWO_PI);
+                worst = fmax(worst, fabs(e) / scale[k]);
+            }
+        }
+    return worst;
+}
+
+/* The crank angle (deg, in [0, 180]) where |CA| = L. */
+static double crank_at(const fourbar *g, double L)
+{
+    return acos((g->a * g->a + g->d * g->d - L * L) / (2 * g->a * g->d)) / DEG;
+}
+
+/* Does the four-bar assemble at crank angle q (|b - c| <= |CA| <= b + c)? */
+static int assembles(const fourbar *g, double q)
+{
+    double L = sqrt(g->a * g->a + g->d * g->d - 2 * g->a * g->d * cos(q));
+    return L <= g->b + g->c && L >= fabs(g->b - g->c);
+}
+
+/* Every requested row that assembles is in the table, in order, and no
+ * other; margin: rows within it of a limit are not counted either way. */
+static void check_rows_exist(const mech_table *t, const fourbar *g, double from, double to,
+                             int steps, double margin)
+{
+    int row = 0, expected = 0;
+    for (int i = 0; i <= steps; i++) {
+        double q = i == steps ? to : from + (to - from) * i / steps;
+        int in = assembles(g, q);
+        int near = assembles(g, q - margin) != in || assembles(g, q + margin) != in;
+        int have = row < t->nrows && fabs(get(t, row, "q") - q) <= 1e-12;
+        cr_assert(have == in || near, "row at %.6f deg: %s", q / DEG,
+                  in ? "assembles but was not solved" : "solved but does not assemble");
+        row += have;
+        expected += in;
+    }
+    cr_assert_eq(row, t->nrows, "%d table rows are not requested positions", t->nrows - row);
+    note("%d rows solved of %d that exist (%d requested)", t->nrows, expected, steps + 1);
+}
+
+static const fourbar NON_GRASHOF = {.a = 0.045, .b = 0.040, .c = 0.055, .d = 0.070,
+                                    .px = 0.020, .py = 0.010, .sign = +1};
+
+/* A non-Grashof crank over a full turn: rows inside both limits
+ * (0..109 and 251..360 deg), none outside; one gap whose limits are the
+ * closed form's +-109.4712206 deg to 1e-9 deg. */
+Test(partial, non_grashof_full_turn)
+{
+    mech_diag d;
+    mech_diag_init(&d);
+    mech_table t = sweep("tests/hard/non-grashof-crank.yaml", 0, TWO_PI, 360, 0, MECH_ESOLVE, &d);
+    check_rows_exist(&t, &NON_GRASHOF, 0, TWO_PI, 360, 0);
+    cr_assert_eq(t.nrows, 220);
+    double lim = crank_at(&NON_GRASHOF, NON_GRASHOF.b + NON_GRASHOF.c);
+    cr_assert_eq(t.ngaps, 1);
+    const mech_gap *g = &t.gaps[0];
+    cr_assert_eq(g->kind, MECH_GAP_NO_ASSEMBLY);
+    cr_assert(g->first_row == 110 && g->last_row == 250, "rows %d..%d", g->first_row, g->last_row);
+    cr_assert(g->from_limit && g->to_limit);
+    note("limits %.12f, %.12f deg; closed form +-%.12f: off %.2g, %.2g deg", g->from / DEG,
+         g->to / DEG, lim, g->from / DEG - lim, g->to / DEG - (360 - lim));
+    /* issue 17 asks for 1e-9 deg; the refinement to 1e-12 of the row spacing
+     * gives 1.2e-10 (without it 5.4e-10) */
+    cr_assert(fabs(g->from / DEG - lim) <= 3e-10, "limit %.12f deg, closed form %.12f",
+              g->from / DEG, lim);
+    cr_assert(fabs(g->to / DEG - (360 - lim)) <= 3e-10, "limit %.12f deg, closed form %.12f",
+              g->to / DEG, 360 - lim);
+    double err = fourbar_worst(&t, &NON_GRASHOF, 0, 0);
+    note("non-Grashof full turn: worst error %.2g", err);
+    cr_assert(err <= 1e-10, "rows off the closed form by %.3g", err);
+    mech_table_free(&t);
+    mech_diag_free(&d);
+}
+
+/* With limit rows: two more rows, at the limits, positions on the closed
+ * form (the rates there are those of a toggle: not compared). */
+Test(partial, non_grashof_limit_rows)
+{
+    mech_diag d;
+    mech_diag_init(&d);
+    mech_table t = sweep("tests/hard/non-grashof-crank.yaml", 0, TWO_PI, 360, 1, MECH_ESOLVE, &d);
+    cr_assert_eq(t.nrows, 222);
+    double lim = crank_at(&NON_GRASHOF, NON_GRASHOF.b + NON_GRASHOF.c) * DEG;
+    cr_assert(fabs(get(&t, 110, "q") - lim) <= 1e-9 * DEG);
+    cr_assert(fabs(get(&t, 111, "q") - (TWO_PI - lim)) <= 1e-9 * DEG);
+    double v[NFOURBAR], worst = 0;
+    for (int i = 110; i <= 111; i++) {
+        fourbar_ref(&NON_GRASHOF, get(&t, i, "q"), 1, 0, v);
+        for (int j = 0; j < NFOURBAR; j++)
+            if (column_kind(FOURBAR_COLS[j]) == 0)
+                worst = fmax(worst, fabs(get(&t, i, FOURBAR_COLS[j]) - v[j]) / 0.1);
+    }
+    note("limit rows: positions off the closed form by %.2g (relative to 0.1 m)", worst);
+    cr_assert(worst <= 1e-6, "limit rows off the closed form by %.3g", worst);
+    mech_table_free(&t);
+    mech_diag_free(&d);
+}
+
+static const fourbar TWO_INTERVALS = {.a = 0.040, .b = 0.060, .c = 0.020, .d = 0.050,
+                                      .px = 0.030, .py = 0.010, .sign = +1};
+
+/* Two intervals, [51.3178, 125.0996] deg and [234.9004, 308.6822] deg, swept
+ * 0..360: rows in both, two gaps' inner limits and the range ends. */
+Test(partial, two_intervals_both_solved)
+{
+    mech_diag d;
+    mech_diag_init(&d);
+    mech_table t = sweep("tests/hard/non-grashof-two-intervals.yaml", 0, TWO_PI, 360, 0,
+                         MECH_ESOLVE, &d);
+    check_rows_exist(&t, &TWO_INTERVALS, 0, TWO_PI, 360, 0);
+    double q1 = crank_at(&TWO_INTERVALS, TWO_INTERVALS.b - TWO_INTERVALS.c),
+           q2 = crank_at(&TWO_INTERVALS, TWO_INTERVALS.b + TWO_INTERVALS.c);
+    cr_assert_eq(t.ngaps, 3, "%d gaps", t.ngaps);
+    /* [0, 51.3178) before, (125.0996, 234.9004) between, (308.6822, 360] after */
+    double want[4] = {q1, q2, 360 - q2, 360 - q1};
+    double got[4] = {t.gaps[0].to, t.gaps[1].from, t.gaps[1].to, t.gaps[2].from};
+    cr_assert(!t.gaps[0].from_limit && t.gaps[0].to_limit && t.gaps[1].from_limit &&
+              t.gaps[1].to_limit && t.gaps[2].from_limit && !t.gaps[2].to_limit);
+    for (int k = 0; k < 4; k++) {
+        note("limit %d: %.12f deg, closed form %.12f", k, got[k] / DEG, want[k]);
+        cr_assert(fabs(got[k] / DEG - want[k]) <= 3e-10, "limit %.12f deg, closed form %.12f",
+                  got[k] / DEG, want[k]);
+    }
+    double err = fourbar_worst(&t, &TWO_INTERVALS, 0, 0);
+    note("two intervals: worst error %.2g", err);
+    cr_assert(err <= 1e-10, "rows off the closed form by %.3g", err);
+    mech_table_free(&t);
+    mech_diag_free(&d);
+}
+
+static const double DC_R = 0.030, DC_L = 0.100;
+
+/* Slider-driven rows: crank angle by the law of cosines (upper branch),
+ * crank speed from dx/dtheta = -r sin - r^2 sin cos / sqrt(l^2 - r^2 sin^2). */
+static double dead_centre_worst(const mech_table *t)
+{
+    double worst = 0;
+    for (int i = 0; i < t->nrows; i++) {
+        double x = get(t, i, "q");
+        double th = acos((DC_R * DC_R + x * x - DC_L * DC_L) / (2 * DC_R * x));
+        double s = sin(th), c = cos(th);
+        double dx = -DC_R * s - DC_R * DC_R * s * c / sqrt(DC_L * DC_L - DC_R * DC_R * s * s);
+        double w = 1.0 / dx;  /* 1 m/s */
+        worst = fmax(worst, fabs(remainder(get(t, i, "crank.angle") - th, TWO_PI)));
+        double v[NSLIDER];  /* the crank-driven closed form at that angle: A, B */
+        const slidercrank g = {.r = DC_R, .l = DC_L, .e = 0};
+        slider_ref(&g, th, 1, 0, v);
+        static const int pos[] = {0, 1, 6, 7};
+        for (int j = 0; j < 4; j++)
+            worst = fmax(worst, fabs(get(t, i, SLIDER_COLS[pos[j]]) - v[pos[j]]) / DC_L);
+        worst = fmax(worst, fabs(get(t, i, "crank.omega") - w) / fabs(w) * 1e-2);
+    }
+    return worst;
+}
+
+/* The piston drives 100 -> 140 mm: rows 100..129 mm, then a gap from the
+ * dead centre (130 mm, crank and rod in line) to the end of the range. */
+Test(partial, slider_to_and_past_dead_centre)
+{
+    mech_diag d;
+    mech_diag_init(&d);
+    mech_table t = sweep("tests/hard/dead-centre-slider.yaml", 0.100, 0.140, 40, 0, MECH_ESOLVE, &d);
+    cr_assert_eq(t.nrows, 30, "%d rows (100..129 mm expected)", t.nrows);
+    cr_assert_eq(t.ngaps, 1);
+    const mech_gap *g = &t.gaps[0];
+    cr_assert_eq(g->kind, MECH_GAP_DEAD_POINT);
+    cr_assert(g->first_row == 30 && g->last_row == 40);
+    note("dead centre found at %.12f mm (130 exactly)", g->from * 1e3);
+    /* 4.6e-14 m (without the refinement to 1e-12 of the row spacing: 9.3e-13) */
+    cr_assert(g->from_limit && fabs(g->from - (DC_R + DC_L)) <= 2e-13, "limit %.15g m", g->from);
+    double err = dead_centre_worst(&t);
+    note("slider to dead centre: worst error %.2g", err);
+    cr_assert(err <= 1e-10, "rows off the law of cosines by %.3g", err);
+    mech_table_free(&t);
+    mech_diag_free(&d);
+}
+
+/* From past the dead centre back: 140 -> 100 mm. The first rows do not
+ * assemble (a gap from the range's start), then every row from 129 mm. */
+Test(partial, slider_from_past_dead_centre)
+{
+    mech_diag d;
+    mech_diag_init(&d);
+    mech_table t = sweep("tests/hard/dead-centre-slider.yaml", 0.140, 0.100, 40, 0, MECH_ESOLVE, &d);
+    cr_assert_eq(t.nrows, 30, "%d rows (129..100 mm expected)", t.nrows);
+    cr_assert_eq(t.ngaps, 1);
+    const mech_gap *g = &t.gaps[0];
+    cr_assert(g->first_row == 0 && g->last_row == 10, "rows %d..%d", g->first_row, g->last_row);
+    cr_assert(!g->from_limit && g->to_limit);
+    note("dead centre found at %.12f mm from the far side", g->to * 1e3);
+    cr_assert(fabs(g->to - (DC_R + DC_L)) <= 2e-13, "limit %.15g m", g->to);
+    double err = dead_centre_worst(&t);
+    cr_assert(err <= 1e-10, "rows off the law of cosines by %.3g", err);
+    mech_table_free(&t);
+    mech_diag_free(&d);
+}
+
+static const fourbar CHANGE = {.a = 0.030, .b = 0.060, .c = 0.050, .d = 0.080,
+                               .px = 0.040, .py = 0.015, .sign = +1};
+
+/* A change point with the branch declared at every position: every row but
+ * the crossing (180 deg), all on the declared assembly. */
+Test(partial, change_point_declared_branch_all_other_rows)
+{
+    mech_diag d;
+    mech_diag_init(&d);
+    mech_table t = sweep("tests/hard/change-point.yaml", 0, TWO_PI, 360, 0, MECH_ESOLVE, &d);
+    cr_assert_eq(t.nrows, 360);
+    cr_assert_eq(t.ngaps, 1);
+    cr_assert_eq(t.gaps[0].kind, MECH_GAP_CHANGE_POINT);
+    cr_assert(t.gaps[0].first_row == 180 && t.gaps[0].last_row == 180);
+    double err = fourbar_worst(&t, &CHANGE, PI, 10 * DEG);
+    note("change point, declared branch: %d rows, worst error away from 180 deg %.2g", t.nrows,
+         err);
+    cr_assert(err <= 1e-10, "rows off the declared branch's closed form by %.3g", err);
+    mech_table_free(&t);
+    mech_diag_free(&d);
+}
