@@ -599,6 +599,7 @@ step_status solver_newton(solver *sv, double q)
        those of x before it: less than tol/100 away, which moves the rates
        by about that relative to the condition (docs/solver.md, section 2). */
     double xtol = 1e-2 * sp->opt.tol;
+    int polish = 0;
     for (int it = 0;; it++) {
         if (!isfinite(r))
             return STEP_NO_ASSEMBLY;
@@ -613,6 +614,18 @@ step_status solver_newton(solver *sv, double q)
         /* converged: residual small, and the step too, or no longer shrinking
            (the rounding floor of an ill-conditioned position) */
         if (r <= sp->ftol && (step <= xtol || step >= 0.9 * prev_step)) {
+            /* least squares: the rates' solve amplifies what the last
+               correction leaves in the factors (the augmented matrix's
+               condition is about J's squared), so correct and refactor until
+               the correction is at rounding (at most 3 more iterations) */
+            if (sp->aug && step <= xtol && step > 16 * DBL_EPSILON && polish++ < 3) {
+                for (int i = 0; i < ns; i++)
+                    sv->x[i] -= sv->dx[i];
+                r = evaluate(sv, sv->x, q, sv->f);
+                prev_step = step;
+                sv->iters = it + 1;
+                continue;
+            }
             sv->resid = r;
             sv->iters = it;
             if (step <= xtol)  /* a real (not noise) correction: take it */

@@ -294,3 +294,83 @@ Test(partial, change_point_declared_branch_all_other_rows)
     mech_table_free(&t);
     mech_diag_free(&d);
 }
+
+/* ---- redundant constraints: rates to rounding from a rough guess -------- */
+
+/* The redundant parallelogram of tests/hard/redundant-parallelogram.yaml
+ * from `initial`: every crank at the driver's angle q, the coupler
+ * translating (angle 0). Exact: angles q, 0; omegas 1, 0; alphas 0 (1 rad/s);
+ * F = E + 40 mm (cos q, sin q). Worst errors: [0] positions (angles in rad,
+ * lengths relative to 100 mm), [1] velocities (relative to 1 rad/s and
+ * 40 mm/s), [2] accelerations (relative to 40 mm/s^2; alphas to 1 rad/s^2). */
+static void redundant_errors(const char *initial, double err[3])
+{
+    char text[2048];
+    snprintf(text, sizeof text,
+             "name: redundant parallelogram\n"
+             "units: {length: mm, angle: deg}\n"
+             "ground: {O: [0, 0], E: [50, 0], C: [100, 0]}\n"
+             "links:\n"
+             "  crank:   {points: {O: [0, 0], A: [40, 0]}}\n"
+             "  coupler: {points: {A: [0, 0], B: [100, 0], F: [50, 0]}}\n"
+             "  rocker:  {points: {C: [0, 0], B: [40, 0]}}\n"
+             "  extra:   {points: {E: [0, 0], F: [40, 0]}}\n"
+             "driver: {link: crank, angle: {from: 30, to: 150, steps: 120}, speed: 1 rad/s}\n"
+             "initial: %s\n"
+             "outputs: {points: [F], links: [coupler, rocker, extra]}\n", initial);
+    mech_model *m = load_text(text);
+    mech_solve_options o;
+    mech_solve_options_default(&o);
+    mech_diag d;
+    mech_diag_init(&d);
+    mech_table t = {0};
+    int rc = mech_solve(m, &o, &t, NULL, &d);
+    cr_assert_eq(rc, MECH_OK, "rc %d", rc);
+    cr_assert_eq(t.nrows, 121);
+    memset(err, 0, 3 * sizeof *err);
+    for (int i = 0; i < t.nrows; i++) {
+        double q = get(&t, i, "q");
+        double p[] = {remainder(get(&t, i, "coupler.angle"), TWO_PI),
+                      remainder(get(&t, i, "rocker.angle") - q, TWO_PI),
+                      remainder(get(&t, i, "extra.angle") - q, TWO_PI),
+                      (get(&t, i, "F.x") - (0.050 + 0.040 * cos(q))) / 0.1,
+                      (get(&t, i, "F.y") - 0.040 * sin(q)) / 0.1};
+        double v[] = {get(&t, i, "coupler.omega"), get(&t, i, "rocker.omega") - 1,
+                      get(&t, i, "extra.omega") - 1,
+                      (get(&t, i, "F.vx") + 0.040 * sin(q)) / 0.04,
+                      (get(&t, i, "F.vy") - 0.040 * cos(q)) / 0.04};
+        double a[] = {get(&t, i, "coupler.alpha"), get(&t, i, "rocker.alpha"),
+                      get(&t, i, "extra.alpha"), (get(&t, i, "F.ax") + 0.040 * cos(q)) / 0.04,
+                      (get(&t, i, "F.ay") + 0.040 * sin(q)) / 0.04};
+        for (int k = 0; k < 5; k++) {
+            err[0] = fmax(err[0], fabs(p[k]));
+            err[1] = fmax(err[1], fabs(v[k]));
+            err[2] = fmax(err[2], fabs(a[k]));
+        }
+    }
+    mech_table_free(&t);
+    mech_diag_free(&d);
+    mech_model_free(&m);
+}
+
+/* Issue 17, item 3: positions, velocities, accelerations to 1e-13, 1e-12,
+ * 1e-12 whatever the guess (before: 3.4e-10 and 7.9e-8 on the first rows
+ * from a rough guess). */
+Test(partial, redundant_rates_to_rounding_from_rough_guess)
+{
+    static const char *const guesses[] = {"{coupler: 2, rocker: 32, extra: 28}",
+                                          "{coupler: 10, rocker: 45, extra: 15}",
+                                          "{coupler: -15, rocker: 10, extra: 60}",
+                                          "{coupler: 0, rocker: 30, extra: 30}",
+                                          "{coupler: 20, rocker: 20, extra: 20}",
+                                          "{coupler: 25, rocker: 10, extra: 0}"};
+    for (int g = 0; g < 6; g++) {
+        double err[3];
+        redundant_errors(guesses[g], err);
+        note("redundant parallelogram from %s: positions %.2g, velocities %.2g, "
+             "accelerations %.2g", guesses[g], err[0], err[1], err[2]);
+        cr_assert(err[0] <= 1e-13 && err[1] <= 1e-12 && err[2] <= 1e-12,
+                  "from %s: positions %.3g, velocities %.3g, accelerations %.3g", guesses[g],
+                  err[0], err[1], err[2]);
+    }
+}
