@@ -118,11 +118,25 @@ typedef struct mech_guess {
     mech_mark mark;
 } mech_guess;
 
-/* Assembly branch: the turn A->B->C must be counter-clockwise (sign +1) or
- * clockwise (sign -1); points are name ids. */
+/* What an assembly branch condition compares (docs/format.md 8.2). */
+typedef enum {
+    MECH_BRANCH_TURN,   /* the turn point[0] -> point[1] -> point[2]: ccw (+1) or cw (-1) */
+    MECH_BRANCH_X,      /* x of point[0] - x of point[1]: right of (+1) or left of (-1) */
+    MECH_BRANCH_Y,      /* y of point[0] - y of point[1]: above (+1) or below (-1) */
+    MECH_BRANCH_SLIDER  /* the displacement of slider joint `slider`: positive (+1) or
+                           negative (-1) */
+} mech_branch_kind;
+
+/* Assembly branch condition: the quantity of `kind` has the sign `sign`;
+ * points are name ids (X, Y: point[2] == point[1]; SLIDER: none, -1).
+ * first_only: it selects the assembly at the first position (and at each
+ * re-assembly after a gap); the continuation then follows by continuity. */
 typedef struct mech_branch {
+    mech_branch_kind kind;
     int point[3];
+    int slider;        /* joint index (SLIDER), else -1 */
     int sign;
+    int first_only;
     mech_mark mark;
 } mech_branch;
 

@@ -81,16 +81,30 @@ static void predict(cont *c, double qn)
     memcpy(sv->x, c->xpred, (size_t)sv->p->ns * sizeof *sv->x);
 }
 
-int cont_branches_hold(cont *c, int *which)
+/* The signed quantity of branch condition b at the published position. */
+static double branch_value(cont *c, const mech_branch *b)
+{
+    if (b->kind == MECH_BRANCH_SLIDER) {
+        int var = c->sv.p->tree.slide_var[b->slider];
+        return var >= 0 ? c->sv.pos[var] : 0.0;
+    }
+    double p[3][2];
+    for (int k = 0; k < 3; k++)
+        kin_point(&c->sv.p->tree, &c->sv.ks, b->point[k], p[k], NULL, NULL);
+    if (b->kind == MECH_BRANCH_X)
+        return p[0][0] - p[1][0];
+    if (b->kind == MECH_BRANCH_Y)
+        return p[0][1] - p[1][1];
+    return (p[1][0] - p[0][0]) * (p[2][1] - p[1][1]) - (p[1][1] - p[0][1]) * (p[2][0] - p[1][0]);
+}
+
+int cont_branches_hold(cont *c, int *which, int continuing)
 {
     const mech_model *m = c->m;
     for (int b = 0; b < m->nbranches; b++) {
-        double p[3][2];
-        for (int k = 0; k < 3; k++)
-            kin_point(&c->sv.p->tree, &c->sv.ks, m->branches[b].point[k], p[k], NULL, NULL);
-        double cross = (p[1][0] - p[0][0]) * (p[2][1] - p[1][1]) -
-                       (p[1][1] - p[0][1]) * (p[2][0] - p[1][0]);
-        if (cross * m->branches[b].sign <= 0.0) {
+        if (continuing && m->branches[b].first_only)
+            continue;
+        if (branch_value(c, &m->branches[b]) * m->branches[b].sign <= 0.0) {
             *which = b;
             return 0;
         }
@@ -166,7 +180,7 @@ step_status cont_try(cont *c, double qn, int continuing)
     int b;
     if (c->m->nbranches) {  /* the branch test needs the point positions */
         solver_publish(sv, qn, c->qd, c->qdd);  /* the row's own, unless rejected */
-        if (!cont_branches_hold(c, &b))
+        if (!cont_branches_hold(c, &b, continuing))
             return STEP_BRANCH;
     }
     return STEP_OK;
@@ -257,7 +271,7 @@ int cont_start(cont *c, double q)
         if (s == STEP_OK)
             break;
         if (s == STEP_BRANCH)
-            cont_branches_hold(c, &branch);
+            cont_branches_hold(c, &branch, 0);
     }
     if (s != STEP_OK) {
         c->fail_status = first == STEP_SINGULAR ? STEP_SINGULAR : s;

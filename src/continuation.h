@@ -77,7 +77,8 @@ void cont_start_values(cont *c, int attempt, unsigned *rng);
  * (continuing: against the prediction). */
 step_status cont_try(cont *c, double qn, int continuing);
 /* Every declared branch condition holds at the published position (else
- * *which is the first that does not). */
-int cont_branches_hold(cont *c, int *which);
+ * *which is the first that does not); continuing: not those that hold at
+ * the first position only. */
+int cont_branches_hold(cont *c, int *which, int continuing);
 
 #endif

@@ -266,6 +266,25 @@ void diagnose_redundant(cont *c, double q)
                  diagnose_q_text(c->m, q, qb, sizeof qb), nr, nr - count, count ? list : "(none found)");
 }
 
+const char *diagnose_branch_text(const mech_model *m, const mech_branch *b, char *buf,
+                                 size_t size)
+{
+    const char *const *pn = (const char *const *)m->point_names;
+    if (b->kind == MECH_BRANCH_TURN)
+        snprintf(buf, size, "%s-%s-%s turning %s", pn[b->point[0]], pn[b->point[1]],
+                 pn[b->point[2]], b->sign > 0 ? "counter-clockwise" : "clockwise");
+    else if (b->kind == MECH_BRANCH_X)
+        snprintf(buf, size, "%s %s of %s", pn[b->point[0]], b->sign > 0 ? "right" : "left",
+                 pn[b->point[1]]);
+    else if (b->kind == MECH_BRANCH_Y)
+        snprintf(buf, size, "%s %s %s", pn[b->point[0]], b->sign > 0 ? "above" : "below",
+                 pn[b->point[1]]);
+    else
+        snprintf(buf, size, "slider %s %s", m->joints[b->slider].name,
+                 b->sign > 0 ? "positive" : "negative");
+    return buf;
+}
+
 void diagnose_start(cont *c, double q, step_status first, double resid, int loop, int branch,
                     int attempts)
 {
@@ -273,12 +292,12 @@ void diagnose_start(cont *c, double q, step_status first, double resid, int loop
     char qb[64], lb[256];
     if (branch >= 0) {
         const mech_branch *b = &m->branches[branch];
+        char what[200];
         diag_error(c->d, m->file, b->mark,
-                   "at %s = %s the mechanism assembles, but not with %s-%s-%s turning %s "
+                   "at %s = %s the mechanism assembles, but not with %s "
                    "(from the initial guesses%s); check the guesses or the branch",
                    diagnose_driver_word(m), diagnose_q_text(m, q, qb, sizeof qb),
-                   m->point_names[b->point[0]], m->point_names[b->point[1]],
-                   m->point_names[b->point[2]], b->sign > 0 ? "counter-clockwise" : "clockwise",
+                   diagnose_branch_text(m, b, what, sizeof what),
                    attempts > 1 ? " and other starts" : "");
         return;
     }

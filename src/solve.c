@@ -75,9 +75,14 @@ static void needed_unknowns(solver_plan *sp, unsigned char *need)
         if (var >= 0 && var < sp->n)
             need[var] = 1;
     }
-    for (int b = 0; b < m->nbranches; b++)
-        for (int k = 0; k < 3; k++)
-            kin_need_point(&sp->tree, m->branches[b].point[k], need);
+    for (int b = 0; b < m->nbranches; b++) {
+        const mech_branch *br = &m->branches[b];
+        int var = br->kind == MECH_BRANCH_SLIDER ? sp->tree.slide_var[br->slider] : -1;
+        if (var >= 0 && var < sp->n)
+            need[var] = 1;
+        for (int k = 0; k < 3 && br->kind != MECH_BRANCH_SLIDER; k++)
+            kin_need_point(&sp->tree, br->point[k], need);
+    }
 }
 
 /* Short name of an unknown for messages. */
