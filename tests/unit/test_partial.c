@@ -374,3 +374,185 @@ Test(partial, redundant_rates_to_rounding_from_rough_guess)
                   err[0], err[1], err[2]);
     }
 }
+
+/* ---- branch conditions users can state (issue 17, item 4) -------------- */
+
+/* A crank-rocker (crank 30, coupler 80 with P at (40, 20), rocker 60, ground
+ * 90 mm), ground point G at (70, 0) mm, swept 60..420 deg; no guesses, so
+ * row 0 comes from scattered starts and only `branch` picks the assembly. */
+static const fourbar CR = {.a = 0.030, .b = 0.080, .c = 0.060, .d = 0.090,
+                           .px = 0.040, .py = 0.020, .sign = +1};
+
+static mech_table crank_rocker_with(const char *branch, int want_rc, mech_diag *d)
+{
+    char text[1024];
+    snprintf(text, sizeof text,
+             "name: crank-rocker with a stated branch\n"
+             "units: {length: mm, angle: deg}\n"
+             "ground: {O: [0, 0], C: [90, 0], G: [70, 0]}\n"
+             "links:\n"
+             "  crank:   {points: {O: [0, 0], A: [30, 0]}}\n"
+             "  coupler: {points: {A: [0, 0], B: [80, 0], P: [40, 20]}}\n"
+             "  rocker:  {points: {C: [0, 0], B: [60, 0]}}\n"
+             "driver: {link: crank, angle: {from: 60, to: 420, steps: 360}, speed: 1 rad/s}\n"
+             "branch: [%s]\n"
+             "outputs: {points: [A, B, P], links: [crank, coupler, rocker]}\n", branch);
+    mech_model *m = load_text(text);
+    mech_solve_options o;
+    mech_solve_options_default(&o);
+    mech_table t = {0};
+    int rc = mech_solve(m, &o, &t, NULL, d);
+    cr_assert_eq(rc, want_rc, "branch %s: rc %d: %s", branch, rc,
+                 d->count ? d->entries[0].message : "");
+    mech_model_free(&m);
+    return t;
+}
+
+/* Each new kind of condition selects each assembly: every row on the
+ * closed form of the assembly it names (sign +1: B left of A -> C). */
+Test(partial, branch_kinds_select_each_assembly)
+{
+    static const struct { const char *branch; int sign; } cases[] = {
+        {"{point: B, right_of: G, first_only: true}", +1},  /* B.x at 60 deg: 87.4 mm */
+        {"{point: B, left_of: G, first_only: true}", -1},   /* 50.9 mm */
+        {"{point: B, above: O}", +1},                        /* at every position */
+        {"{point: B, below: C}", -1},
+        {"{points: [A, B, C], turn: cw, first_only: true}", +1},
+        {"{points: [A, B, C], turn: ccw, first_only: true}", -1}};
+    for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
+        mech_diag d;
+        mech_diag_init(&d);
+        mech_table t = crank_rocker_with(cases[k].branch, MECH_OK, &d);
+        fourbar g = CR;
+        g.sign = cases[k].sign;
+        double err = fourbar_worst(&t, &g, 0, 0);
+        note("branch %s: %d rows, worst error against the sign %+d closed form %.2g",
+             cases[k].branch, t.nrows, cases[k].sign, err);
+        cr_assert_eq(t.nrows, 361);
+        cr_assert(err <= 1e-10, "branch %s: off the %+d assembly by %.3g", cases[k].branch,
+                  cases[k].sign, err);
+        mech_table_free(&t);
+        mech_diag_free(&d);
+    }
+}
+
+/* The slider's sign picks the piston's side: an offset slider-crank (crank
+ * 30, rod 100, offset 10 mm) assembles with the piston right of the crank
+ * (x_B = r cos q + w) or left (x_B = r cos q - w), w = sqrt(l^2 - (e - r sin q)^2). */
+Test(partial, branch_slider_sign_selects_each_side)
+{
+    for (int sign = -1; sign <= 1; sign += 2) {
+        char text[1024];
+        snprintf(text, sizeof text,
+                 "name: offset slider-crank\n"
+                 "units: {length: mm, angle: deg}\n"
+                 "ground: {O: [0, 0], G: [0, 10]}\n"
+                 "links:\n"
+                 "  crank:  {points: {O: [0, 0], A: [30, 0]}}\n"
+                 "  rod:    {points: {A: [0, 0], B: [100, 0]}}\n"
+                 "  piston: {points: {B: [0, 0]}}\n"
+                 "joints:\n"
+                 "  - {slider: B, link: piston, on: ground, through: G, angle: 0, name: x_B}\n"
+                 "driver: {link: crank, angle: {from: 0, to: 360, steps: 72}, speed: 1 rad/s}\n"
+                 "branch: [{slider: x_B, sign: %s}]\n"
+                 "outputs: {points: [B], sliders: [x_B]}\n", sign > 0 ? "positive" : "negative");
+        mech_model *m = load_text(text);
+        mech_solve_options o;
+        mech_solve_options_default(&o);
+        mech_diag d;
+        mech_diag_init(&d);
+        mech_table t = {0};
+        cr_assert_eq(mech_solve(m, &o, &t, NULL, &d), MECH_OK);
+        double worst = 0;
+        for (int i = 0; i < t.nrows; i++) {
+            double q = get(&t, i, "q"), u = 0.010 - 0.030 * sin(q);
+            double x = 0.030 * cos(q) + sign * sqrt(0.100 * 0.100 - u * u);
+            worst = fmax(worst, fabs(get(&t, i, "x_B.s") - x) / 0.1);
+            worst = fmax(worst, fabs(get(&t, i, "B.x") - x) / 0.1);
+        }
+        note("slider sign %+d: %d rows, worst error %.2g", sign, t.nrows, worst);
+        cr_assert_eq(t.nrows, 73);
+        cr_assert(worst <= 1e-12, "slider sign %+d: off by %.3g", sign, worst);
+        mech_table_free(&t);
+        mech_diag_free(&d);
+        mech_model_free(&m);
+    }
+}
+
+/* A condition that can never hold is refused at load. */
+Test(partial, branch_never_holding_refused)
+{
+    static const char *const bad[] = {
+        "{point: B, right_of: B}", "{point: O, right_of: C}", "{point: O, above: C}",
+        "{point: A, above: A2}", "{slider: x_B, sign: up}", "{point: B, right_of: C, above: C}"};
+    static const char *const says[] = {"twice", "not right of", "not above", "one place",
+                                       "positive", "one of"};
+    for (size_t k = 0; k < sizeof bad / sizeof *bad; k++) {
+        char text[1024];
+        snprintf(text, sizeof text,
+                 "name: refused\n"
+                 "ground: {O: [0, 0], C: [0.09, 0]}\n"
+                 "links:\n"
+                 "  crank:   {points: {O: [0, 0], A: [0.03, 0], A2: [0.03, 0]}}\n"
+                 "  coupler: {points: {A: [0, 0], B: [0.08, 0]}}\n"
+                 "  rocker:  {points: {C: [0, 0], B: [0.06, 0]}}\n"
+                 "driver: {link: crank, angle: {from: 0 deg, to: 1 deg, steps: 1}}\n"
+                 "branch: [%s]\n", bad[k]);
+        mech_diag d;
+        mech_diag_init(&d);
+        mech_model *m = NULL;
+        int rc = mech_load_string(text, strlen(text), "refused.yaml", &m, &d);
+        const char *msg = d.count ? d.entries[0].message : "";
+        for (size_t e = 0; e < d.count; e++)
+            if (strstr(d.entries[e].message, "branch"))
+                msg = d.entries[e].message;
+        note("%s: %s", bad[k], msg);
+        cr_assert_neq(rc, MECH_OK, "'%s' accepted", bad[k]);
+        cr_assert(strstr(msg, says[k]), "'%s': message '%s' does not say '%s'", bad[k], msg,
+                  says[k]);
+        mech_model_free(&m);
+        mech_diag_free(&d);
+    }
+}
+
+/* A first-position-only branch through a change point (crank 30, coupler
+ * 60, rocker 50, ground 80 mm: the branches cross at 180 deg): no row on
+ * the crossing (361 intervals), every row solved; the smooth continuation
+ * is the declared (open) assembly before 180 deg and the crossed one after. */
+Test(partial, change_point_crossed_with_first_only_branch)
+{
+    const char *text =
+        "name: change point, branch at the first position only\n"
+        "units: {length: mm, angle: deg}\n"
+        "ground: {O: [0, 0], C: [80, 0]}\n"
+        "links:\n"
+        "  crank:   {points: {O: [0, 0], A: [30, 0]}}\n"
+        "  coupler: {points: {A: [0, 0], B: [60, 0], P: [40, 15]}}\n"
+        "  rocker:  {points: {C: [0, 0], B: [50, 0]}}\n"
+        "driver: {link: crank, angle: {from: 0, to: 360, steps: 361}, speed: 1 rad/s}\n"
+        "branch: [{points: [A, B, C], turn: cw, first_only: true}]\n"
+        "outputs: {points: [A, B, P], links: [crank, coupler, rocker]}\n";
+    mech_model *m = load_text(text);
+    mech_solve_options o;
+    mech_solve_options_default(&o);
+    mech_diag d;
+    mech_diag_init(&d);
+    mech_table t = {0};
+    int rc = mech_solve(m, &o, &t, NULL, &d);
+    cr_assert_eq(rc, MECH_OK, "rc %d: %s", rc, d.count ? d.entries[0].message : "");
+    cr_assert_eq(t.nrows, 362);
+    mech_table before = t, after = t;
+    before.nrows = 181;  /* 0 .. 179.5 deg */
+    after.values = t.values + (size_t)181 * (size_t)t.ncolumns;
+    after.nrows = 181;
+    fourbar open = CHANGE, crossed = CHANGE;
+    crossed.sign = -1;
+    double e1 = fourbar_worst(&before, &open, PI, 10 * DEG);
+    double e2 = fourbar_worst(&after, &crossed, PI, 10 * DEG);
+    note("change point, first-only branch: %d rows; before 180 deg on the open assembly %.2g, "
+         "after on the crossed %.2g", t.nrows, e1, e2);
+    cr_assert(e1 <= 1e-10 && e2 <= 1e-10, "off the smooth branch: %.3g, %.3g", e1, e2);
+    mech_table_free(&t);
+    mech_diag_free(&d);
+    mech_model_free(&m);
+}
