@@ -167,6 +167,51 @@ static void list_large(const solver *sv, const double *v, int loops, char *buf, 
     }
 }
 
+/* Another pin of link li than joint j (revolute or slider point), or -1. */
+static int other_pin(const mech_model *m, int li, int j)
+{
+    for (int k = 0; k < m->njoints; k++)
+        for (int side = 0; side < 2 && k != j; side++)
+            if (m->joints[k].link[side] == li)
+                return m->links[li].points[m->joints[k].point[side]].id;
+    return -1;
+}
+
+/* Which two moving links, pinned together, lie most nearly in line at the
+ * position x (q): "coupler and rocker extended in line" (their pin between
+ * their other pins) or "... folded in line"; "" when no pair is within
+ * 1e-3 rad of it. Publishes x (diagnostics only). */
+static void in_line_text(solver *sv, double q, const double *x, char *buf, size_t size)
+{
+    const mech_model *m = sv->p->m;
+    memcpy(sv->x, x, (size_t)sv->p->ns * sizeof *sv->x);
+    sv->generation++;
+    solver_publish(sv, q, 0.0, 0.0);
+    double best = 1.0 - 5e-7;  /* cos of 1e-3 rad */
+    buf[0] = '\0';
+    for (int j = 0; j < m->njoints; j++) {
+        const mech_joint *jt = &m->joints[j];
+        if (jt->kind != MECH_JOINT_REVOLUTE || jt->link[0] == 0 || jt->link[1] == 0)
+            continue;
+        int pin = m->links[jt->link[0]].points[jt->point[0]].id;
+        int q1 = other_pin(m, jt->link[0], j), q2 = other_pin(m, jt->link[1], j);
+        if (q1 < 0 || q2 < 0 || q1 == pin || q2 == pin)
+            continue;
+        double p[2], a[2], b[2];
+        kin_point(&sv->p->tree, &sv->ks, pin, p, NULL, NULL);
+        kin_point(&sv->p->tree, &sv->ks, q1, a, NULL, NULL);
+        kin_point(&sv->p->tree, &sv->ks, q2, b, NULL, NULL);
+        double ux = a[0] - p[0], uy = a[1] - p[1], vx = b[0] - p[0], vy = b[1] - p[1];
+        double nu = hypot(ux, uy), nv = hypot(vx, vy);
+        double cs = nu > 0 && nv > 0 ? (ux * vx + uy * vy) / (nu * nv) : 0.0;
+        if (fabs(cs) > best) {
+            best = fabs(cs);
+            snprintf(buf, size, "%s and %s %s in line", m->links[jt->link[0]].name,
+                     m->links[jt->link[1]].name, cs < 0 ? "extended" : "folded");
+        }
+    }
+}
+
 /* At a singular position, is the driver's column -f_q in the range of J
  * (w . f_q = 0 for the left null vector w)? Then the solution curve goes on
  * through the position and another crosses it: a change point. Otherwise
@@ -194,6 +239,7 @@ void diagnose_singular(cont *c, double q)
     const char *kind = "a dead point, toggle or limit position";
     double *right = xcalloc((size_t)sv->p->ns + 1, sizeof *right);
     double *left = xcalloc((size_t)sv->p->nr + 1, sizeof *left);
+    char line[200] = "", kindb[512];
     c->fail_change_point = 0;
     if (right && left && dense_null(sv, right, left) == 0) {
         if ((c->fail_change_point = is_change_point(sv, left)))
@@ -209,6 +255,18 @@ void diagnose_singular(cont *c, double q)
     }
     free(right);
     free(left);
+    double *xs = xcalloc((size_t)sv->p->ns + 1, sizeof *xs);
+    if (xs && !c->fail_change_point) {
+        memcpy(xs, sv->x, (size_t)sv->p->ns * sizeof *xs);
+        in_line_text(sv, q, xs, line, sizeof line);
+        memcpy(sv->x, xs, (size_t)sv->p->ns * sizeof *xs);
+    }
+    free(xs);
+    if (line[0]) {
+        snprintf(kindb, sizeof kindb, "%s (%s%s)", kind, line,
+                 c->m->driver.kind == MECH_DRIVE_SLIDER ? ": dead centre of the slider" : "");
+        kind = kindb;
+    }
     diag_error(c->d, c->m->file, c->m->driver.mark,
                "singular position at %s = %s (reciprocal condition %.2g, limit %.2g): %s%s; "
                "velocities there are not unique", diagnose_driver_word(c->m),
@@ -366,6 +424,15 @@ void diagnose_failure(cont *c, double q_row, double hrow)
         return;
     }
     if (s == STEP_NO_ASSEMBLY) {
+        char line[200], why[300] = "";
+        in_line_text(sv, upper, c->xc, line, sizeof line);
+        if (line[0]) {  /* the limit to the digits the refinement (1e-9 of a row) reached */
+            double unit = is_angle_driver(m) ? 180.0 / PI : 1e3;
+            double acc = fmax(1e-9 * fabs(hrow), 1e-11 * fmax(fabs(upper), fabs(hrow))) * unit;
+            int dec = (int)floor(-log10(acc)) - 1;
+            snprintf(why, sizeof why, "; at %.*f %s, %s", dec < 0 ? 0 : dec > 12 ? 12 : dec,
+                     upper * unit, is_angle_driver(m) ? "deg" : "mm", line);
+        }
         c->searching = 1;
         double span = is_angle_driver(m) ? 2.0 * PI : fabs(q_row - c->q0) * 4.0 + sv->p->lref;
         int found;
@@ -377,12 +444,12 @@ void diagnose_failure(cont *c, double q_row, double hrow)
                      diagnose_q_text(m, hi2, qe, sizeof qe));
         diag_error(c->d, m->file, m->driver.mark,
                    "cannot assemble at %s = %s: %s does not close (residual %.3g m); the "
-                   "mechanism assembles for %s from %s%s to %s%s (limit positions%s)",
+                   "mechanism assembles for %s from %s%s to %s%s (limit positions%s%s)",
                    diagnose_driver_word(m), diagnose_q_text(m, q_row, qa, sizeof qa),
                    diagnose_loop_label(sv, loop, lb, sizeof lb), resid, diagnose_driver_word(m),
                    found || lo == lower ? "" : "at most ", diagnose_q_text(m, lo, qb, sizeof qb),
                    diagnose_q_text(m, hi, qc, sizeof qc), more,
-                   found ? "" : "; the other side was not searched past one range");
+                   found ? "" : "; the other side was not searched past one range", why);
         return;
     }
     if (s == STEP_JUMP)

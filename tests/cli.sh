@@ -180,6 +180,7 @@ if run "mech solve non-Grashof" 1 "$MECH" solve tests/solve/non-grashof.yaml -o 
     has_line "$tmp/err" 'cannot assemble at driver angle = 143 deg.*assembles for driver angle from -142.83[0-9]* deg to 142.83[0-9]* deg' "non-Grashof message"
     has_line "$tmp/err" '^mech solve: gap: rows 144 to 218 of 361 (driver at 143.000000 deg to 217.000000 deg) not solved: the mechanism does not assemble; limits found: from 142.8327145[0-9] deg to 217.1672854[0-9] deg$' "non-Grashof gap"
     has_line "$tmp/err" '^mech solve: 286 rows solved (361 positions requested); the rows solved are written$' "non-Grashof rows count"
+    has_line "$tmp/err" '(limit positions; at 142.8327145 deg, coupler and rocker extended in line)$' "non-Grashof: the links in line at the limit"
     [ "$(wc -l <"$tmp/old.csv")" -eq 287 ] && pass || fail "non-Grashof: $(wc -l <"$tmp/old.csv") lines written, expected 287 (header and 286 rows)"
 fi
 run "mech solve non-Grashof --within-assembly" 0 "$MECH" solve tests/solve/non-grashof.yaml --within-assembly -o "$tmp/wa.csv" && pass
@@ -194,6 +195,7 @@ fi
 
 if run "mech solve dead centre" 1 "$MECH" solve tests/solve/dead-centre.yaml -o "$tmp/dc.csv"; then
     has_line "$tmp/err" 'singular position at driver displacement = 180 mm.*dead point.*th_crank (at 0.000 deg), th_rod (at 0.000 deg)' "dead-centre message"
+    has_line "$tmp/err" 'a dead point, toggle or limit position (crank and rod extended in line: dead centre of the slider)' "dead centre named"
     has_line "$tmp/err" '^mech solve: gap: row 31 of 31 (driver at 180.000000 mm) not solved: a dead point or limit position the driver cannot pass; limits found: from 180.0000000[0-9]* mm$' "dead-centre gap"
     [ "$(wc -l <"$tmp/dc.csv")" -eq 31 ] && pass || fail "dead centre: $(wc -l <"$tmp/dc.csv") lines written, expected 31"
 fi

@@ -556,3 +556,39 @@ Test(partial, change_point_crossed_with_first_only_branch)
     mech_diag_free(&d);
     mech_model_free(&m);
 }
+
+/* ---- limits named as an engineer names them (issue 17, item 2) --------- */
+
+static int any_message(const mech_diag *d, const char *text)
+{
+    for (size_t i = 0; i < d->count; i++)
+        if (strstr(d->entries[i].message, text))
+            return 1;
+    return 0;
+}
+
+/* |CA| = b + c: coupler and rocker extended in line; |CA| = b - c: folded;
+ * the piston's dead centre: crank and rod in line. The limit's value to the
+ * digits reached (109.4712206 deg: the closed form is 109.47122063449). */
+Test(partial, limits_named)
+{
+    mech_diag d;
+    mech_diag_init(&d);
+    mech_table t = sweep("tests/hard/non-grashof-crank.yaml", 0, TWO_PI, 360, 0, MECH_ESOLVE, &d);
+    cr_assert(any_message(&d, "(limit positions; at 109.4712206 deg, coupler and rocker "
+                              "extended in line)"), "%s", d.entries[0].message);
+    mech_table_free(&t);
+    mech_diag_free(&d);
+    mech_diag_init(&d);
+    t = sweep("tests/hard/non-grashof-two-intervals.yaml", 0, TWO_PI, 360, 0, MECH_ESOLVE, &d);
+    cr_assert(any_message(&d, "at 125.0996322 deg, coupler and rocker extended in line"));
+    cr_assert(any_message(&d, "at 308.6821875 deg, coupler and rocker folded in line"));
+    mech_table_free(&t);
+    mech_diag_free(&d);
+    mech_diag_init(&d);
+    t = sweep("tests/hard/dead-centre-slider.yaml", 0.100, 0.140, 40, 0, MECH_ESOLVE, &d);
+    cr_assert(any_message(&d, "a dead point, toggle or limit position (crank and rod extended "
+                              "in line: dead centre of the slider)"), "%s", d.entries[0].message);
+    mech_table_free(&t);
+    mech_diag_free(&d);
+}
