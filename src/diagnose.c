@@ -430,8 +430,9 @@ void diagnose_failure(cont *c, double q_row, double hrow)
             double unit = is_angle_driver(m) ? 180.0 / PI : 1e3;
             double acc = fmax(1e-9 * fabs(hrow), 1e-11 * fmax(fabs(upper), fabs(hrow))) * unit;
             int dec = (int)floor(-log10(acc)) - 1;
-            snprintf(why, sizeof why, "; at %.*f %s, %s", dec < 0 ? 0 : dec > 12 ? 12 : dec,
-                     upper * unit, is_angle_driver(m) ? "deg" : "mm", line);
+            snprintf(why, sizeof why, "; at %.*f %s, %s%s", dec < 0 ? 0 : dec > 12 ? 12 : dec,
+                     upper * unit, is_angle_driver(m) ? "deg" : "mm", line,
+                     is_angle_driver(m) ? "" : ": dead centre of the slider");
         }
         c->searching = 1;
         double span = is_angle_driver(m) ? 2.0 * PI : fabs(q_row - c->q0) * 4.0 + sv->p->lref;
