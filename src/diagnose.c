@@ -273,10 +273,49 @@ void diagnose_singular(cont *c, double q)
                diagnose_q_text(c->m, q, qb, sizeof qb), sv->rcond, sv->p->opt.min_rcond, kind, what);
 }
 
+/* Modified Gram-Schmidt over the rows of a (nr x ns, dense), in order,
+ * keeping each reduced row as a combination cf (nr x nr) of the original
+ * rows: a row left with less than 1e-8 of its length is implied by those
+ * before it, and its combination is a left null vector w (w^T J = 0). For
+ * each, named[] gets the equation with the largest |w| (on a tie, the later
+ * one): an equation that takes part in the dependency. Returns the count. */
+static int dependent_rows(int nr, int ns, double *a, double *cf, int *named)
+{
+    int count = 0;
+    for (int i = 0; i < nr; i++) {
+        double *ri = a + (size_t)i * ns, *ci = cf + (size_t)i * nr, len0 = 0.0, len = 0.0;
+        ci[i] = 1.0;
+        for (int col = 0; col < ns; col++)
+            len0 += ri[col] * ri[col];
+        for (int j = 0; j < i; j++) {
+            double *rj = a + (size_t)j * ns, *cj = cf + (size_t)j * nr, dot = 0.0, nj = 0.0;
+            for (int col = 0; col < ns; col++)
+                dot += ri[col] * rj[col], nj += rj[col] * rj[col];
+            if (!(nj > 0.0))
+                continue;
+            for (int col = 0; col < ns; col++)
+                ri[col] -= dot / nj * rj[col];
+            for (int k = 0; k <= j; k++)
+                ci[k] -= dot / nj * cj[k];
+        }
+        for (int col = 0; col < ns; col++)
+            len += ri[col] * ri[col];
+        if (len > 1e-16 * len0)
+            continue;
+        for (int col = 0; col < ns; col++)
+            ri[col] = 0.0;
+        int best = i;
+        for (int k = 0; k <= i; k++)
+            if (fabs(ci[k]) >= (1.0 - 1e-9) * fabs(ci[best]))
+                best = k;
+        named[count++] = best;
+    }
+    return count;
+}
+
 /* With redundant constraints (more loop equations than unknowns), say which
- * equations are implied by the others at the first position: modified
- * Gram-Schmidt over the rows of J, in order; a row left with less than 1e-8
- * of its length is redundant. Small systems only (dense). */
+ * equations are implied by the others at the first position, by the rows'
+ * dependencies (dependent_rows). Small systems only (dense). */
 void diagnose_redundant(cont *c, double q)
 {
     solver *sv = &c->sv;
@@ -284,38 +323,27 @@ void diagnose_redundant(cont *c, double q)
     if (!sv->p->aug || nr > 400)
         return;
     double *a = xcalloc((size_t)nr * (size_t)ns + 1, sizeof *a);
-    if (!a)
+    double *cf = xcalloc((size_t)nr * (size_t)nr + 1, sizeof *cf);
+    int *named = xcalloc((size_t)nr + 1, sizeof *named);
+    if (!a || !cf || !named) {
+        free(a);
+        free(cf);
+        free(named);
         return;
+    }
     for (int col = 0, k = 0; col < ns; col++)
         for (int p = sv->p->Ap[nr + col]; p < sv->p->Ap[nr + col + 1]; p++, k++)
             a[(size_t)sv->p->Ai[p] * ns + col] = sv->Jv[k];
+    int count = dependent_rows(nr, ns, a, cf, named);
     char list[600] = "", lb[256], qb[64];
     size_t at = 0;
-    int count = 0;
-    for (int i = 0; i < nr; i++) {
-        double *ri = a + (size_t)i * ns, len0 = 0.0, len = 0.0;
-        for (int col = 0; col < ns; col++)
-            len0 += ri[col] * ri[col];
-        for (int j = 0; j < i; j++) {
-            double *rj = a + (size_t)j * ns, dot = 0.0, nj = 0.0;
-            for (int col = 0; col < ns; col++)
-                dot += ri[col] * rj[col], nj += rj[col] * rj[col];
-            if (nj > 0.0)
-                for (int col = 0; col < ns; col++)
-                    ri[col] -= dot / nj * rj[col];
-        }
-        for (int col = 0; col < ns; col++)
-            len += ri[col] * ri[col];
-        if (len <= 1e-16 * len0) {
-            for (int col = 0; col < ns; col++)
-                ri[col] = 0.0;
-            if (at < sizeof list)
-                at += (size_t)snprintf(list + at, sizeof list - at, "%s%s equation of %s",
-                                       count++ ? ", " : "", sv->p->row[i] % 2 ? "y" : "x",
-                                       diagnose_loop_label(sv, sv->p->row[i] / 2, lb, sizeof lb));
-        }
-    }
+    for (int i = 0; i < count && at < sizeof list; i++)
+        at += (size_t)snprintf(list + at, sizeof list - at, "%s%s equation of %s",
+                               i ? ", " : "", sv->p->row[named[i]] % 2 ? "y" : "x",
+                               diagnose_loop_label(sv, sv->p->row[named[i]] / 2, lb, sizeof lb));
     free(a);
+    free(cf);
+    free(named);
     diag_warning(c->d, c->m->file, c->m->driver.mark,
                  "redundant constraints: at %s = %s the %d loop equations have rank %d; "
                  "implied by the others: the %s; the mechanism moves because "

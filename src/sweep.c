@@ -105,9 +105,12 @@ static int copy_outputs(mech_outputs *to, const mech_outputs *from)
         mech_outputs_free(to);
         return -1;
     }
-    memcpy(to->points, from->points, (size_t)from->npoints * sizeof *to->points);
-    memcpy(to->links, from->links, (size_t)from->nlinks * sizeof *to->links);
-    memcpy(to->sliders, from->sliders, (size_t)from->nsliders * sizeof *to->sliders);
+    if (from->npoints)  /* an empty list may be NULL: memcpy from NULL is undefined */
+        memcpy(to->points, from->points, (size_t)from->npoints * sizeof *to->points);
+    if (from->nlinks)
+        memcpy(to->links, from->links, (size_t)from->nlinks * sizeof *to->links);
+    if (from->nsliders)
+        memcpy(to->sliders, from->sliders, (size_t)from->nsliders * sizeof *to->sliders);
     return 0;
 }
 

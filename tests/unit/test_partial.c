@@ -592,3 +592,53 @@ Test(partial, limits_named)
     mech_table_free(&t);
     mech_diag_free(&d);
 }
+
+/* The redundancy report names the equation with the largest component of
+ * the left null vector w of J (w^T J = 0). By hand, with the coupler at 0
+ * and both cranks at q (b = 100, c = 40 mm): the rows of J over (coupler,
+ * rocker, extra) are loop 1 (B-C-O-A-B) x: [0, c sin q, 0], y: [b, -c cos q,
+ * 0]; loop 2 (F-E-O-A-F) x: [0, 0, c sin q], y: [b/2, 0, -c cos q]; so
+ * w = (cot q, 1, -2 cot q, -2): at 30 deg the largest is loop 2's x
+ * equation (3.46), at 70 deg loop 2's y equation (2). */
+Test(partial, redundancy_names_largest_left_null_component)
+{
+    static const double qs[] = {30, 70};
+    for (int k = 0; k < 2; k++) {
+        double q = qs[k] * DEG, w[4] = {1 / tan(q), 1, -2 / tan(q), -2};
+        int big = 0;
+        for (int i = 1; i < 4; i++)
+            if (fabs(w[i]) > fabs(w[big]))
+                big = i;
+        static const char *const eq[4] = {"x equation of loop 1 (B-C-O-A-B)",
+                                          "y equation of loop 1 (B-C-O-A-B)",
+                                          "x equation of loop 2 (F-E-O-A-F)",
+                                          "y equation of loop 2 (F-E-O-A-F)"};
+        char text[1024], want[128];
+        snprintf(text, sizeof text,
+                 "name: redundant parallelogram\n"
+                 "units: {length: mm, angle: deg}\n"
+                 "ground: {O: [0, 0], E: [50, 0], C: [100, 0]}\n"
+                 "links:\n"
+                 "  crank:   {points: {O: [0, 0], A: [40, 0]}}\n"
+                 "  coupler: {points: {A: [0, 0], B: [100, 0], F: [50, 0]}}\n"
+                 "  rocker:  {points: {C: [0, 0], B: [40, 0]}}\n"
+                 "  extra:   {points: {E: [0, 0], F: [40, 0]}}\n"
+                 "driver: {link: crank, angle: {from: %g, to: %g, steps: 1}}\n"
+                 "initial: {coupler: 1, rocker: %g, extra: %g}\n", qs[k], qs[k] + 1, qs[k] + 2,
+                 qs[k] - 2);
+        snprintf(want, sizeof want, "implied by the others: the %s;", eq[big]);
+        mech_model *m = load_text(text);
+        mech_solve_options o;
+        mech_solve_options_default(&o);
+        mech_diag d;
+        mech_diag_init(&d);
+        mech_table t = {0};
+        cr_assert_eq(mech_solve(m, &o, &t, NULL, &d), MECH_OK);
+        note("at %g deg: expected '%s'", qs[k], want);
+        cr_assert(any_message(&d, want), "at %g deg no message says '%s': %s", qs[k], want,
+                  d.count > 1 ? d.entries[1].message : "");
+        mech_table_free(&t);
+        mech_diag_free(&d);
+        mech_model_free(&m);
+    }
+}
