@@ -188,6 +188,10 @@ if run "mech solve non-Grashof --range assembly" 0 "$MECH" solve tests/solve/non
     [ "$(wc -l <"$tmp/ra.csv")" -eq 289 ] && pass || fail "--range assembly: $(wc -l <"$tmp/ra.csv") lines, expected 289 (286 rows and the two limits)"
     has_line "$tmp/ra.csv" '^2.492901' "--range assembly: a row at the limit 142.8327 deg (2.492901 rad)"
 fi
+if run "mech sweep with a partial variant" 0 "$MECH" sweep mechanisms/double-crank.yaml --vary 'l0=20mm:80mm:2' -o "$tmp/sw.csv"; then
+    has_line "$tmp/err" '^360 of 361 rows solved, 1 gap$' "sweep: rows and gaps of a partial variant"
+    has_line "$tmp/sw.csv" '^1,80 mm,no-assembly,360$' "sweep: the partial variant's rows"
+fi
 run "mech solve --range bogus" 2 "$MECH" solve tests/solve/non-grashof.yaml --range bogus && pass
 if run "mech solve change point --within-assembly" 1 "$MECH" solve tests/hard/change-point.yaml --within-assembly -o "$tmp/cp.csv"; then
     has_line "$tmp/err" '^mech solve: gap: row 181 of 361 (driver at 180.000000 deg) not solved: a change point, where two assembly branches cross' "change-point gap"
