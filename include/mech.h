@@ -118,11 +118,25 @@ typedef struct mech_guess {
     mech_mark mark;
 } mech_guess;
 
-/* Assembly branch: the turn A->B->C must be counter-clockwise (sign +1) or
- * clockwise (sign -1); points are name ids. */
+/* What an assembly branch condition compares (docs/format.md 8.2). */
+typedef enum {
+    MECH_BRANCH_TURN,   /* the turn point[0] -> point[1] -> point[2]: ccw (+1) or cw (-1) */
+    MECH_BRANCH_X,      /* x of point[0] - x of point[1]: right of (+1) or left of (-1) */
+    MECH_BRANCH_Y,      /* y of point[0] - y of point[1]: above (+1) or below (-1) */
+    MECH_BRANCH_SLIDER  /* the displacement of slider joint `slider`: positive (+1) or
+                           negative (-1) */
+} mech_branch_kind;
+
+/* Assembly branch condition: the quantity of `kind` has the sign `sign`;
+ * points are name ids (X, Y: point[2] == point[1]; SLIDER: none, -1).
+ * first_only: it selects the assembly at the first position (and at each
+ * re-assembly after a gap); the continuation then follows by continuity. */
 typedef struct mech_branch {
+    mech_branch_kind kind;
     int point[3];
+    int slider;        /* joint index (SLIDER), else -1 */
     int sign;
+    int first_only;
     mech_mark mark;
 } mech_branch;
 
@@ -280,6 +294,9 @@ typedef struct mech_solve_options {
                           (mech_outputs_parse), or NULL; borrowed for the analysis */
     int friction;      /* MECH_FRICTION_*: how joint friction enters the forces */
     int linear_solver; /* MECH_LINEAR_*: how the Jacobians are factored */
+    int limit_rows;    /* 1: a partial sweep also gets a row at each limit of a gap
+                          found (mech_gap.from/to with from_limit/to_limit), where
+                          the position is not singular (mech solve --range assembly) */
 } mech_solve_options;
 
 enum {
@@ -302,11 +319,36 @@ typedef struct mech_column {
     char *unit;        /* "m", "rad/s", "-", ...; owned */
 } mech_column;
 
+/* Why requested rows of a sweep are missing (mech_gap.kind). */
+typedef enum {
+    MECH_GAP_NO_ASSEMBLY,  /* the loops do not close there: past a limit position */
+    MECH_GAP_DEAD_POINT,   /* a singular position the driver cannot pass: dead point,
+                              toggle, limit position (rows on or past it) */
+    MECH_GAP_CHANGE_POINT, /* a singular position where two assembly branches cross */
+    MECH_GAP_BRANCH,       /* the continuation leaves the declared branch */
+    MECH_GAP_JUMP          /* the solution jumps even with a tiny step */
+} mech_gap_kind;
+
+/* A run of requested rows that were not solved. from/to bound it: the last
+ * driver position solved before it and the first after it (when from_limit /
+ * to_limit: a limit of the assembly, found to about 1e-12 of the row
+ * spacing; otherwise the requested position itself, as when the gap starts
+ * at the first requested row or runs to the last). */
+typedef struct mech_gap {
+    mech_gap_kind kind;    /* why its first row failed */
+    int first_row, last_row; /* requested rows (indices into the driver positions) */
+    double from, to;       /* rad or m */
+    int from_limit, to_limit;
+} mech_gap;
+
 typedef struct mech_table {
     mech_column *columns;  /* [ncolumns] */
     int ncolumns;
     double *values;        /* [nrows * ncolumns], row-major */
-    int nrows;
+    int nrows;             /* rows solved (the q column says which positions) */
+    int nrequested;        /* driver positions asked for (a solver's table) */
+    mech_gap *gaps;        /* [ngaps] requested rows not solved, in order; owned */
+    int ngaps;
 } mech_table;
 
 void mech_table_free(mech_table *t);
@@ -341,10 +383,18 @@ typedef struct mech_solve_stats {
 /* Solve the driver sweep of a checked model. On success *out holds one row
  * per driver position with the outputs the model asks for (points: x, y, vx,
  * vy, ax, ay; links: angle, omega, alpha; sliders: s, v, a; with forces,
- * joint reactions, driver torque or force, power balance; SI units). On
- * failure returns MECH_ESOLVE (or MECH_EINPUT for an invalid system), d says
- * what happened and where (driver position, loop, unknowns), and *out holds
- * the rows solved before the failure. `stats` may be NULL. */
+ * joint reactions, driver torque or force, power balance; SI units).
+ *
+ * Partial sweeps: when a row cannot be reached (past a limit position, at a
+ * dead point, off the declared branch) d says why and where (driver
+ * position, loop, unknowns, the assembly interval), the sweep looks for
+ * re-assembly at each following requested row (Newton from the last
+ * position, the guesses and scattered starts, with the declared `branch:`
+ * conditions) and goes on from there; *out holds every row solved, in order,
+ * and out->gaps lists the runs of requested rows that are missing, with their
+ * limits and kind. The status is then MECH_ESOLVE (some requested row is
+ * missing). A failure of the force analysis stops the sweep there (no gap).
+ * MECH_EINPUT for an invalid system. `stats` may be NULL. */
 int mech_solve(const mech_model *m, const mech_solve_options *o, mech_table *out,
                mech_solve_stats *stats, mech_diag *d);
 

@@ -130,6 +130,9 @@ static void run_job(const batch *b, job *jb)
     }
     mech_diag_print(&d, out);
     mech_diag_free(&d);
+    if (rc == MECH_ESOLVE && t.nrequested > 0)  /* a partial sweep (issue 17) */
+        fprintf(out, "%s: %d of %d rows solved, %d gap%s\n", jb->path, t.nrows, t.nrequested,
+                t.ngaps, t.ngaps == 1 ? "" : "s");
     jb->code = exit_of(rc);
     jb->steps = st.steps;
     jb->worst_residual = st.worst_residual;

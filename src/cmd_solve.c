@@ -13,6 +13,7 @@ const char cmd_solve_help[] =
     "                  [--outputs NAME,...] [--level positions|velocities|accelerations]\n"
     "                  [--forces] [--friction on|off|both]\n"
     "                  [--diagnostics] [--stats] [--verbose] [--all]\n"
+    "                  [--within-assembly] [--range assembly]\n"
     "\n"
     "Solve positions, velocities and accelerations of the mechanism at every\n"
     "driver position and write one CSV row per position: the driver position q,\n"
@@ -52,11 +53,17 @@ const char cmd_solve_help[] =
     "                      rcond and time per step to standard error\n"
     "  --verbose           say which blocks of equations are solved and why\n"
     "  --all               solve every unknown, also those no output needs\n"
+    "  --within-assembly   the request is the part of the range where the mechanism\n"
+    "                      assembles: exit 0 when every row there was solved (gaps\n"
+    "                      past limit positions and dead points are expected)\n"
+    "  --range assembly    as --within-assembly, and add a row at each limit of the\n"
+    "                      assembly found (where it is not singular)\n"
     "  -h, --help          show this help\n"
     "\n"
     "exit status: 0 solved, 1 the mechanism cannot be solved somewhere in the range\n"
     "(the message gives the driver position, the loop and the unknowns involved;\n"
-    "no output is written), 2 invalid file or usage, 3 a file cannot be read or written\n";
+    "the rows that were solved are written, each gap is listed), 2 invalid file or\n"
+    "usage, 3 a file cannot be read or written\n";
 
 enum { MAX_SET = 64 };
 
@@ -75,6 +82,7 @@ typedef struct solve_args {
     char *set_text[MAX_SET];
     int nset;
     int steps, stats, verbose;
+    int within;                  /* --within-assembly or --range assembly */
     mech_outputs selected;       /* --outputs, parsed (opt.outputs points here) */
     mech_solve_options opt;
 } solve_args;
@@ -89,7 +97,8 @@ static int parse_number(const char *text, double *v)
 
 static const char *const value_options[] = {"-o", "--output", "--from", "--to", "--outputs",
                                            "--steps", "--tol", "--max-iter", "--min-rcond",
-                                           "--level", "--friction", "--set", "--linear-solver"};
+                                           "--level", "--friction", "--set", "--linear-solver",
+                                           "--range"};
 
 static int takes_value(const char *arg)
 {
@@ -146,6 +155,11 @@ static int parse_valued(solve_args *a, const char *arg, const char *val)
         a->set_text[a->nset] = copy;
         a->set[a->nset].name = copy;
         a->set[a->nset++].text = copy + (eq - val) + 1;
+    } else if (strcmp(arg, "--range") == 0) {
+        if (strcmp(val, "assembly") != 0)
+            return cmd_usage_error("solve", "--range needs 'assembly', not '%s'", val);
+        a->within = 1;
+        a->opt.limit_rows = 1;
     } else if (strcmp(arg, "--friction") == 0) {
         if (strcmp(val, "on") == 0)
             a->opt.friction = MECH_FRICTION_ON;
@@ -190,6 +204,8 @@ static int parse_args(int argc, char **argv, solve_args *a)
             a->opt.diagnostics = 1;
         else if (strcmp(arg, "--all") == 0)
             a->opt.all_blocks = 1;
+        else if (strcmp(arg, "--within-assembly") == 0)
+            a->within = 1;
         else if (strcmp(arg, "--forces") == 0)
             a->opt.forces = 1;
         else if (arg[0] == '-' && arg[1] != '\0')
@@ -275,6 +291,97 @@ static void print_stats(const mech_model *m, const mech_solve_stats *st, FILE *o
             per * 1e6, st->seconds, st->setup_seconds);
 }
 
+/* Requested driver position i (as mech_analysis_new lists them). */
+static double requested_q(const solve_args *a, const mech_model *m, int i)
+{
+    if (!a->opt.has_range)
+        return m->driver.values[i];
+    int steps = a->opt.steps > 0 ? a->opt.steps : 1;
+    return i == steps ? a->opt.to : a->opt.from + (a->opt.to - a->opt.from) * i / steps;
+}
+
+/* A driver position as users read it: degrees or millimetres, with
+ * `decimals` decimals. */
+static void q_text(const mech_model *m, double q, int decimals, char *buf, size_t size)
+{
+    int angle = m->driver.kind == MECH_DRIVE_ANGLE;
+    snprintf(buf, size, "%.*f %s", decimals, angle ? q * 57.295779513082321 : q * 1e3,
+             angle ? "deg" : "mm");
+}
+
+/* Decimals that a limit found to 1e-12 of the row spacing h deserves,
+ * bounded by the position's own rounding floor (about 1e-11 of it, rad or m). */
+static int limit_decimals(const mech_model *m, double q, double h)
+{
+    double unit = m->driver.kind == MECH_DRIVE_ANGLE ? 57.295779513082321 : 1e3;
+    double acc = fmax(1e-12 * fabs(h), 1e-11 * fmax(fabs(q), fabs(h))) * unit;
+    int d = (int)floor(-log10(acc));
+    return d < 0 ? 0 : d > 12 ? 12 : d;
+}
+
+static const char *gap_words(mech_gap_kind k)
+{
+    switch (k) {
+    case MECH_GAP_NO_ASSEMBLY: return "the mechanism does not assemble";
+    case MECH_GAP_DEAD_POINT: return "a dead point or limit position the driver cannot pass";
+    case MECH_GAP_CHANGE_POINT: return "a change point, where two assembly branches cross";
+    case MECH_GAP_BRANCH: return "the mechanism leaves the declared branch";
+    default: return "the solution jumps to another assembly";
+    }
+}
+
+/* One line per gap: the rows missing, why, and the limits found. */
+static void print_gaps(const solve_args *a, const mech_model *m, const mech_table *t)
+{
+    for (int i = 0; i < t->ngaps; i++) {
+        const mech_gap *g = &t->gaps[i];
+        int n = t->nrequested;
+        double h = n > 1 ? fabs(requested_q(a, m, n - 1) - requested_q(a, m, 0)) / (n - 1) : 1.0;
+        char q1[64], q2[64], l1[64] = "", l2[64] = "";
+        q_text(m, requested_q(a, m, g->first_row), 6, q1, sizeof q1);
+        q_text(m, requested_q(a, m, g->last_row), 6, q2, sizeof q2);
+        if (g->from_limit)
+            q_text(m, g->from, limit_decimals(m, g->from, h), l1, sizeof l1);
+        if (g->to_limit)
+            q_text(m, g->to, limit_decimals(m, g->to, h), l2, sizeof l2);
+        char rows[200];
+        if (g->first_row == g->last_row)
+            snprintf(rows, sizeof rows, "row %d of %d (driver at %s)", g->first_row + 1, n, q1);
+        else
+            snprintf(rows, sizeof rows, "rows %d to %d of %d (driver at %s to %s)",
+                     g->first_row + 1, g->last_row + 1, n, q1, q2);
+        fprintf(stderr, "mech solve: gap: %s not solved: %s%s%s%s%s%s\n", rows, gap_words(g->kind),
+                l1[0] || l2[0] ? "; limits found: " : "", l1[0] ? "from " : "", l1,
+                l1[0] && l2[0] ? " to " : l2[0] ? "to " : "", l2);
+    }
+}
+
+/* --within-assembly: every requested row missing lies in a gap where the
+ * mechanism does not assemble or cannot be driven past a dead point. */
+static int only_assembly_gaps(const mech_table *t)
+{
+    int missing = t->nrequested;
+    for (int i = 0; i < t->ngaps; i++) {
+        if (t->gaps[i].kind != MECH_GAP_NO_ASSEMBLY && t->gaps[i].kind != MECH_GAP_DEAD_POINT)
+            return 0;
+        missing -= t->gaps[i].last_row - t->gaps[i].first_row + 1;
+    }
+    return t->nrows >= missing && t->nrows > 0;
+}
+
+/* The rows solved (all, or those of a partial sweep) to the output. */
+static int write_rows(const solve_args *a, const mech_table *t)
+{
+    mech_diag d;
+    mech_diag_init(&d);
+    int code = MECH_EXIT_OK;
+    if (mech_table_write_csv(t, a->out ? a->out : "-", &d) != MECH_OK)
+        code = MECH_EXIT_IO;
+    mech_diag_print(&d, stderr);
+    mech_diag_free(&d);
+    return code;
+}
+
 int cmd_solve(int argc, char **argv)
 {
     solve_args a = {0};
@@ -304,19 +411,21 @@ int cmd_solve(int argc, char **argv)
     mech_solve_stats st;
     int rc = mech_solve(m, &a.opt, &t, &st, &d);
     mech_diag_print(&d, stderr);
-    if (rc == MECH_ESOLVE)
-        fprintf(stderr, "mech solve: %d of the sweep's positions were solved before this; "
-                "%s\n", t.nrows, a.out ? "no output file written" : "no output written");
     mech_diag_free(&d);
+    if (rc == MECH_ESOLVE) {
+        print_gaps(&a, m, &t);
+        fprintf(stderr, "mech solve: %d rows solved (%d positions requested); %s\n", t.nrows,
+                t.nrequested, t.nrows == 0 ? (a.out ? "no output file written" : "no output written")
+                : a.out ? "the rows solved are written" : "the rows solved follow");
+    }
     if (a.stats)
         print_stats(m, &st, stderr);
     code = cmd_exit_status(rc);
-    if (rc == MECH_OK) {
-        mech_diag_init(&d);
-        if (mech_table_write_csv(&t, a.out ? a.out : "-", &d) != MECH_OK)
-            code = MECH_EXIT_IO;
-        mech_diag_print(&d, stderr);
-        mech_diag_free(&d);
+    if (rc == MECH_ESOLVE && a.within && only_assembly_gaps(&t))
+        code = MECH_EXIT_OK;
+    if (rc == MECH_OK || (rc == MECH_ESOLVE && t.nrows > 0)) {
+        int wc = write_rows(&a, &t);
+        code = wc != MECH_EXIT_OK ? wc : code;
     }
     mech_table_free(&t);
     mech_outputs_free(&a.selected);

@@ -360,6 +360,9 @@ static void run_variant(const sweep_run *r, variant *var)
     fputc('\n', out);
     mech_diag_print(&d, out);
     mech_diag_free(&d);
+    if (rc == MECH_ESOLVE && t.nrequested > 0)  /* a partial sweep (issue 17) */
+        fprintf(out, "%d of %d rows solved, %d gap%s\n", t.nrows, t.nrequested, t.ngaps,
+                t.ngaps == 1 ? "" : "s");
     var->rows = t.nrows;
     var->status = rc == MECH_OK ? "ok"
                   : rc == MECH_ESOLVE ? (locking ? "self-locking" : singular ? "singular" : "no-assembly")

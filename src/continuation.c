@@ -50,7 +50,7 @@ int cont_init(cont *c, const solver_plan *sp, mech_diag *d, mech_solve_stats *st
         return -1;
     size_t ns = (size_t)sp->ns + 1;
     double **arrays[] = {&c->xc, &c->xqc, &c->xqqc, &c->xqq_prev, &c->xpred,
-                         &c->x0, &c->xq0, &c->xqq0};
+                         &c->x0, &c->xq0, &c->xqq0, &c->xgap, &c->xqgap, &c->xqqgap};
     for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
         if (!(*arrays[i] = xcalloc(ns, sizeof(double))))
             return -1;
@@ -60,7 +60,7 @@ int cont_init(cont *c, const solver_plan *sp, mech_diag *d, mech_solve_stats *st
 void cont_free(cont *c)
 {
     double *arrays[] = {c->xc, c->xqc, c->xqqc, c->xqq_prev, c->xpred, c->x0,
-                        c->xq0, c->xqq0, c->guess};
+                        c->xq0, c->xqq0, c->guess, c->xgap, c->xqgap, c->xqqgap};
     for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
         free(arrays[i]);
     solver_free(&c->sv);
@@ -87,16 +87,30 @@ static void predict(cont *c, double qn)
     memcpy(sv->x, c->xpred, (size_t)sv->p->ns * sizeof *sv->x);
 }
 
-int cont_branches_hold(cont *c, int *which)
+/* The signed quantity of branch condition b at the published position. */
+static double branch_value(cont *c, const mech_branch *b)
+{
+    if (b->kind == MECH_BRANCH_SLIDER) {
+        int var = c->sv.p->tree.slide_var[b->slider];
+        return var >= 0 ? c->sv.pos[var] : 0.0;
+    }
+    double p[3][2];
+    for (int k = 0; k < 3; k++)
+        kin_point(&c->sv.p->tree, &c->sv.ks, b->point[k], p[k], NULL, NULL);
+    if (b->kind == MECH_BRANCH_X)
+        return p[0][0] - p[1][0];
+    if (b->kind == MECH_BRANCH_Y)
+        return p[0][1] - p[1][1];
+    return (p[1][0] - p[0][0]) * (p[2][1] - p[1][1]) - (p[1][1] - p[0][1]) * (p[2][0] - p[1][0]);
+}
+
+int cont_branches_hold(cont *c, int *which, int continuing)
 {
     const mech_model *m = c->m;
     for (int b = 0; b < m->nbranches; b++) {
-        double p[3][2];
-        for (int k = 0; k < 3; k++)
-            kin_point(&c->sv.p->tree, &c->sv.ks, m->branches[b].point[k], p[k], NULL, NULL);
-        double cross = (p[1][0] - p[0][0]) * (p[2][1] - p[1][1]) -
-                       (p[1][1] - p[0][1]) * (p[2][0] - p[1][0]);
-        if (cross * m->branches[b].sign <= 0.0) {
+        if (continuing && m->branches[b].first_only)
+            continue;
+        if (branch_value(c, &m->branches[b]) * m->branches[b].sign <= 0.0) {
             *which = b;
             return 0;
         }
@@ -180,7 +194,7 @@ step_status cont_try(cont *c, double qn, int continuing)
     int b;
     if (c->m->nbranches) {  /* the branch test needs the point positions */
         solver_publish(sv, qn, c->qd, c->qdd);  /* the row's own, unless rejected */
-        if (!cont_branches_hold(c, &b))
+        if (!cont_branches_hold(c, &b, continuing))
             return STEP_BRANCH;
     }
     return STEP_OK;
@@ -287,9 +301,10 @@ int cont_start(cont *c, double q)
         if (s == STEP_OK)
             break;
         if (s == STEP_BRANCH)
-            cont_branches_hold(c, &branch);
+            cont_branches_hold(c, &branch, 0);
     }
     if (s != STEP_OK) {
+        c->fail_status = first == STEP_SINGULAR ? STEP_SINGULAR : s;
         diagnose_start(c, q, first, first_resid, first_loop, branch, attempts);
         return MECH_ESOLVE;
     }
@@ -304,6 +319,84 @@ int cont_start(cont *c, double q)
     memcpy(c->xq0, c->xqc, bytes);
     memcpy(c->xqq0, c->xqqc, bytes);
     return MECH_OK;
+}
+
+/* Keep the solved row at q as the base and as row 0's copy. */
+static void set_start(cont *c, double q)
+{
+    solver *sv = &c->sv;
+    note_stats(c, q);
+    c->qc = q;
+    c->det_sign = 0;  /* another interval may have the other sign */
+    accept(c, q);
+    c->have_prev = 0;
+    c->q0 = q;
+    size_t bytes = (size_t)sv->p->ns * sizeof(double);
+    memcpy(c->x0, c->xc, bytes);
+    memcpy(c->xq0, c->xqc, bytes);
+    memcpy(c->xqq0, c->xqqc, bytes);
+}
+
+/* Scattered starting values for every unknown, guessed or not. */
+static void scatter_all(cont *c, unsigned *rng)
+{
+    const solver_plan *sp = c->sv.p;
+    for (int i = 0; i < sp->ns; i++) {
+        double u = (double)(next_random(rng) & 0xffff) / 65536.0 - 0.5;
+        c->sv.x[i] = sp->sys->unk_kind[sp->col[i]] == UNK_ANGLE ? 2.0 * PI * u : 4.0 * sp->lref * u;
+    }
+}
+
+/* Scattered starts tried at each row of a gap. */
+enum { RESTART_ATTEMPTS = 16 };
+
+int cont_restart(cont *c, double q)
+{
+    solver *sv = &c->sv;
+    const solver_plan *sp = sv->p;
+    unsigned rng = 20261125u;
+    int attempts = sp->ns <= 50 ? RESTART_ATTEMPTS : 2;
+    for (int a = 0; a < attempts; a++) {
+        if (a == 0)
+            memcpy(sv->x, c->xgap, (size_t)sp->ns * sizeof *sv->x);
+        else if (a == 1)
+            cont_start_values(c, 0, &rng);
+        else
+            scatter_all(c, &rng);
+        if (cont_try(c, q, 0) != STEP_OK)
+            continue;
+        for (int i = 0; i < sp->ns; i++)  /* angles continuous across the gap */
+            if (sp->sys->unk_kind[sp->col[i]] == UNK_ANGLE)
+                sv->x[i] -= 2.0 * PI * nearbyint((sv->x[i] - c->xgap[i]) / (2.0 * PI));
+        c->searching = 0;
+        set_start(c, q);
+        return MECH_OK;
+    }
+    return MECH_ESOLVE;
+}
+
+double cont_limit_behind(cont *c, double qback, double hmin, int *found)
+{
+    int searching = c->searching;
+    c->searching = 1;
+    *found = cont_advance(c, qback, hmin) != STEP_OK;
+    c->searching = searching;
+    return c->qc;
+}
+
+step_status cont_solve_at(cont *c, double q, const double *x)
+{
+    memcpy(c->sv.x, x, (size_t)c->sv.p->ns * sizeof *c->sv.x);
+    return cont_try(c, q, 0);
+}
+
+void cont_back_to_start(cont *c)
+{
+    solver *sv = &c->sv;
+    if (cont_solve_at(c, c->q0, c->x0) != STEP_OK)  /* from its own solution: one iteration */
+        memcpy(sv->x, c->x0, (size_t)sv->p->ns * sizeof *sv->x);
+    cont_set_base(c, c->q0, c->x0, c->xq0, c->xqq0);
+    c->det_sign = solver_det_sign(sv);
 }
 
 /* Make (q, x, x_q, x_qq) the base of the continuation. */

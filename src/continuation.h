@@ -33,6 +33,8 @@ typedef struct cont {
     /* row 0, kept to look for the assembly range after a failure */
     double q0, *x0, *xq0, *xqq0;
     double *guess;             /* [n] the file's guess of each unknown, NAN if none */
+    double *xgap;              /* [ns] the last position before a gap (restarts) */
+    double *xqgap, *xqqgap;    /* [ns] its rates */
     int row_iters;             /* Newton iterations spent on the current row */
     int row_substeps;          /* extra continuation steps the row needed (refinement) */
     int det_sign;              /* sign of det J at the base (0: unknown) */
@@ -44,6 +46,7 @@ typedef struct cont {
     step_status fail_status;
     double fail_resid;         /* residual and worst loop of the first rejected attempt */
     int fail_loop;
+    int fail_change_point;     /* the last singular position diagnosed was a change point */
 } cont;
 
 /* A walk on the plan's mechanism; messages go to d, worst values to st. */
@@ -52,6 +55,19 @@ void cont_free(cont *c);
 
 /* Row 0 at q: MECH_OK, or MECH_ESOLVE with the reason reported. */
 int cont_start(cont *c, double q);
+/* After a gap, the row at q: Newton from the last position before the gap,
+ * the guesses and scattered starts, on the declared branch; quiet. On
+ * success (MECH_OK) the row is solved and becomes the base and row 0's copy
+ * (for later diagnoses); angles are taken nearest to those before the gap. */
+int cont_restart(cont *c, double q);
+/* From the base (just set by cont_restart) back toward qback: the limit of
+ * assembly between them, to within hmin (*found: the march failed before
+ * qback); the base is left there. */
+double cont_limit_behind(cont *c, double qback, double hmin, int *found);
+/* Newton at q from x, with the checks of a first position (cont_try). */
+step_status cont_solve_at(cont *c, double q, const double *x);
+/* The row kept by cont_restart solved again and made the base. */
+void cont_back_to_start(cont *c);
 /* From the base to q by continuation, halving rejected steps down to hmin. */
 step_status cont_advance(cont *c, double q, double hmin);
 /* Make (q, x, x_q, x_qq) the base of the continuation. */
@@ -65,7 +81,8 @@ void cont_start_values(cont *c, int attempt, unsigned *rng);
  * (continuing: against the prediction). */
 step_status cont_try(cont *c, double qn, int continuing);
 /* Every declared branch condition holds at the published position (else
- * *which is the first that does not). */
-int cont_branches_hold(cont *c, int *which);
+ * *which is the first that does not); continuing: not those that hold at
+ * the first position only. */
+int cont_branches_hold(cont *c, int *which, int continuing);
 
 #endif

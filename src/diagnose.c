@@ -167,6 +167,51 @@ static void list_large(const solver *sv, const double *v, int loops, char *buf, 
     }
 }
 
+/* Another pin of link li than joint j (revolute or slider point), or -1. */
+static int other_pin(const mech_model *m, int li, int j)
+{
+    for (int k = 0; k < m->njoints; k++)
+        for (int side = 0; side < 2 && k != j; side++)
+            if (m->joints[k].link[side] == li)
+                return m->links[li].points[m->joints[k].point[side]].id;
+    return -1;
+}
+
+/* Which two moving links, pinned together, lie most nearly in line at the
+ * position x (q): "coupler and rocker extended in line" (their pin between
+ * their other pins) or "... folded in line"; "" when no pair is within
+ * 1e-3 rad of it. Publishes x (diagnostics only). */
+static void in_line_text(solver *sv, double q, const double *x, char *buf, size_t size)
+{
+    const mech_model *m = sv->p->m;
+    memcpy(sv->x, x, (size_t)sv->p->ns * sizeof *sv->x);
+    sv->generation++;
+    solver_publish(sv, q, 0.0, 0.0);
+    double best = 1.0 - 5e-7;  /* cos of 1e-3 rad */
+    buf[0] = '\0';
+    for (int j = 0; j < m->njoints; j++) {
+        const mech_joint *jt = &m->joints[j];
+        if (jt->kind != MECH_JOINT_REVOLUTE || jt->link[0] == 0 || jt->link[1] == 0)
+            continue;
+        int pin = m->links[jt->link[0]].points[jt->point[0]].id;
+        int q1 = other_pin(m, jt->link[0], j), q2 = other_pin(m, jt->link[1], j);
+        if (q1 < 0 || q2 < 0 || q1 == pin || q2 == pin)
+            continue;
+        double p[2], a[2], b[2];
+        kin_point(&sv->p->tree, &sv->ks, pin, p, NULL, NULL);
+        kin_point(&sv->p->tree, &sv->ks, q1, a, NULL, NULL);
+        kin_point(&sv->p->tree, &sv->ks, q2, b, NULL, NULL);
+        double ux = a[0] - p[0], uy = a[1] - p[1], vx = b[0] - p[0], vy = b[1] - p[1];
+        double nu = hypot(ux, uy), nv = hypot(vx, vy);
+        double cs = nu > 0 && nv > 0 ? (ux * vx + uy * vy) / (nu * nv) : 0.0;
+        if (fabs(cs) > best) {
+            best = fabs(cs);
+            snprintf(buf, size, "%s and %s %s in line", m->links[jt->link[0]].name,
+                     m->links[jt->link[1]].name, cs < 0 ? "extended" : "folded");
+        }
+    }
+}
+
 /* At a singular position, is the driver's column -f_q in the range of J
  * (w . f_q = 0 for the left null vector w)? Then the solution curve goes on
  * through the position and another crosses it: a change point. Otherwise
@@ -194,8 +239,10 @@ void diagnose_singular(cont *c, double q)
     const char *kind = "a dead point, toggle or limit position";
     double *right = xcalloc((size_t)sv->p->ns + 1, sizeof *right);
     double *left = xcalloc((size_t)sv->p->nr + 1, sizeof *left);
+    char line[200] = "", kindb[512];
+    c->fail_change_point = 0;
     if (right && left && dense_null(sv, right, left) == 0) {
-        if (is_change_point(sv, left))
+        if ((c->fail_change_point = is_change_point(sv, left)))
             kind = "a change point, where two assembly branches cross";
         snprintf(what, sizeof what, ": the unknowns ");
         list_large(sv, right, 0, what, sizeof what);
@@ -208,16 +255,67 @@ void diagnose_singular(cont *c, double q)
     }
     free(right);
     free(left);
+    double *xs = xcalloc((size_t)sv->p->ns + 1, sizeof *xs);
+    if (xs && !c->fail_change_point) {
+        memcpy(xs, sv->x, (size_t)sv->p->ns * sizeof *xs);
+        in_line_text(sv, q, xs, line, sizeof line);
+        memcpy(sv->x, xs, (size_t)sv->p->ns * sizeof *xs);
+    }
+    free(xs);
+    if (line[0]) {
+        snprintf(kindb, sizeof kindb, "%s (%s%s)", kind, line,
+                 c->m->driver.kind == MECH_DRIVE_SLIDER ? ": dead centre of the slider" : "");
+        kind = kindb;
+    }
     diag_error(c->d, c->m->file, c->m->driver.mark,
                "singular position at %s = %s (reciprocal condition %.2g, limit %.2g): %s%s; "
                "velocities there are not unique", diagnose_driver_word(c->m),
                diagnose_q_text(c->m, q, qb, sizeof qb), sv->rcond, sv->p->opt.min_rcond, kind, what);
 }
 
+/* Modified Gram-Schmidt over the rows of a (nr x ns, dense), in order,
+ * keeping each reduced row as a combination cf (nr x nr) of the original
+ * rows: a row left with less than 1e-8 of its length is implied by those
+ * before it, and its combination is a left null vector w (w^T J = 0). For
+ * each, named[] gets the equation with the largest |w| (on a tie, the later
+ * one): an equation that takes part in the dependency. Returns the count. */
+static int dependent_rows(int nr, int ns, double *a, double *cf, int *named)
+{
+    int count = 0;
+    for (int i = 0; i < nr; i++) {
+        double *ri = a + (size_t)i * ns, *ci = cf + (size_t)i * nr, len0 = 0.0, len = 0.0;
+        ci[i] = 1.0;
+        for (int col = 0; col < ns; col++)
+            len0 += ri[col] * ri[col];
+        for (int j = 0; j < i; j++) {
+            double *rj = a + (size_t)j * ns, *cj = cf + (size_t)j * nr, dot = 0.0, nj = 0.0;
+            for (int col = 0; col < ns; col++)
+                dot += ri[col] * rj[col], nj += rj[col] * rj[col];
+            if (!(nj > 0.0))
+                continue;
+            for (int col = 0; col < ns; col++)
+                ri[col] -= dot / nj * rj[col];
+            for (int k = 0; k <= j; k++)
+                ci[k] -= dot / nj * cj[k];
+        }
+        for (int col = 0; col < ns; col++)
+            len += ri[col] * ri[col];
+        if (len > 1e-16 * len0)
+            continue;
+        for (int col = 0; col < ns; col++)
+            ri[col] = 0.0;
+        int best = i;
+        for (int k = 0; k <= i; k++)
+            if (fabs(ci[k]) >= (1.0 - 1e-9) * fabs(ci[best]))
+                best = k;
+        named[count++] = best;
+    }
+    return count;
+}
+
 /* With redundant constraints (more loop equations than unknowns), say which
- * equations are implied by the others at the first position: modified
- * Gram-Schmidt over the rows of J, in order; a row left with less than 1e-8
- * of its length is redundant. Small systems only (dense). */
+ * equations are implied by the others at the first position, by the rows'
+ * dependencies (dependent_rows). Small systems only (dense). */
 void diagnose_redundant(cont *c, double q)
 {
     solver *sv = &c->sv;
@@ -225,44 +323,52 @@ void diagnose_redundant(cont *c, double q)
     if (!sv->p->aug || nr > 400)
         return;
     double *a = xcalloc((size_t)nr * (size_t)ns + 1, sizeof *a);
-    if (!a)
+    double *cf = xcalloc((size_t)nr * (size_t)nr + 1, sizeof *cf);
+    int *named = xcalloc((size_t)nr + 1, sizeof *named);
+    if (!a || !cf || !named) {
+        free(a);
+        free(cf);
+        free(named);
         return;
+    }
     for (int col = 0, k = 0; col < ns; col++)
         for (int p = sv->p->Ap[nr + col]; p < sv->p->Ap[nr + col + 1]; p++, k++)
             a[(size_t)sv->p->Ai[p] * ns + col] = sv->Jv[k];
+    int count = dependent_rows(nr, ns, a, cf, named);
     char list[600] = "", lb[256], qb[64];
     size_t at = 0;
-    int count = 0;
-    for (int i = 0; i < nr; i++) {
-        double *ri = a + (size_t)i * ns, len0 = 0.0, len = 0.0;
-        for (int col = 0; col < ns; col++)
-            len0 += ri[col] * ri[col];
-        for (int j = 0; j < i; j++) {
-            double *rj = a + (size_t)j * ns, dot = 0.0, nj = 0.0;
-            for (int col = 0; col < ns; col++)
-                dot += ri[col] * rj[col], nj += rj[col] * rj[col];
-            if (nj > 0.0)
-                for (int col = 0; col < ns; col++)
-                    ri[col] -= dot / nj * rj[col];
-        }
-        for (int col = 0; col < ns; col++)
-            len += ri[col] * ri[col];
-        if (len <= 1e-16 * len0) {
-            for (int col = 0; col < ns; col++)
-                ri[col] = 0.0;
-            if (at < sizeof list)
-                at += (size_t)snprintf(list + at, sizeof list - at, "%s%s equation of %s",
-                                       count++ ? ", " : "", sv->p->row[i] % 2 ? "y" : "x",
-                                       diagnose_loop_label(sv, sv->p->row[i] / 2, lb, sizeof lb));
-        }
-    }
+    for (int i = 0; i < count && at < sizeof list; i++)
+        at += (size_t)snprintf(list + at, sizeof list - at, "%s%s equation of %s",
+                               i ? ", " : "", sv->p->row[named[i]] % 2 ? "y" : "x",
+                               diagnose_loop_label(sv, sv->p->row[named[i]] / 2, lb, sizeof lb));
     free(a);
+    free(cf);
+    free(named);
     diag_warning(c->d, c->m->file, c->m->driver.mark,
                  "redundant constraints: at %s = %s the %d loop equations have rank %d; "
                  "implied by the others: the %s; the mechanism moves because "
                  "they are consistent, and it is solved in the least-squares sense (joint "
                  "reactions are not unique)", diagnose_driver_word(c->m),
                  diagnose_q_text(c->m, q, qb, sizeof qb), nr, nr - count, count ? list : "(none found)");
+}
+
+const char *diagnose_branch_text(const mech_model *m, const mech_branch *b, char *buf,
+                                 size_t size)
+{
+    const char *const *pn = (const char *const *)m->point_names;
+    if (b->kind == MECH_BRANCH_TURN)
+        snprintf(buf, size, "%s-%s-%s turning %s", pn[b->point[0]], pn[b->point[1]],
+                 pn[b->point[2]], b->sign > 0 ? "counter-clockwise" : "clockwise");
+    else if (b->kind == MECH_BRANCH_X)
+        snprintf(buf, size, "%s %s of %s", pn[b->point[0]], b->sign > 0 ? "right" : "left",
+                 pn[b->point[1]]);
+    else if (b->kind == MECH_BRANCH_Y)
+        snprintf(buf, size, "%s %s %s", pn[b->point[0]], b->sign > 0 ? "above" : "below",
+                 pn[b->point[1]]);
+    else
+        snprintf(buf, size, "slider %s %s", m->joints[b->slider].name,
+                 b->sign > 0 ? "positive" : "negative");
+    return buf;
 }
 
 void diagnose_start(cont *c, double q, step_status first, double resid, int loop, int branch,
@@ -272,12 +378,12 @@ void diagnose_start(cont *c, double q, step_status first, double resid, int loop
     char qb[64], lb[256];
     if (branch >= 0) {
         const mech_branch *b = &m->branches[branch];
+        char what[200];
         diag_error(c->d, m->file, b->mark,
-                   "at %s = %s the mechanism assembles, but not with %s-%s-%s turning %s "
+                   "at %s = %s the mechanism assembles, but not with %s "
                    "(from the initial guesses%s); check the guesses or the branch",
                    diagnose_driver_word(m), diagnose_q_text(m, q, qb, sizeof qb),
-                   m->point_names[b->point[0]], m->point_names[b->point[1]],
-                   m->point_names[b->point[2]], b->sign > 0 ? "counter-clockwise" : "clockwise",
+                   diagnose_branch_text(m, b, what, sizeof what),
                    attempts > 1 ? " and other starts" : "");
         return;
     }
@@ -346,9 +452,30 @@ static int at_limit(cont *c)
     return limit;
 }
 
+/* "; at 109.4712206 deg, coupler and rocker extended in line" at the limit
+ * the sweep reached (the base of the continuation), to the digits the
+ * refinement (1e-9 of a row) reached; "" when no links are in line. */
+static void limit_words(cont *c, double hrow, char *why, size_t size)
+{
+    const mech_model *m = c->m;
+    char line[200];
+    double upper = c->qc;
+    why[0] = '\0';
+    in_line_text(&c->sv, upper, c->xc, line, sizeof line);
+    if (!line[0])
+        return;
+    double unit = is_angle_driver(m) ? 180.0 / PI : 1e3;
+    double acc = fmax(1e-9 * fabs(hrow), 1e-11 * fmax(fabs(upper), fabs(hrow))) * unit;
+    int dec = (int)floor(-log10(acc)) - 1;
+    snprintf(why, size, "; at %.*f %s, %s%s", dec < 0 ? 0 : dec > 12 ? 12 : dec, upper * unit,
+             is_angle_driver(m) ? "deg" : "mm", line,
+             is_angle_driver(m) ? "" : ": dead centre of the slider");
+}
+
 /* The interval(s) where the mechanism assembles, from row 0 and the last
  * position reached: "from A to B[ and from C to D] (limit positions...)". */
-static void assembly_range(cont *c, double q_row, double hrow, char *buf, size_t size)
+static void assembly_range(cont *c, double q_row, double hrow, const char *why, char *buf,
+                           size_t size)
 {
     const mech_model *m = c->m;
     char qb[64], qc[64], qd[64], qe[64], more[200] = "";
@@ -361,10 +488,10 @@ static void assembly_range(cont *c, double q_row, double hrow, char *buf, size_t
     if (found && is_angle_driver(m) && other_interval(c, lo, hi, fabs(hrow), &lo2, &hi2))
         snprintf(more, sizeof more, " and from %s to %s", diagnose_q_text(m, lo2, qd, sizeof qd),
                  diagnose_q_text(m, hi2, qe, sizeof qe));
-    snprintf(buf, size, "the mechanism assembles for %s from %s%s to %s%s (limit positions%s)",
+    snprintf(buf, size, "the mechanism assembles for %s from %s%s to %s%s (limit positions%s%s)",
              diagnose_driver_word(m), found || lo == lower ? "" : "at most ",
              diagnose_q_text(m, lo, qb, sizeof qb), diagnose_q_text(m, hi, qc, sizeof qc), more,
-             found ? "" : "; the other side was not searched past one range");
+             found ? "" : "; the other side was not searched past one range", why);
 }
 
 void diagnose_failure(cont *c, double q_row, double hrow)
@@ -380,7 +507,9 @@ void diagnose_failure(cont *c, double q_row, double hrow)
        (a row on the limit itself is a singular position, below) */
     if (s == STEP_SINGULAR && fabs(q_row - fq) > 1e-6 * fabs(hrow) && at_limit(c)) {
         double rcond = sv->rcond;
-        assembly_range(c, q_row, hrow, range, sizeof range);
+        char why[300];
+        limit_words(c, hrow, why, sizeof why);
+        assembly_range(c, q_row, hrow, why, range, sizeof range);
         diag_error(c->d, m->file, m->driver.mark,
                    "cannot assemble at %s = %s: the sweep reached a limit position at %s "
                    "(reciprocal condition %.2g), past which %s does not close; %s",
@@ -394,7 +523,9 @@ void diagnose_failure(cont *c, double q_row, double hrow)
         return;
     }
     if (s == STEP_NO_ASSEMBLY) {
-        assembly_range(c, q_row, hrow, range, sizeof range);
+        char why[300];
+        limit_words(c, hrow, why, sizeof why);
+        assembly_range(c, q_row, hrow, why, range, sizeof range);
         diag_error(c->d, m->file, m->driver.mark,
                    "cannot assemble at %s = %s: %s does not close (residual %.3g m); %s",
                    diagnose_driver_word(m), diagnose_q_text(m, q_row, qa, sizeof qa),

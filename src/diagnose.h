@@ -13,6 +13,9 @@ const char *diagnose_q_text(const mech_model *m, double q, char *buf, size_t siz
 const char *diagnose_driver_word(const mech_model *m);
 /* "loop 2 (A-B-C-D-A)" */
 const char *diagnose_loop_label(const solver *sv, int k, char *buf, size_t size);
+/* "A-B-C turning clockwise", "D right of C", "B above O", "slider s positive". */
+const char *diagnose_branch_text(const mech_model *m, const mech_branch *b, char *buf,
+                                 size_t size);
 /* The loop that closes worst at the current iterate. */
 int diagnose_worst_loop(const solver *sv);
 

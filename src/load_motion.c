@@ -280,6 +280,101 @@ static int branch_can_turn(loader *ld, const ynode *b, const mech_branch *br)
     return 1;
 }
 
+/* A side condition whose points never differ strictly in the direction
+ * asked: one point named twice, the two at one place on a link, or both on
+ * the ground on the wrong side (or level). Reported; returns 0. */
+static int branch_can_side(loader *ld, const ynode *b, const mech_branch *br, const char *word)
+{
+    const mech_model *m = ld->m;
+    const char *a = m->point_names[br->point[0]], *c = m->point_names[br->point[1]];
+    if (br->point[0] == br->point[1])
+        return load_err(ld, b, "branch condition '%s %s %s' names one point twice, so it never "
+                               "holds", a, word, c), 0;
+    int first, end;
+    load_carriers_of(ld, br->point[0], &first, &end);
+    for (int k = first; k < end; k++) {
+        int li = ld->carrier_link[k], i1 = load_point_in_link(ld, li, br->point[1]);
+        if (i1 < 0 || ld->link_failed[li])
+            continue;
+        const mech_link *l = &m->links[li];
+        const mech_point *p0 = &l->points[ld->carrier_point[k]], *p1 = &l->points[i1];
+        double dx = p0->x - p1->x, dy = p0->y - p1->y, size = fmax(fabs(p0->x), fabs(p0->y));
+        double size1 = fmax(fmax(fabs(p1->x), fabs(p1->y)), size);
+        double d = br->kind == MECH_BRANCH_X ? dx : dy;
+        if (fabs(dx) <= 1e-12 * size1 && fabs(dy) <= 1e-12 * size1)
+            return load_err(ld, b, "branch condition '%s %s %s': the two points are at one "
+                                   "place on link '%s', so it never holds", a, word, c,
+                            l->name), 0;
+        if (l->is_ground && !(d * br->sign > 1e-12 * size1))
+            return load_err(ld, b, "branch condition '%s %s %s': both points are fixed on the "
+                                   "ground, and %s is not %s %s", a, word, c, a, word, c), 0;
+    }
+    return 1;
+}
+
+/* {points: [A, B, C], turn: ccw|cw} */
+static int branch_turn(loader *ld, const ynode *b, const ynode *pts, mech_branch *br)
+{
+    const ynode *turn = ymap_get(b, "turn");
+    if (!turn)
+        return load_err(ld, b, "a branch condition with 'points' needs 'turn: ccw' or 'cw'"), 0;
+    if (pts->kind != YNODE_SEQ || pts->n != 3)
+        return load_err(ld, pts, "'points' of a branch condition must list three points"), 0;
+    int ok = 1;
+    for (int k = 0; k < 3; k++)
+        ok = (br->point[k] = load_find_point_or_report(ld, pts->items[k], "branch point")) >= 0
+             && ok;
+    if (turn->kind == YNODE_SCALAR && strcmp(turn->text, "ccw") == 0)
+        br->sign = 1;
+    else if (turn->kind == YNODE_SCALAR && strcmp(turn->text, "cw") == 0)
+        br->sign = -1;
+    else
+        ok = 0, load_err(ld, turn, "'turn' must be 'ccw' (counter-clockwise) or 'cw' (clockwise)");
+    return ok && branch_can_turn(ld, b, br);
+}
+
+/* {point: D, right_of|left_of|above|below: C} */
+static int branch_side(loader *ld, const ynode *b, const ynode *pt, mech_branch *br)
+{
+    static const char *const words[] = {"right_of", "left_of", "above", "below"};
+    const ynode *other = NULL;
+    int w = -1;
+    for (int k = 0; k < 4; k++)
+        if (ymap_get(b, words[k])) {
+            if (other)
+                return load_err(ld, b, "a branch condition gives one of right_of, left_of, "
+                                       "above, below"), 0;
+            other = ymap_get(b, words[k]), w = k;
+        }
+    if (!other)
+        return load_err(ld, b, "a branch condition with 'point' needs 'right_of', 'left_of', "
+                               "'above' or 'below' another point"), 0;
+    br->kind = w < 2 ? MECH_BRANCH_X : MECH_BRANCH_Y;
+    br->sign = w % 2 == 0 ? 1 : -1;
+    int ok = (br->point[0] = load_find_point_or_report(ld, pt, "branch point")) >= 0;
+    ok = (br->point[1] = load_find_point_or_report(ld, other, "branch point")) >= 0 && ok;
+    br->point[2] = br->point[1];
+    static const char *const shown[] = {"right of", "left of", "above", "below"};
+    return ok && branch_can_side(ld, b, br, shown[w]);
+}
+
+/* {slider: S, sign: positive|negative} */
+static int branch_slider(loader *ld, const ynode *b, const ynode *sl, mech_branch *br)
+{
+    const ynode *sign = ymap_get(b, "sign");
+    br->kind = MECH_BRANCH_SLIDER;
+    br->point[0] = br->point[1] = br->point[2] = -1;
+    int ok = (br->slider = load_slider_by_name(ld, sl, "branch slider")) >= 0;
+    if (sign && sign->kind == YNODE_SCALAR && strcmp(sign->text, "positive") == 0)
+        br->sign = 1;
+    else if (sign && sign->kind == YNODE_SCALAR && strcmp(sign->text, "negative") == 0)
+        br->sign = -1;
+    else
+        ok = 0, load_err(ld, sign ? sign : b, "a slider branch condition needs 'sign: positive' "
+                                              "or 'negative'");
+    return ok;
+}
+
 void load_branches(loader *ld, const ynode *seq)
 {
     mech_model *m = ld->m;
@@ -292,33 +387,27 @@ void load_branches(loader *ld, const ynode *seq)
     if (!m->branches)
         return (void)load_err(ld, seq, "out of memory");
     for (size_t i = 0; i < seq->n; i++) {
-        static const char *const keys[] = {"points", "turn"};
+        static const char *const keys[] = {"points", "turn", "point", "right_of", "left_of",
+                                           "above", "below", "slider", "sign", "first_only"};
         const ynode *b = seq->items[i];
         if (!load_check_keys(ld, b, keys, COUNT(keys), "a branch condition"))
             continue;
-        const ynode *pts = ymap_get(b, "points"), *turn = ymap_get(b, "turn");
-        if (!pts || !turn) {
-            load_err(ld, b, "a branch condition needs 'points: [A, B, C]' and 'turn: ccw' or 'cw'");
-            continue;
-        }
+        const ynode *pts = ymap_get(b, "points"), *pt = ymap_get(b, "point"),
+                    *sl = ymap_get(b, "slider"), *fo = ymap_get(b, "first_only");
         mech_branch *br = &m->branches[m->nbranches];
+        memset(br, 0, sizeof *br);
         br->mark = b->mark;
-        if (pts->kind != YNODE_SEQ || pts->n != 3) {
-            load_err(ld, pts, "'points' of a branch condition must list three points");
-            continue;
-        }
-        int ok = 1;
-        for (int k = 0; k < 3; k++)
-            ok = (br->point[k] = load_find_point_or_report(ld, pts->items[k], "branch point")) >= 0
-                 && ok;
-        if (turn->kind == YNODE_SCALAR && strcmp(turn->text, "ccw") == 0)
-            br->sign = 1;
-        else if (turn->kind == YNODE_SCALAR && strcmp(turn->text, "cw") == 0)
-            br->sign = -1;
+        br->slider = -1;
+        int ok = 0;
+        if ((pts != NULL) + (pt != NULL) + (sl != NULL) != 1)
+            load_err(ld, b, "a branch condition is one of {points: [A, B, C], turn: ccw|cw}, "
+                            "{point: D, right_of|left_of|above|below: C}, {slider: S, sign: "
+                            "positive|negative}");
         else
-            ok = 0, load_err(ld, turn, "'turn' must be 'ccw' (counter-clockwise) or 'cw' (clockwise)");
-        if (ok)
-            ok = branch_can_turn(ld, b, br);
+            ok = pts ? branch_turn(ld, b, pts, br)
+                 : pt ? branch_side(ld, b, pt, br) : branch_slider(ld, b, sl, br);
+        if (ok && fo && !load_get_bool(ld, fo, "'first_only'", &br->first_only))
+            ok = 0;
         if (ok)
             m->nbranches++;
     }

@@ -40,6 +40,7 @@ void mech_table_free(mech_table *t)
     }
     free(t->columns);
     free(t->values);
+    free(t->gaps);
     memset(t, 0, sizeof *t);
 }
 

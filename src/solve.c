@@ -75,9 +75,14 @@ static void needed_unknowns(solver_plan *sp, unsigned char *need)
         if (var >= 0 && var < sp->n)
             need[var] = 1;
     }
-    for (int b = 0; b < m->nbranches; b++)
-        for (int k = 0; k < 3; k++)
-            kin_need_point(&sp->tree, m->branches[b].point[k], need);
+    for (int b = 0; b < m->nbranches; b++) {
+        const mech_branch *br = &m->branches[b];
+        int var = br->kind == MECH_BRANCH_SLIDER ? sp->tree.slide_var[br->slider] : -1;
+        if (var >= 0 && var < sp->n)
+            need[var] = 1;
+        for (int k = 0; k < 3 && br->kind != MECH_BRANCH_SLIDER; k++)
+            kin_need_point(&sp->tree, br->point[k], need);
+    }
 }
 
 /* Short name of an unknown for messages. */
@@ -599,6 +604,7 @@ step_status solver_newton(solver *sv, double q)
        those of x before it: less than tol/100 away, which moves the rates
        by about that relative to the condition (docs/solver.md, section 2). */
     double xtol = 1e-2 * sp->opt.tol;
+    int polish = 0;
     for (int it = 0;; it++) {
         if (!isfinite(r))
             return STEP_NO_ASSEMBLY;
@@ -613,6 +619,18 @@ step_status solver_newton(solver *sv, double q)
         /* converged: residual small, and the step too, or no longer shrinking
            (the rounding floor of an ill-conditioned position) */
         if (r <= sp->ftol && (step <= xtol || step >= 0.9 * prev_step)) {
+            /* least squares: the rates' solve amplifies what the last
+               correction leaves in the factors (the augmented matrix's
+               condition is about J's squared), so correct and refactor until
+               the correction is at rounding (at most 3 more iterations) */
+            if (sp->aug && step <= xtol && step > 16 * DBL_EPSILON && polish++ < 3) {
+                for (int i = 0; i < ns; i++)
+                    sv->x[i] -= sv->dx[i];
+                r = evaluate(sv, sv->x, q, sv->f);
+                prev_step = step;
+                sv->iters = it + 1;
+                continue;
+            }
             sv->resid = r;
             sv->iters = it;
             if (step <= xtol)  /* a real (not noise) correction: take it */

@@ -105,8 +105,7 @@ static int copy_outputs(mech_outputs *to, const mech_outputs *from)
         mech_outputs_free(to);
         return -1;
     }
-    /* an empty list may be NULL, and memcpy from NULL is undefined even for 0 bytes */
-    if (from->npoints)
+    if (from->npoints)  /* an empty list may be NULL: memcpy from NULL is undefined */
         memcpy(to->points, from->points, (size_t)from->npoints * sizeof *to->points);
     if (from->nlinks)
         memcpy(to->links, from->links, (size_t)from->nlinks * sizeof *to->links);
@@ -199,6 +198,7 @@ typedef struct run {
     forces fc;
     mech_diag *d;
     mech_solve_stats *st;
+    mech_table *t;             /* rows are appended here */
     int refined_notes;         /* refinements reported so far */
 } run;
 
@@ -274,35 +274,165 @@ static int check_finite(run *r, double q, const double *out)
            MECH_ESOLVE;
 }
 
-/* Row `row` at driver position q: reach it, publish it, its forces, fill it. */
-static int solve_row(run *r, const double *q, int row, double *out)
+/* fill_row's status when the force analysis fails: the sweep stops there. */
+enum { ROW_STOP = 1 };
+
+/* Publish the reached row at q, its forces, append it to the table:
+ * MECH_OK, or ROW_STOP (the force analysis failed, reported). */
+static int fill_row(run *r, double q)
 {
     cont *c = &r->c;
-    c->row_iters = 0;
-    c->row_substeps = 0;
-    if (row == 0) {
-        if (cont_start(c, q[0]) != MECH_OK)
-            return MECH_ESOLVE;
-    } else {
-        double hrow = q[row] - q[row - 1];
-        if (cont_advance(c, q[row], 1e-9 * fmax(fabs(hrow), 1e-12)) != STEP_OK) {
-            diagnose_failure(c, q[row], hrow);
-            return MECH_ESOLVE;
-        }
-    }
-    note_refined(r, q[row]);
-    solver_publish(&c->sv, q[row], c->qd, c->qdd);
-    int rc = r->a->want_forces ? solve_forces(r, q[row]) : MECH_OK;
-    if (rc != MECH_OK)
-        return rc;
+    double *out = r->t->values + (size_t)r->t->nrows * (size_t)r->t->ncolumns;
+    note_refined(r, q);
+    solver_publish(&c->sv, q, c->qd, c->qdd);
+    if (r->a->want_forces && solve_forces(r, q) != MECH_OK)
+        return ROW_STOP;
     row_sources rs = {&c->sv, r->a->want_forces ? &r->fc : NULL, c->row_iters, c->row_substeps};
     columns_fill(&r->a->cols, &rs, out);
-    if ((rc = check_finite(r, q[row], out)) != MECH_OK)
-        return rc;
+    if (check_finite(r, q, out) != MECH_OK)
+        return ROW_STOP;
+    r->t->nrows++;
     r->st->iterations += c->row_iters;
     if (c->row_iters > r->st->max_iterations)
         r->st->max_iterations = c->row_iters;
     return MECH_OK;
+}
+
+/* With opt.limit_rows, a row at the limit q (solution near x) when the
+ * position is not singular there. */
+static int limit_row(run *r, double q, const double *x)
+{
+    cont *c = &r->c;
+    if (!r->a->opt.limit_rows)
+        return MECH_OK;
+    c->row_iters = 0;
+    c->row_substeps = 0;
+    return cont_solve_at(c, q, x) == STEP_OK ? fill_row(r, q) : MECH_OK;
+}
+
+static mech_gap_kind gap_kind(const cont *c, step_status s)
+{
+    switch (s) {
+    case STEP_SINGULAR:
+        return c->fail_change_point ? MECH_GAP_CHANGE_POINT : MECH_GAP_DEAD_POINT;
+    case STEP_BRANCH:
+        return MECH_GAP_BRANCH;
+    case STEP_JUMP:
+        return MECH_GAP_JUMP;
+    default:
+        return MECH_GAP_NO_ASSEMBLY;
+    }
+}
+
+/* The continuation failed before q[row]: why (diagnosed from the state of
+ * the failure), then the limit it reached refined to 1e-12 of the row
+ * spacing from the position kept before the diagnosis, kept for restarts,
+ * and its row. */
+static int failed_row(run *r, const double *q, int row, mech_gap *g)
+{
+    cont *c = &r->c;
+    size_t bytes = (size_t)c->sv.p->ns * sizeof(double);
+    double hrow = q[row] - q[row - 1], fq = c->fail_q, qbase = c->qc;
+    step_status s = c->fail_status;
+    memcpy(c->xgap, c->xc, bytes);
+    memcpy(c->xqgap, c->xqc, bytes);
+    memcpy(c->xqqgap, c->xqqc, bytes);
+    diagnose_failure(c, q[row], hrow);
+    *g = (mech_gap){gap_kind(c, s), row, row, qbase, qbase, 1, 0};
+    cont_set_base(c, qbase, c->xgap, c->xqgap, c->xqqgap);
+    c->searching = 1;
+    cont_advance(c, fq, 1e-12 * fmax(fabs(hrow), 1e-12));
+    g->from = c->qc;
+    memcpy(c->xgap, c->xc, bytes);
+    return limit_row(r, g->from, c->xgap);
+}
+
+/* After a gap, the row at q[row]: re-assembly, the limit behind it (and its
+ * row), then the row itself. MECH_ESOLVE when it does not assemble. */
+static int restart_row(run *r, const double *q, int row, mech_gap *g)
+{
+    cont *c = &r->c;
+    if (cont_restart(c, q[row]) != MECH_OK)
+        return MECH_ESOLVE;
+    int found = 0, rc = MECH_OK;
+    g->to = q[row];
+    if (row > 0) {
+        double h = 1e-12 * fmax(fabs(q[row] - q[row - 1]), 1e-12);
+        g->to = cont_limit_behind(c, q[row - 1], h, &found);
+        if (found)
+            rc = limit_row(r, g->to, c->xc);
+        cont_back_to_start(c);
+    }
+    g->to_limit = found;
+    c->row_iters = 0;  /* the search is not the row's work */
+    c->row_substeps = 0;
+    return rc != MECH_OK ? rc : fill_row(r, q[row]);
+}
+
+/* Row `row`: reach it (row 0 from the guesses, after a gap by a restart,
+ * else by continuation) and append it. MECH_ESOLVE when it cannot be
+ * reached (*g then describes the gap it opens), else fill_row's status. */
+static int solve_row(run *r, const double *q, int row, mech_gap *g, int in_gap)
+{
+    cont *c = &r->c;
+    c->row_iters = 0;
+    c->row_substeps = 0;
+    if (in_gap)
+        return restart_row(r, q, row, g);
+    if (row == 0) {
+        if (cont_start(c, q[0]) != MECH_OK) {
+            unsigned rng = 0;
+            cont_start_values(c, 0, &rng);
+            memcpy(c->xgap, c->sv.x, (size_t)c->sv.p->ns * sizeof *c->xgap);
+            *g = (mech_gap){gap_kind(c, c->fail_status), 0, 0, q[0], q[0], 0, 0};
+            return MECH_ESOLVE;
+        }
+    } else if (cont_advance(c, q[row], 1e-9 * fmax(fabs(q[row] - q[row - 1]), 1e-12)) !=
+               STEP_OK) {
+        int rc = failed_row(r, q, row, g);
+        return rc != MECH_OK ? rc : MECH_ESOLVE;
+    }
+    return fill_row(r, q[row]);
+}
+
+/* Append *g to the table's gaps (allocated only when a gap closes). */
+static int add_gap(mech_table *t, const mech_gap *g)
+{
+    mech_gap *more = realloc(t->gaps, (size_t)(t->ngaps + 1) * sizeof *more);
+    if (!more)
+        return -1;
+    t->gaps = more;
+    t->gaps[t->ngaps++] = *g;
+    return 0;
+}
+
+/* Every requested row that can be reached; the others as gaps. A failure
+ * of the forces stops the sweep (its status returned). */
+static int sweep_rows(run *r, const double *q, int nq)
+{
+    int status = MECH_OK, in_gap = 0;
+    mech_gap g = {0};
+    for (int row = 0; row < nq; row++) {
+        int rc = solve_row(r, q, row, &g, in_gap);
+        if (rc == MECH_OK) {
+            if (in_gap && add_gap(r->t, &g) != 0)
+                return no_memory(r->a->m, r->d);
+            in_gap = 0;
+            continue;
+        }
+        if (rc != MECH_ESOLVE)
+            return rc == ROW_STOP ? MECH_ESOLVE : rc;
+        status = MECH_ESOLVE;
+        g.last_row = row;
+        in_gap = 1;
+    }
+    if (in_gap) {
+        g.to = q[nq - 1];
+        g.to_limit = 0;
+        if (add_gap(r->t, &g) != 0)
+            return no_memory(r->a->m, r->d);
+    }
+    return status;
 }
 
 static void finish_stats(run *r, int rows, double t0)
@@ -346,16 +476,16 @@ int mech_analysis_solve(const mech_analysis *a, const double *q, int nq, mech_ta
         nq = a->nvalues;
     }
     int rc = too_large(a, nq, d) ? MECH_EINPUT : run_init(&r, a, d);
-    if (rc == MECH_OK && columns_make_table(&a->cols, out, nq) != MECH_OK)
+    /* with limit rows, at most one more per requested row and one more */
+    int capacity = a->opt.limit_rows ? 2 * nq + 1 : nq;
+    if (rc == MECH_OK && columns_make_table(&a->cols, out, capacity) != MECH_OK)
         rc = no_memory(a->m, d);
     double t0 = now_seconds();
-    int row = 0;
-    for (; rc == MECH_OK && row < nq; row++)
-        if ((rc = solve_row(&r, q, row, out->values + (size_t)row * (size_t)out->ncolumns)) !=
-            MECH_OK)
-            break;
-    out->nrows = row;
-    finish_stats(&r, row, t0);
+    out->nrequested = nq;
+    r.t = out;
+    if (rc == MECH_OK)
+        rc = sweep_rows(&r, q, nq);
+    finish_stats(&r, out->nrows, t0);
     forces_free(&r.fc);
     cont_free(&r.c);
     return rc;

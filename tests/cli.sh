@@ -219,16 +219,36 @@ run "mech solve unwritable output" 3 "$MECH" solve mechanisms/fourbar.yaml -o "$
 
 # crank 40, coupler 50, rocker 45, ground 60 mm: the loop closes while
 # |CA| <= 50 + 45, i.e. cos q >= (40^2 + 60^2 - 95^2) / (2 40 60): |q| <= 142.833 deg
-echo "keep me" >"$tmp/old.csv"
+# Partial sweeps (issue 17): the rows that exist are written, each gap is
+# listed with its limits, exit 1; --within-assembly makes that the request.
 if run "mech solve non-Grashof" 1 "$MECH" solve tests/solve/non-grashof.yaml -o "$tmp/old.csv"; then
     has_line "$tmp/err" 'cannot assemble at driver angle = 143 deg.*assembles for driver angle from -142.83[0-9]* deg to 142.83[0-9]* deg' "non-Grashof message"
-    [ "$(cat "$tmp/old.csv")" = "keep me" ] && pass || fail "a failed solve overwrote the output file"
+    has_line "$tmp/err" '^mech solve: gap: rows 144 to 218 of 361 (driver at 143.000000 deg to 217.000000 deg) not solved: the mechanism does not assemble; limits found: from 142.8327145[0-9] deg to 217.1672854[0-9] deg$' "non-Grashof gap"
+    has_line "$tmp/err" '^mech solve: 286 rows solved (361 positions requested); the rows solved are written$' "non-Grashof rows count"
+    has_line "$tmp/err" '(limit positions; at 142.8327145 deg, coupler and rocker extended in line)$' "non-Grashof: the links in line at the limit"
+    [ "$(wc -l <"$tmp/old.csv")" -eq 287 ] && pass || fail "non-Grashof: $(wc -l <"$tmp/old.csv") lines written, expected 287 (header and 286 rows)"
+fi
+run "mech solve non-Grashof --within-assembly" 0 "$MECH" solve tests/solve/non-grashof.yaml --within-assembly -o "$tmp/wa.csv" && pass
+if run "mech solve non-Grashof --range assembly" 0 "$MECH" solve tests/solve/non-grashof.yaml --range assembly -o "$tmp/ra.csv"; then
+    [ "$(wc -l <"$tmp/ra.csv")" -eq 289 ] && pass || fail "--range assembly: $(wc -l <"$tmp/ra.csv") lines, expected 289 (286 rows and the two limits)"
+    has_line "$tmp/ra.csv" '^2.492901' "--range assembly: a row at the limit 142.8327 deg (2.492901 rad)"
+fi
+if run "mech sweep with a partial variant" 0 "$MECH" sweep mechanisms/double-crank.yaml --vary 'l0=20mm:80mm:2' -o "$tmp/sw.csv"; then
+    has_line "$tmp/err" '^360 of 361 rows solved, 1 gap$' "sweep: rows and gaps of a partial variant"
+    has_line "$tmp/sw.csv" '^1,80 mm,no-assembly,360$' "sweep: the partial variant's rows"
+fi
+run "mech solve --range bogus" 2 "$MECH" solve tests/solve/non-grashof.yaml --range bogus && pass
+if run "mech solve change point --within-assembly" 1 "$MECH" solve tests/hard/change-point.yaml --within-assembly -o "$tmp/cp.csv"; then
+    has_line "$tmp/err" '^mech solve: gap: row 181 of 361 (driver at 180.000000 deg) not solved: a change point, where two assembly branches cross' "change-point gap"
 fi
 
 if run "mech solve dead centre" 1 "$MECH" solve tests/solve/dead-centre.yaml -o "$tmp/dc.csv"; then
     has_line "$tmp/err" 'singular position at driver displacement = 180 mm.*dead point.*th_crank (at 0.000 deg), th_rod (at 0.000 deg)' "dead-centre message"
-    [ -e "$tmp/dc.csv" ] && fail "a failed solve wrote an output file" || pass
+    has_line "$tmp/err" 'a dead point, toggle or limit position (crank and rod extended in line: dead centre of the slider)' "dead centre named"
+    has_line "$tmp/err" '^mech solve: gap: row 31 of 31 (driver at 180.000000 mm) not solved: a dead point or limit position the driver cannot pass; limits found: from 180.0000000[0-9]* mm$' "dead-centre gap"
+    [ "$(wc -l <"$tmp/dc.csv")" -eq 31 ] && pass || fail "dead centre: $(wc -l <"$tmp/dc.csv") lines written, expected 31"
 fi
+run "mech solve dead centre --within-assembly" 0 "$MECH" solve tests/solve/dead-centre.yaml --within-assembly -o "$tmp/dc2.csv" && pass
 
 if run "mech solve --forces --friction both" 0 "$MECH" solve mechanisms/conveyor.yaml --friction both --stats -o "$tmp/cv.csv"; then
     has_line "$tmp/cv.csv" '^q \[rad\],.*,O\.Fx \[N\],O\.Fy \[N\],O\.F \[N\],.*driver\.torque \[N\*m\],power\.residual \[-\],friction\.power \[W\],friction\.iterations \[-\],.*driver\.torque\.nofriction \[N\*m\],power\.residual\.nofriction \[-\]$' "--friction both header"
@@ -276,6 +296,7 @@ if run "mech batch all goldens" 0 "$MECH" batch -j 2 -q --out-dir "$tmp/bo" --go
 fi
 if run "mech batch with failures" 1 "$MECH" batch -j 3 mechanisms/fourbar.yaml tests/solve/non-grashof.yaml tests/bad/01-bad-indentation.yaml mechanisms/slider-crank.yaml; then
     has_line "$tmp/out" '^non-grashof  *FAILED' "batch: failing file reported"
+    has_line "$tmp/err" 'tests/solve/non-grashof.yaml: 286 of 361 rows solved, 1 gap$' "batch: rows and gaps of a partial sweep"
     has_line "$tmp/out" '^slider-crank  *ok' "batch: files after a failure still solved"
     has_line "$tmp/err" 'cannot assemble at driver angle = 143 deg' "batch: messages kept per file"
 fi

@@ -449,10 +449,13 @@ Test(hard, change_point_stays_on_declared_branch)
     int rc = mech_solve(m, &o, &t, NULL, &d);
     note("change point: rc %d, %d rows; %s", rc, t.nrows, first_message(&d));
     cr_assert(rc == MECH_OK || rc == MECH_ESOLVE, "rc %d: %s", rc, first_message(&d));
-    if (rc == MECH_ESOLVE) {
-        cr_assert_geq(t.nrows, 180, "stopped at row %d, before the crossing: %s", t.nrows,
-                      first_message(&d));
-        cr_assert_leq(t.nrows, 181);
+    if (rc == MECH_ESOLVE) {  /* every row but the crossing (issue 17: partial sweeps) */
+        cr_assert_eq(t.nrows, 360, "%d rows, expected all but 180 deg: %s", t.nrows,
+                     first_message(&d));
+        cr_assert_eq(t.ngaps, 1);
+        cr_assert_eq(t.gaps[0].first_row, 180);
+        cr_assert_eq(t.gaps[0].last_row, 180);
+        cr_assert_eq(t.gaps[0].kind, MECH_GAP_CHANGE_POINT);
         cr_assert(message_with(&d, "180 deg"), "the crossing (180 deg) is not named: %s",
                   first_message(&d));
     } else {
@@ -581,16 +584,17 @@ static void check_non_grashof(double to_deg, int expect_rows, const char *fail_a
 }
 
 /* 0..360 deg: rows 0..109 deg, then "cannot assemble at 110 deg" with the
- * interval -109.471 .. 109.471 deg (limit positions). */
+ * interval -109.471 .. 109.471 deg (limit positions), then (issue 17) rows
+ * 251..360 deg again: 220 rows. */
 Test(hard, non_grashof_reports_interval_and_limits)
 {
-    check_non_grashof(360, 110, "driver angle = 110 deg");
+    check_non_grashof(360, 220, "driver angle = 110 deg");
 }
 
-/* The same, swept backwards: stops at -110 deg. */
+/* The same, swept backwards: fails at -110 deg, rows again from -251 deg. */
 Test(hard, non_grashof_backwards)
 {
-    check_non_grashof(-360, 110, "driver angle = -110 deg");
+    check_non_grashof(-360, 220, "driver angle = -110 deg");
 }
 
 static const fourbar TWO_INTERVALS = {.a = 0.040, .b = 0.060, .c = 0.020, .d = 0.050,
@@ -608,7 +612,9 @@ Test(hard, two_intervals_reports_the_current_one)
     note("two intervals: %d rows; %s", t.nrows, msg);
     double q1 = crank_at(&TWO_INTERVALS, TWO_INTERVALS.b - TWO_INTERVALS.c),
            q2 = crank_at(&TWO_INTERVALS, TWO_INTERVALS.b + TWO_INTERVALS.c), lo, hi;
-    cr_assert_eq(t.nrows, 36, "%d rows (90..125 deg expected): %s", t.nrows, msg);
+    /* 90..125, 235..308 and 412..450 deg (issue 17: the later intervals too) */
+    cr_assert_eq(t.nrows, 36 + 74 + 39, "%d rows (90..125, 235..308, 412..450 deg expected): %s",
+                 t.nrows, msg);
     cr_assert(strstr(msg, "cannot assemble at driver angle = 126 deg"), "%s", msg);
     cr_assert(assembly_interval(msg, "deg", &lo, &hi), "no interval: %s", msg);
     cr_assert(fabs(lo - q1) <= 1e-3 && fabs(hi - q2) <= 1e-3,
@@ -1325,13 +1331,15 @@ Test(hard, crank_past_its_limit_cannot_assemble)
     cr_assert_eq(mech_solve(m, &o, &t, NULL, &d), MECH_ESOLVE);
     const char *msg = first_message(&d);
     double limit = acos((45.0 * 45 + 70.0 * 70 - 110.0 * 110) / (2.0 * 45 * 70)) * 180 / PI;
-    cr_assert_eq(t.nrows, (int)floor(limit) + 1, "%d rows: %s", t.nrows, msg);
+    /* the rows that exist: 0 .. 145 deg and 215 .. 360 deg (a partial sweep) */
+    cr_assert_eq(t.nrows, 2 * ((int)floor(limit) + 1), "%d rows: %s", t.nrows, msg);
     cr_assert(strstr(msg, "cannot assemble at driver angle = 146 deg"), "%s", msg);
     cr_assert(!strstr(msg, "singular position"), "%s", msg);
     double lo, hi;
     cr_assert(assembly_interval(msg, "deg", &lo, &hi), "no range: %s", msg);
     cr_assert(fabs(hi - limit) <= 1e-3 && fabs(lo + limit) <= 1e-3,
               "range [%g, %g] deg, limits +-%.6f by the law of cosines: %s", lo, hi, limit, msg);
+    cr_assert(strstr(msg, "coupler and rocker extended in line"), "%s", msg);
     mech_table_free(&t);
     mech_diag_free(&d);
     mech_model_free(&m);

@@ -452,8 +452,12 @@ Test(solve, non_grashof_crank_cannot_assemble)
     int rc = mech_solve(m, &o, &t, NULL, &d);
     cr_assert_eq(rc, MECH_ESOLVE, "mech_solve returned %d: %s", rc, first_message(&d));
     cr_assert_lt(t.nrows, 361);
-    cr_assert_eq(t.nrows, 101, "%d rows solved before the failure, expected 101 (0..100 deg): %s",
+    /* 0..100 and 260..360 deg: every row where it assembles (issue 17) */
+    cr_assert_eq(t.nrows, 202, "%d rows solved, expected 202 (0..100, 260..360 deg): %s",
                  t.nrows, first_message(&d));
+    cr_assert_eq(t.ngaps, 1);
+    cr_assert_eq(t.gaps[0].first_row, 101);
+    cr_assert_eq(t.gaps[0].last_row, 259);
     cr_assert(any_message_has(&d, "cannot assemble"), "no 'cannot assemble' message: %s",
               first_message(&d));
     cr_assert(any_message_has(&d, "deg"), "the driver position is not given in degrees: %s",
@@ -489,8 +493,12 @@ Test(solve, slider_through_dead_centre_is_singular)
     int rc = mech_solve(m, &o, &t, NULL, &d);
     cr_assert_eq(rc, MECH_ESOLVE, "mech_solve returned %d: %s", rc, first_message(&d));
     cr_assert_lt(t.nrows, 5);
-    cr_assert_eq(t.nrows, 2, "%d rows solved before the failure, expected 2: %s", t.nrows,
-                 first_message(&d));
+    /* every row but the dead centre (issue 17: partial sweeps) */
+    cr_assert_eq(t.nrows, 4, "%d rows solved, expected 4: %s", t.nrows, first_message(&d));
+    cr_assert_eq(t.ngaps, 1);
+    cr_assert_eq(t.gaps[0].first_row, 2);
+    cr_assert_eq(t.gaps[0].last_row, 2);
+    cr_assert_eq(t.gaps[0].kind, MECH_GAP_DEAD_POINT);
     cr_assert(any_message_has(&d, "singular"), "no 'singular' message: %s", first_message(&d));
     /* the rows solved are right: crank angle by the law of cosines */
     int qc = table_col(&t, "q"), cc = table_col(&t, "crank.angle");
