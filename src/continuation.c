@@ -125,13 +125,16 @@ static void note_crossing(cont *c, double qn)
     int sign = c->try_sign;  /* of the step being accepted (cont_try) */
     if (sign != 0 && c->det_sign != 0 && sign != c->det_sign && !c->searching &&
         c->crossings++ < 10) {
-        char qa[64], qb[64];
+        char qab[128], loops[400], where[420] = "";
+        diagnose_dependent_loops(&c->sv, loops, sizeof loops);  /* J nearly singular here */
+        if (loops[0])
+            snprintf(where, sizeof where, " of %s", loops);
         diag_warning(c->d, c->m->file, c->m->driver.mark,
-                     "between %s = %s and %s the Jacobian's determinant changes sign: the "
-                     "sweep passed a change point, where assembly branches cross, and may "
+                     "between %s = %s the Jacobian's determinant changes sign: the "
+                     "sweep passed a change point%s, where assembly branches cross, and may "
                      "continue on the other assembly; declare `branch:` to keep one",
-                     diagnose_driver_word(c->m), diagnose_q_text(c->m, fmin(c->qc, qn), qa, sizeof qa),
-                     diagnose_q_text(c->m, fmax(c->qc, qn), qb, sizeof qb));
+                     diagnose_driver_word(c->m),
+                     diagnose_q_interval(c->m, c->qc, qn, qab, sizeof qab), where);
     }
     if (sign != 0)
         c->det_sign = sign;

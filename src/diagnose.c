@@ -21,6 +21,18 @@ const char *diagnose_q_text(const mech_model *m, double q, char *buf, size_t siz
     return buf;
 }
 
+const char *diagnose_q_interval(const mech_model *m, double a, double b, char *buf,
+                                size_t size)
+{
+    double unit = is_angle_driver(m) ? 180.0 / PI : 1e3;
+    double lo = fmin(a, b) * unit, hi = fmax(a, b) * unit, width = hi - lo;
+    int dec = width > 0.0 ? (int)ceil(-log10(width)) + 1 : 6;
+    dec = dec < 0 ? 0 : dec > 12 ? 12 : dec;
+    const char *u = is_angle_driver(m) ? "deg" : "mm";
+    snprintf(buf, size, "%.*f %s and %.*f %s", dec, lo, u, dec, hi, u);
+    return buf;
+}
+
 const char *diagnose_driver_word(const mech_model *m)
 {
     return is_angle_driver(m) ? "driver angle" : "driver displacement";
@@ -230,6 +242,17 @@ static int is_change_point(solver *sv, const double *left)
     }
     free(fq);
     return nw > 0.0 && nf > 0.0 && fabs(dot) <= 1e-3 * sqrt(nw * nf);
+}
+
+void diagnose_dependent_loops(const solver *sv, char *buf, size_t size)
+{
+    double *right = xcalloc((size_t)sv->p->ns + 1, sizeof *right);
+    double *left = xcalloc((size_t)sv->p->nr + 1, sizeof *left);
+    buf[0] = '\0';
+    if (right && left && dense_null(sv, right, left) == 0)
+        list_large(sv, left, 1, buf, size);
+    free(right);
+    free(left);
 }
 
 void diagnose_singular(cont *c, double q)

@@ -9,6 +9,10 @@
 
 /* "123.4 deg" or "0.1834 mm": the driver position as users think of it. */
 const char *diagnose_q_text(const mech_model *m, double q, char *buf, size_t size);
+/* "179.9995 deg and 180.0005 deg": two positions with the digits that
+ * tell them apart. */
+const char *diagnose_q_interval(const mech_model *m, double a, double b, char *buf,
+                                size_t size);
 /* "driver angle" or "driver displacement". */
 const char *diagnose_driver_word(const mech_model *m);
 /* "loop 2 (A-B-C-D-A)" */
@@ -24,6 +28,9 @@ int diagnose_worst_loop(const solver *sv);
  * (-1 none), attempts how many starts were tried. */
 void diagnose_start(cont *c, double q, step_status first, double resid, int loop, int branch,
                     int attempts);
+/* The loops whose equations depend at the current (nearly singular)
+ * factors, e.g. "loop 1 (A-B-C-D-A)"; "" when unknown (a large system). */
+void diagnose_dependent_loops(const solver *sv, char *buf, size_t size);
 /* A singular position at q: which unknowns are free, which loops depend. */
 void diagnose_singular(cont *c, double q);
 /* Redundant constraints at row 0: which equations the others imply. */

@@ -512,8 +512,9 @@ Test(hard, change_point_reported_as_crossing)
  * from one assembly to the other is reported (error or warning, naming
  * about 180 deg), not done silently.
  * mech_solve returns MECH_OK with the warning "between driver angle =
- * 179.501 deg and 180.499 deg the Jacobian's determinant changes sign: the
- * sweep passed a change point, where assembly branches cross, and may
+ * 179.99951 deg and 180.00049 deg the Jacobian's determinant changes sign:
+ * the sweep passed a change point of loop 1 (B-C-O-A-B), where assembly
+ * branches cross, and may
  * continue on the other assembly; declare `branch:` to keep one" (the row at
  * 360 deg is the crossed assembly, coupler angle -0.9273 rad, +0.9273 at
  * 0 deg). */
@@ -536,6 +537,10 @@ Test(hard, change_point_undeclared_not_silent)
                            "%d times", rc, t.nrows, flips);
     cr_assert(message_with(&d, "180") || message_with(&d, "179.") || message_with(&d, "180."),
               "the crossing is reported but not where: %s", first_message(&d));
+    /* the loop that folds (issue 17), and two positions that differ */
+    cr_assert(message_with(&d, "a change point of loop 1 (B-C-O-A-B)"), "no loop named: %s",
+              first_message(&d));
+    cr_assert(!message_with(&d, "180 deg and 180 deg"), "%s", first_message(&d));
     mech_table_free(&t);
     mech_diag_free(&d);
     mech_model_free(&m);
