@@ -297,9 +297,9 @@ fi
 # ---- mech sweep -----------------------------------------------------------
 
 if run "mech sweep" 0 "$MECH" sweep mechanisms/slider-crank.yaml --vary r=30mm:60mm:4 --list l=45mm,140mm --metric range:x_B.s -j 2 -o "$tmp/sw.csv"; then
-    has_line "$tmp/sw.csv" '^variant,r,l,status,rows,range:x_B.s$' "sweep header"
-    has_line "$tmp/sw.csv" '^7,60 mm,140mm,ok,73,0.12$' "sweep: stroke = 2 r"
-    has_line "$tmp/sw.csv" '^6,60 mm,45mm,no-assembly,' "sweep: a variant that cannot assemble is a row, not a failure"
+    has_line "$tmp/sw.csv" '^variant \[-\],r \[m\],l \[m\],status \[-\],rows \[-\],range:x_B.s \[m\]$' "sweep header: name [unit], as the solve CSV"
+    has_line "$tmp/sw.csv" '^7,0.06,0.14,ok,73,0.12$' "sweep: stroke = 2 r"
+    has_line "$tmp/sw.csv" '^6,0.06,0.045,no-assembly,' "sweep: a variant that cannot assemble is a row, not a failure"
 fi
 if run "mech sweep --shard" 0 "$MECH" sweep mechanisms/slider-crank.yaml --vary r=30mm:60mm:4 --list l=45mm,140mm --metric range:x_B.s --shard 1/3; then
     rows=$(grep -c '^[0-9]' "$tmp/out")
@@ -322,8 +322,8 @@ if run "mech sweep transmission: unknown link" 2 "$MECH" sweep $sc --vary r=30mm
 fi
 # the first variant cannot assemble: its columns are known all the same
 if run "mech sweep, first variant fails" 0 "$MECH" sweep $sc --vary r=60mm:30mm:4 --list l=45mm,140mm --metric range:x_B.s; then
-    has_line "$tmp/out" '^0,60 mm,45mm,no-assembly,' "sweep: variant 0 cannot assemble"
-    has_line "$tmp/out" '^1,60 mm,140mm,ok,73,0.12$' "sweep: the others are solved"
+    has_line "$tmp/out" '^0,0.06,0.045,no-assembly,' "sweep: variant 0 cannot assemble"
+    has_line "$tmp/out" '^1,0.06,0.14,ok,73,0.12$' "sweep: the others are solved"
 fi
 # every variant fails: exit 1, the rows still written
 if run "mech sweep, no variant solved" 1 "$MECH" sweep $sc --vary r=300mm:600mm:2 --metric range:x_B.s; then
@@ -339,9 +339,24 @@ if run "mech sweep --list with a newline" 2 "$MECH" sweep $sc --list "l=140mm${n
     has_line "$tmp/err" "control character (byte 0x0a)" "sweep: control character named"
     [ -s "$tmp/out" ] && fail "sweep --list with a newline: rows written" || pass
 fi
-if run "mech sweep --list with a quote" 0 "$MECH" sweep $sc --list 'l=140mm,"9"'; then
-    has_line "$tmp/out" '^1,"""9""",invalid,0$' "sweep: a quote in a cell is quoted (RFC 4180)"
-    [ "$(wc -l <"$tmp/out")" -eq 3 ] && pass || fail "sweep --list with a quote: $(wc -l <"$tmp/out") lines, expected 3"
+if run "mech sweep --list with a quote" 2 "$MECH" sweep $sc --list 'l=140mm,"9"'; then
+    has_line "$tmp/err" "value '\"9\"' is not a number with a unit" "sweep: a value that is not a quantity is refused"
+    [ -s "$tmp/out" ] && fail "sweep --list with a quote: rows written" || pass
+fi
+
+# the sweep CSV is the solve CSV's dialect (issue 22 item 5): SI numbers,
+# 'name [unit]' headers, bare parameters in '-', no trailing spaces
+if run "mech sweep, the CSV dialect" 0 "$MECH" sweep mechanisms/jansen.yaml --vary La=37:39:3 \
+        --list 'Lb=41.5' --metric transmission:upper,foot --metric maxabs:foot.omega -j 2; then
+    has_line "$tmp/out" '^variant \[-\],La \[-\],Lb \[-\],status \[-\],rows \[-\],transmission:upper/foot \[rad\],maxabs:foot.omega \[rad/s\]$' "sweep: bare parameters in '-', transmission in rad"
+    has_line "$tmp/out" '^1,38,41.5,ok,' "sweep: a bare value written as its number"
+    grep -q ' $' "$tmp/out" && fail "sweep: a trailing space in the CSV" || pass
+fi
+if run "mech sweep, a value in another dimension" 2 "$MECH" sweep $sc --list l=140mm,2kg; then
+    has_line "$tmp/err" "value '2kg' is in kg, '140mm' in m" "sweep: mixed dimensions refused"
+fi
+if run "mech sweep, a value in the wrong dimension" 2 "$MECH" sweep $sc --list l=2kg; then
+    has_line "$tmp/err" "parameter 'l' replaced by '2kg': a quantity in kg, where the file's '140 mm' is in m" "sweep: the parameter's dimension"
 fi
 
 # ---- bare driver angles are radians (issue 16 item 8) -----------------------
