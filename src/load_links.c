@@ -85,6 +85,10 @@ void load_parameters(loader *ld, const ynode *map)
         if (taken) {
             load_err(ld, k, "parameter name '%s' is already %s '%s' in expressions; choose another "
                             "name", name, taken, name);
+            /* its uses would each fail again ("unit 'm' without a number"):
+             * this one error says it */
+            if (name_map_put(&ld->bad_params, k->text, 1) < 0)
+                load_err(ld, k, "out of memory");
             continue;
         }
         if (k->dup_of)
