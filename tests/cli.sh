@@ -158,6 +158,13 @@ fi
 if run "mech solve --outputs typo" 2 "$MECH" solve mechanisms/fourbar.yaml --outputs cuopler; then
     has_line "$tmp/err" "did you mean 'coupler'" "--outputs typo"
 fi
+# the other case, and a column's name for its point (issue 22 item 6)
+if run "mech solve --outputs b" 2 "$MECH" solve mechanisms/fourbar.yaml --outputs A,b; then
+    has_line "$tmp/err" "'b' is not a point.*(did you mean 'B'?)" "--outputs b: the case"
+fi
+if run "mech solve --outputs B.x" 2 "$MECH" solve mechanisms/fourbar.yaml --outputs B.x; then
+    has_line "$tmp/err" "'B.x' is not a point.*(did you mean 'B'?); outputs are names, each giving all its columns" "--outputs B.x: a column"
+fi
 if run "mech solve --outputs empty item" 2 "$MECH" solve mechanisms/fourbar.yaml --outputs B,,C -o "$tmp/e.csv"; then
     has_line "$tmp/err" "^mech solve: --outputs: item 2 of the list is empty (names are separated by one comma)$" "--outputs B,,C"
     [ ! -e "$tmp/e.csv" ] && pass || fail "--outputs B,,C: wrote $tmp/e.csv"
