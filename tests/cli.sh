@@ -158,6 +158,26 @@ fi
 if run "mech solve --outputs typo" 2 "$MECH" solve mechanisms/fourbar.yaml --outputs cuopler; then
     has_line "$tmp/err" "did you mean 'coupler'" "--outputs typo"
 fi
+# a point name on one link only, near a joint's name: a typo that leaves the
+# point unconnected is named at its line and column (issue 22 item 6)
+cat >"$tmp/typo.yaml" <<'EOF2'
+name: Crank-rocker four-bar, a typo
+units: {length: mm, angle: deg}
+ground: {O: [0, 0], C: [70, 0]}
+links:
+  crank:   {points: {O: [0, 0], A: [20, 0]}}
+  coupler: {points: {A: [0, 0], B: [60, 0], P1: [30, 10]}}
+  rocker:  {points: {C: [0, 0], b: [50, 0], P2: [0, 9]}}
+driver: {link: crank, angle: {from: 0, to: 360, steps: 36}}
+EOF2
+if run "mech check, a point name typo" 2 "$MECH" check "$tmp/typo.yaml"; then
+    has_line "$tmp/err" "^$tmp/typo.yaml:7:33: warning: point 'b' of link 'rocker' is on no other link and in no joint, so it joins nothing (did you mean 'B', as on link 'coupler'?)$" "point typo: did you mean"
+    grep -q "point 'P[12]'" "$tmp/err" && fail "point typo: P1/P2, a numbered series, named" || pass
+fi
+if run "mech check fourbar: no point typo" 0 "$MECH" check mechanisms/fourbar.yaml; then
+    grep -q "joins nothing" "$tmp/err" && fail "fourbar: a point typo warning" || pass
+fi
+
 # the other case, and a column's name for its point (issue 22 item 6)
 if run "mech solve --outputs b" 2 "$MECH" solve mechanisms/fourbar.yaml --outputs A,b; then
     has_line "$tmp/err" "'b' is not a point.*(did you mean 'B'?)" "--outputs b: the case"
