@@ -23,7 +23,9 @@ const char cmd_sweep_help[] =
     "variant's index, its parameter values, its status, and the metrics.\n"
     "A variant that cannot assemble over the driver range is reported as such\n"
     "(status 'no-assembly', 'singular' or 'self-locking' when joint friction\n"
-    "locks it), not as a failure of the run.\n"
+    "locks it), not as a failure of the run. The CSV is mech solve's: headers\n"
+    "'name [unit]', values in SI (r=30mm is 0.03 under 'r [m]'; bare numbers '-';\n"
+    "transmission angles in rad).\n"
     "\n"
     "options:\n"
     "  --vary NAME=FROM:TO:COUNT  COUNT values from FROM to TO (inclusive); a unit\n"
@@ -34,7 +36,7 @@ const char cmd_sweep_help[] =
     "                    range:COL (max - min, e.g. range:x_B.s, the stroke),\n"
     "                    max:COL, min:COL, maxabs:COL (e.g. maxabs:driver.torque,\n"
     "                    the peak torque), or transmission:LINK1,LINK2 (the\n"
-    "                    smallest angle between the two links, 0..90 deg, e.g. the\n"
+    "                    smallest angle between the two links, 0..pi/2 rad, e.g. the\n"
     "                    transmission angle of a four-bar: coupler,rocker)\n"
     "                    (default: the number of rows solved)\n"
     "  -o FILE           write the summary CSV to FILE (default: standard output)\n"
@@ -52,6 +54,8 @@ enum { MAX_VARY = 8, MAX_METRICS = 32 };
 typedef struct axis {
     char name[64];
     char **texts;    /* [count] parameter texts, e.g. "135 mm" */
+    double *si;      /* [count] their values in SI (or the bare number) */
+    char unit[32];   /* the SI unit of the values, "-" for bare numbers */
     int count;
 } axis;
 
@@ -61,6 +65,7 @@ typedef struct metric {
     metric_kind kind;
     char col[128], col2[128];  /* column names (transmission: two link names) */
     char label[160];
+    char unit[32];             /* of the column (transmission: rad) */
 } metric;
 
 typedef struct variant {
@@ -117,6 +122,50 @@ static int control_char(const char *s)
     return 0;
 }
 
+/* The SI values of axis a's texts and their unit, for the CSV (the solve
+ * CSV's dialect: numbers in SI, the unit in the header). A value is a
+ * quantity on its own: a number with a unit ("45mm", "0.5 rad/s") or a bare
+ * number (unit "-", the file's unit where it is used); every value of one
+ * parameter has the same dimension. 0, or a usage error printed (-1). */
+static int axis_values(axis *a, const char *opt, const char *arg)
+{
+    unit_defaults u;
+    unit_defaults_init(&u);
+    expr_env env = {&u, NULL, 0, NULL};
+    a->si = calloc((size_t)a->count, sizeof *a->si);
+    if (!a->si)
+        return -2;
+    expr_param first = {0};
+    for (int i = 0; i < a->count; i++) {
+        expr_param p = {0};
+        char err[256], msg[512], unit[32];
+        size_t pos = 0;
+        if (quantity_eval_param(a->texts[i], &env, &p, err, sizeof err, &pos) < 0 ||
+            !isfinite(p.value)) {
+            snprintf(msg, sizeof msg, "%s %s: value '%s' is not a number with a unit such as "
+                     "45mm (%s)", opt, arg, a->texts[i], isfinite(p.value) ? err : "not finite");
+            cmd_usage_error("sweep", "%s", msg);
+            return -1;
+        }
+        if (p.bare)
+            snprintf(unit, sizeof unit, "-");
+        else
+            dim_format(p.d, unit, sizeof unit);
+        if (i == 0) {
+            first = p;
+            snprintf(a->unit, sizeof a->unit, "%s", unit);
+        } else if (p.bare != first.bare || !dim_equal(p.d, first.d)) {
+            snprintf(msg, sizeof msg, "%s %s: value '%s' is in %s, '%s' in %s; every value of "
+                     "parameter '%s' has the same dimension", opt, arg, a->texts[i], unit,
+                     a->texts[0], a->unit, a->name);
+            cmd_usage_error("sweep", "%s", msg);
+            return -1;
+        }
+        a->si[i] = p.value;
+    }
+    return 0;
+}
+
 static int parse_vary(sweep_run *r, const char *arg, int is_list)
 {
     const char *opt = is_list ? "--list" : "--vary";
@@ -159,18 +208,26 @@ static int parse_vary(sweep_run *r, const char *arg, int is_list)
         for (long i = 0; !bad && !oom && i < n; i++) {
             char text[96];
             double v = n == 1 ? f : f + (t - f) * (double)i / (double)(n - 1);
-            snprintf(text, sizeof text, "%.15g %s", v, uf);
+            snprintf(text, sizeof text, "%.15g%s%s", v, uf[0] ? " " : "", uf);
             oom = add_text(a, text) < 0;
         }
     }
     free(spec);
+    int av = !bad && !oom ? axis_values(a, opt, arg) : 0;
+    oom |= av == -2;
+    if (av == -1)
+        bad = 2;
     if (bad || oom) {  /* the axis is not kept: free its texts here */
         for (int i = 0; i < a->count; i++)
             free(a->texts[i]);
         free(a->texts);
+        free(a->si);
         a->texts = NULL;
+        a->si = NULL;
         a->count = 0;
     }
+    if (bad == 2)
+        return MECH_EXIT_INPUT;
     if (oom)
         return fprintf(stderr, "mech sweep: out of memory\n"), MECH_EXIT_IO;
     if (bad)
@@ -245,7 +302,7 @@ static int check_column(const metric *mt, const char *col, const mech_table *t, 
  * Returns -1 when all are there (or the columns cannot be known: the base
  * does not even build, and every variant will say why), else the exit
  * status. */
-static int check_metrics(const sweep_run *r, const mech_model *m)
+static int check_metrics(sweep_run *r, const mech_model *m)
 {
     mech_diag d;
     mech_diag_init(&d);
@@ -277,6 +334,12 @@ static int check_metrics(const sweep_run *r, const mech_model *m)
         if (check_column(mt, mt->col, &t, r->forces) != 0 ||
             (mt->kind == MET_TRANSMISSION && check_column(mt, mt->col2, &t, r->forces) != 0))
             code = MECH_EXIT_INPUT;
+    }
+    for (int k = 0; code < 0 && k < r->nmetrics; k++) {  /* the header's units */
+        metric *mt = &r->metrics[k];
+        int c = mech_table_column(&t, mt->col);
+        snprintf(mt->unit, sizeof mt->unit, "%s", mt->kind == MET_TRANSMISSION ? "rad"
+                 : c >= 0 && t.columns[c].unit ? t.columns[c].unit : "-");
     }
     mech_table_free(&t);
     return code;
@@ -311,7 +374,7 @@ static double metric_value(const metric *mt, const mech_table *t, FILE *msg)
         lo = fmin(lo, x);
         hi = fmax(hi, x);
         big = fmax(big, fabs(x));
-        if (c2 >= 0) {  /* angle between the link axes, folded to 0..90 deg */
+        if (c2 >= 0) {  /* angle between the link axes, folded to 0..pi/2 */
             double d = fabs(remainder(x - mech_table_get(t, i, c2), 3.14159265358979323846));
             tmin = fmin(tmin, fmin(d, 3.14159265358979323846 - d));
         }
@@ -321,7 +384,7 @@ static double metric_value(const metric *mt, const mech_table *t, FILE *msg)
     case MET_MAX: return hi;
     case MET_MIN: return lo;
     case MET_MAXABS: return big;
-    case MET_TRANSMISSION: return tmin * 180.0 / 3.14159265358979323846;
+    case MET_TRANSMISSION: return tmin;  /* rad, as every angle of the CSVs */
     }
     return NAN;
 }
@@ -401,22 +464,46 @@ static void put_cell(FILE *f, const char *s)
     fputc('"', f);
 }
 
+/* The index into axis k of variant v (as variant_overrides). */
+static int axis_index(const sweep_run *r, int v, int k)
+{
+    for (int j = r->naxes - 1; j > k; j--)
+        v /= r->axes[j].count;
+    return v % r->axes[k].count;
+}
+
+/* The shortest "%.Ng" of x that reads back as x: 0.04, not
+ * 0.040000000000000001 (the value is exact either way). */
+static const char *shortest(double x, char *buf, size_t size)
+{
+    for (int p = 1; p <= 17; p++) {
+        snprintf(buf, size, "%.*g", p, x);
+        if (strtod(buf, NULL) == x)
+            break;
+    }
+    return buf;
+}
+
 static void write_summary(const sweep_run *r, FILE *f)
 {
-    mech_override ov[MAX_VARY];
-    fprintf(f, "variant");
-    for (int k = 0; k < r->naxes; k++)
-        put_cell(f, r->axes[k].name);
-    fprintf(f, ",status,rows");
-    for (int k = 0; k < r->nmetrics; k++)
-        put_cell(f, r->metrics[k].label);
+    char cell[256];
+    fprintf(f, "variant [-]");
+    for (int k = 0; k < r->naxes; k++) {
+        snprintf(cell, sizeof cell, "%s [%s]", r->axes[k].name, r->axes[k].unit);
+        put_cell(f, cell);
+    }
+    fprintf(f, ",status [-],rows [-]");
+    for (int k = 0; k < r->nmetrics; k++) {
+        snprintf(cell, sizeof cell, "%s [%s]", r->metrics[k].label,
+                 r->metrics[k].unit[0] ? r->metrics[k].unit : "-");
+        put_cell(f, cell);
+    }
     fputc('\n', f);
     for (int i = 0; i < r->nvars; i++) {
         const variant *v = &r->vars[i];
-        variant_overrides(r, v->index, ov);
         fprintf(f, "%d", v->index);
         for (int k = 0; k < r->naxes; k++)
-            put_cell(f, ov[k].text);
+            fprintf(f, ",%s", shortest(r->axes[k].si[axis_index(r, v->index, k)], cell, sizeof cell));
         fprintf(f, ",%s,%d", v->status, v->rows);
         for (int k = 0; k < r->nmetrics; k++)
             fprintf(f, ",%.17g", v->value[k]);
@@ -447,6 +534,7 @@ static void free_run(sweep_run *r)
         for (int i = 0; i < r->axes[k].count; i++)
             free(r->axes[k].texts[i]);
         free(r->axes[k].texts);
+        free(r->axes[k].si);
     }
     if (r->vars)
         for (int i = 0; i < r->nvars; i++)

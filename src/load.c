@@ -83,6 +83,7 @@ static void load_document(loader *ld, const ynode *root)
         load_joints(ld, v);
     load_add_implicit_revolutes(ld);
     load_check_link_points(ld);
+    load_warn_point_typos(ld);
     if ((v = ymap_get(root, "driver")))
         load_driver(ld, v);
     if ((v = ymap_get(root, "initial")))

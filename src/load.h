@@ -113,6 +113,7 @@ void load_index_carriers(loader *ld);
 void load_joints(loader *ld, const ynode *seq);
 void load_add_implicit_revolutes(loader *ld);
 void load_check_link_points(loader *ld);
+void load_warn_point_typos(loader *ld);
 
 /* ---- load_motion.c: driver, initial guesses, branch conditions, loops. */
 void load_driver(loader *ld, const ynode *map);

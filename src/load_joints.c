@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 #include "load.h"
 
@@ -445,4 +446,97 @@ void load_check_link_points(loader *ld)
 done:
     free(locked_by);
     free(slides);
+}
+
+/* Do two names differ only in their digits ("P1", "P2")? A numbered
+ * series, not a typo. */
+static int differ_in_digits_only(const char *a, const char *b)
+{
+    for (;; a++, b++) {
+        while (*a >= '0' && *a <= '9')
+            a++;
+        while (*b >= '0' && *b <= '9')
+            b++;
+        if (*a != *b)
+            return 0;
+        if (!*a)
+            return 1;
+    }
+}
+
+/* A point name on one link only, in no joint, joins nothing: when it is
+ * close to the name of a point of another link ("b" or "BB" where another
+ * link has "B"), shared or not, it is likely a typo that left a point
+ * unconnected; a warning at it (the later of the two in the file) names
+ * the near one. Names differing only in digits (P1, P2) are a series, not
+ * a typo. Bounded: a file of very many points skips it. */
+void load_warn_point_typos(loader *ld)
+{
+    mech_model *m = ld->m;
+    int n = m->npoint_names;
+    if (n == 0)
+        return;
+    int *count = xcalloc((size_t)n, sizeof *count), *first = xcalloc((size_t)n, sizeof *first);
+    const char **cand = xcalloc((size_t)n, sizeof *cand);
+    int *cand_link = xcalloc((size_t)n, sizeof *cand_link);
+    if (!count || !first || !cand || !cand_link || n > 2000)
+        goto done;
+    for (int id = 0; id < n; id++)
+        first[id] = -1;
+    for (int li = 0; li < m->nlinks; li++)
+        for (int p = 0; p < m->links[li].npoints; p++) {
+            int id = m->links[li].points[p].id;
+            if (id >= 0 && id < n) {
+                count[id]++;
+                if (first[id] < 0)
+                    first[id] = li;
+            }
+        }
+    for (int ji = 0; ji < m->njoints; ji++)  /* a point in a joint joins */
+        for (int k = 0; k < 2; k++) {
+            const mech_joint *j = &m->joints[ji];
+            if (j->link[k] < 0 || j->link[k] >= m->nlinks || j->point[k] < 0 ||
+                j->point[k] >= m->links[j->link[k]].npoints)
+                continue;
+            int id = m->links[j->link[k]].points[j->point[k]].id;
+            if (id >= 0 && id < n)
+                count[id] += 2;
+        }
+    size_t ncand = 0;  /* shared names, then the lone names of earlier links */
+    for (int id = 0; id < n; id++)
+        if (count[id] >= 2)
+            cand_link[ncand] = first[id], cand[ncand++] = m->point_names[id];
+    for (int li = 0; li < m->nlinks; li++) {
+        size_t before = ncand;
+        for (int p = 0; p < m->links[li].npoints; p++) {
+            const mech_point *pt = &m->links[li].points[p];
+            if (pt->id < 0 || pt->id >= n || count[pt->id] != 1 || !pt->name)
+                continue;
+            if (ncand < (size_t)n)
+                cand_link[ncand] = li, cand[ncand++] = pt->name;
+            const char *near = NULL;
+            for (size_t i = 0; i < before && !near; i++)
+                if (strcasecmp(pt->name, cand[i]) == 0 && cand_link[i] != li)
+                    near = cand[i];
+            if (!near)
+                near = nearest_name(pt->name, cand, before);
+            if (!near || differ_in_digits_only(pt->name, near))
+                continue;
+            int nl = -1;
+            for (size_t i = 0; i < before && nl < 0; i++)
+                if (cand[i] == near)
+                    nl = cand_link[i];
+            if (nl == li || nl < 0)
+                continue;
+            diag_warning(ld->d, ld->file, pt->mark,
+                         "point '%s' of link '%s' is on no other link and in no joint, so it "
+                         "joins nothing (did you mean '%s', as on link '%s'?)",
+                         pt->name, m->links[li].name, near, m->links[nl].name);
+        }
+    }
+done:
+    free(count);
+    free(first);
+    free(cand);
+    free(cand_link);
 }

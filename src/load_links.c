@@ -85,6 +85,10 @@ void load_parameters(loader *ld, const ynode *map)
         if (taken) {
             load_err(ld, k, "parameter name '%s' is already %s '%s' in expressions; choose another "
                             "name", name, taken, name);
+            /* its uses would each fail again ("unit 'm' without a number"):
+             * this one error says it */
+            if (name_map_put(&ld->bad_params, k->text, 1) < 0)
+                load_err(ld, k, "out of memory");
             continue;
         }
         if (k->dup_of)
@@ -103,6 +107,17 @@ void load_parameters(loader *ld, const ynode *map)
         if (text != v->text && quantity_eval_param(text, &ld->env, &p, msg, sizeof msg, &pos) < 0) {
             diag_error(ld->d, ld->file, v->mark, "parameter '%s' replaced by '%s': %s", name,
                        text, msg);
+            continue;
+        }
+        expr_param was = {0};
+        if (text != v->text && !p.bare &&
+            quantity_eval_param(v->text, &ld->env, &was, msg, sizeof msg, &pos) == 0 &&
+            !was.bare && !dim_equal(was.d, p.d)) {
+            char du[32], dw[32];
+            dim_format(p.d, du, sizeof du);
+            dim_format(was.d, dw, sizeof dw);
+            diag_error(ld->d, ld->file, v->mark, "parameter '%s' replaced by '%s': a quantity in "
+                       "%s, where the file's '%s' is in %s", name, text, du, v->text, dw);
             continue;
         }
         if (text == v->text && quantity_eval_param(v->text, &ld->env, &p, msg, sizeof msg, &pos) < 0) {

@@ -2,6 +2,7 @@
  * (connectivity, Gruebler-Kutzbach mobility, unknowns against equations). */
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 #include "internal.h"
 
@@ -415,6 +416,26 @@ static const char **all_names(const mech_model *m, int *count)
     return v;
 }
 
+/* The output name that `w` likely meant: the same letters in other case
+ * ("b" for "B", one only), the name of a column ("B.x" for "B"), or a
+ * near one by edit distance; NULL when none. */
+static const char *output_near(const char *w, const char **names, int n)
+{
+    const char *same = NULL;
+    int nsame = 0;
+    for (int i = 0; i < n; i++)
+        if (names[i] && strcasecmp(w, names[i]) == 0)
+            same = names[i], nsame++;
+    if (nsame == 1)
+        return same;
+    const char *dot = strchr(w, '.');
+    for (int i = 0; dot && i < n; i++)
+        if (names[i] && strlen(names[i]) == (size_t)(dot - w) &&
+            strncmp(w, names[i], (size_t)(dot - w)) == 0)
+            return names[i];
+    return nearest_name(w, names, (size_t)n);
+}
+
 /* Add output `w` (a point, moving link or slider name) to `o`; MECH_EINPUT
  * with a message in err when it is none of them. */
 static int add_output(const mech_model *m, mech_outputs *o, const char *w, char *err,
@@ -430,9 +451,12 @@ static int add_output(const mech_model *m, mech_outputs *o, const char *w, char 
     else {
         int n;
         const char **names = all_names(m, &n);
-        const char *near = names ? nearest_name(w, names, (size_t)n) : NULL;
-        snprintf(err, errsize, "'%s' is not a point, moving link or slider of %s%s%s%s", w,
-                 m->file, near ? " (did you mean '" : "", near ? near : "", near ? "'?)" : "");
+        const char *near = names ? output_near(w, names, n) : NULL;
+        const char *dot = strchr(w, '.');
+        int column = near && dot && strlen(near) == (size_t)(dot - w);
+        snprintf(err, errsize, "'%s' is not a point, moving link or slider of %s%s%s%s%s", w,
+                 m->file, near ? " (did you mean '" : "", near ? near : "", near ? "'?)" : "",
+                 column ? "; outputs are names, each giving all its columns" : "");
         free(names);
         return MECH_EINPUT;
     }

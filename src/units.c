@@ -17,6 +17,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 #include "internal.h"
 
@@ -337,7 +338,12 @@ static qval parse_number(qparser *p)
         const char *names[NUNITS];
         for (size_t i = 0; i < NUNITS; i++)
             names[i] = unit_table[i].name;
-        const char *near = nearest_name(word, names, NUNITS);
+        const char *near = NULL;
+        for (size_t i = 0; i < NUNITS && !near; i++)  /* "RPM", "MM": the case is wrong */
+            if (strcasecmp(word, names[i]) == 0)
+                near = names[i];
+        if (!near)
+            near = nearest_name(word, names, NUNITS);
         if (near)
             qfail(p, u, "unknown unit '%s' (did you mean '%s'?)", word, near);
         else {

@@ -158,6 +158,33 @@ fi
 if run "mech solve --outputs typo" 2 "$MECH" solve mechanisms/fourbar.yaml --outputs cuopler; then
     has_line "$tmp/err" "did you mean 'coupler'" "--outputs typo"
 fi
+# a point name on one link only, near a joint's name: a typo that leaves the
+# point unconnected is named at its line and column (issue 22 item 6)
+cat >"$tmp/typo.yaml" <<'EOF2'
+name: Crank-rocker four-bar, a typo
+units: {length: mm, angle: deg}
+ground: {O: [0, 0], C: [70, 0]}
+links:
+  crank:   {points: {O: [0, 0], A: [20, 0]}}
+  coupler: {points: {A: [0, 0], B: [60, 0], P1: [30, 10]}}
+  rocker:  {points: {C: [0, 0], b: [50, 0], P2: [0, 9]}}
+driver: {link: crank, angle: {from: 0, to: 360, steps: 36}}
+EOF2
+if run "mech check, a point name typo" 2 "$MECH" check "$tmp/typo.yaml"; then
+    has_line "$tmp/err" "^$tmp/typo.yaml:7:33: warning: point 'b' of link 'rocker' is on no other link and in no joint, so it joins nothing (did you mean 'B', as on link 'coupler'?)$" "point typo: did you mean"
+    grep -q "point 'P[12]'" "$tmp/err" && fail "point typo: P1/P2, a numbered series, named" || pass
+fi
+if run "mech check fourbar: no point typo" 0 "$MECH" check mechanisms/fourbar.yaml; then
+    grep -q "joins nothing" "$tmp/err" && fail "fourbar: a point typo warning" || pass
+fi
+
+# the other case, and a column's name for its point (issue 22 item 6)
+if run "mech solve --outputs b" 2 "$MECH" solve mechanisms/fourbar.yaml --outputs A,b; then
+    has_line "$tmp/err" "'b' is not a point.*(did you mean 'B'?)" "--outputs b: the case"
+fi
+if run "mech solve --outputs B.x" 2 "$MECH" solve mechanisms/fourbar.yaml --outputs B.x; then
+    has_line "$tmp/err" "'B.x' is not a point.*(did you mean 'B'?); outputs are names, each giving all its columns" "--outputs B.x: a column"
+fi
 if run "mech solve --outputs empty item" 2 "$MECH" solve mechanisms/fourbar.yaml --outputs B,,C -o "$tmp/e.csv"; then
     has_line "$tmp/err" "^mech solve: --outputs: item 2 of the list is empty (names are separated by one comma)$" "--outputs B,,C"
     [ ! -e "$tmp/e.csv" ] && pass || fail "--outputs B,,C: wrote $tmp/e.csv"
@@ -235,7 +262,7 @@ if run "mech solve non-Grashof --range assembly" 0 "$MECH" solve tests/solve/non
 fi
 if run "mech sweep with a partial variant" 0 "$MECH" sweep mechanisms/double-crank.yaml --vary 'l0=20mm:80mm:2' -o "$tmp/sw.csv"; then
     has_line "$tmp/err" '^360 of 361 rows solved, 1 gap$' "sweep: rows and gaps of a partial variant"
-    has_line "$tmp/sw.csv" '^1,80 mm,no-assembly,360$' "sweep: the partial variant's rows"
+    has_line "$tmp/sw.csv" '^1,0.08,no-assembly,360$' "sweep: the partial variant's rows"
 fi
 run "mech solve --range bogus" 2 "$MECH" solve tests/solve/non-grashof.yaml --range bogus && pass
 if run "mech solve change point --within-assembly" 1 "$MECH" solve tests/hard/change-point.yaml --within-assembly -o "$tmp/cp.csv"; then
@@ -318,9 +345,9 @@ fi
 # ---- mech sweep -----------------------------------------------------------
 
 if run "mech sweep" 0 "$MECH" sweep mechanisms/slider-crank.yaml --vary r=30mm:60mm:4 --list l=45mm,140mm --metric range:x_B.s -j 2 -o "$tmp/sw.csv"; then
-    has_line "$tmp/sw.csv" '^variant,r,l,status,rows,range:x_B.s$' "sweep header"
-    has_line "$tmp/sw.csv" '^7,60 mm,140mm,ok,73,0.12$' "sweep: stroke = 2 r"
-    has_line "$tmp/sw.csv" '^6,60 mm,45mm,no-assembly,' "sweep: a variant that cannot assemble is a row, not a failure"
+    has_line "$tmp/sw.csv" '^variant \[-\],r \[m\],l \[m\],status \[-\],rows \[-\],range:x_B.s \[m\]$' "sweep header: name [unit], as the solve CSV"
+    has_line "$tmp/sw.csv" '^7,0.06,0.14,ok,73,0.12$' "sweep: stroke = 2 r"
+    has_line "$tmp/sw.csv" '^6,0.06,0.045,no-assembly,' "sweep: a variant that cannot assemble is a row, not a failure"
 fi
 if run "mech sweep --shard" 0 "$MECH" sweep mechanisms/slider-crank.yaml --vary r=30mm:60mm:4 --list l=45mm,140mm --metric range:x_B.s --shard 1/3; then
     rows=$(grep -c '^[0-9]' "$tmp/out")
@@ -343,8 +370,8 @@ if run "mech sweep transmission: unknown link" 2 "$MECH" sweep $sc --vary r=30mm
 fi
 # the first variant cannot assemble: its columns are known all the same
 if run "mech sweep, first variant fails" 0 "$MECH" sweep $sc --vary r=60mm:30mm:4 --list l=45mm,140mm --metric range:x_B.s; then
-    has_line "$tmp/out" '^0,60 mm,45mm,no-assembly,' "sweep: variant 0 cannot assemble"
-    has_line "$tmp/out" '^1,60 mm,140mm,ok,73,0.12$' "sweep: the others are solved"
+    has_line "$tmp/out" '^0,0.06,0.045,no-assembly,' "sweep: variant 0 cannot assemble"
+    has_line "$tmp/out" '^1,0.06,0.14,ok,73,0.12$' "sweep: the others are solved"
 fi
 # every variant fails: exit 1, the rows still written
 if run "mech sweep, no variant solved" 1 "$MECH" sweep $sc --vary r=300mm:600mm:2 --metric range:x_B.s; then
@@ -360,9 +387,24 @@ if run "mech sweep --list with a newline" 2 "$MECH" sweep $sc --list "l=140mm${n
     has_line "$tmp/err" "control character (byte 0x0a)" "sweep: control character named"
     [ -s "$tmp/out" ] && fail "sweep --list with a newline: rows written" || pass
 fi
-if run "mech sweep --list with a quote" 0 "$MECH" sweep $sc --list 'l=140mm,"9"'; then
-    has_line "$tmp/out" '^1,"""9""",invalid,0$' "sweep: a quote in a cell is quoted (RFC 4180)"
-    [ "$(wc -l <"$tmp/out")" -eq 3 ] && pass || fail "sweep --list with a quote: $(wc -l <"$tmp/out") lines, expected 3"
+if run "mech sweep --list with a quote" 2 "$MECH" sweep $sc --list 'l=140mm,"9"'; then
+    has_line "$tmp/err" "value '\"9\"' is not a number with a unit" "sweep: a value that is not a quantity is refused"
+    [ -s "$tmp/out" ] && fail "sweep --list with a quote: rows written" || pass
+fi
+
+# the sweep CSV is the solve CSV's dialect (issue 22 item 5): SI numbers,
+# 'name [unit]' headers, bare parameters in '-', no trailing spaces
+if run "mech sweep, the CSV dialect" 0 "$MECH" sweep mechanisms/jansen.yaml --vary La=37:39:3 \
+        --list 'Lb=41.5' --metric transmission:upper,foot --metric maxabs:foot.omega -j 2; then
+    has_line "$tmp/out" '^variant \[-\],La \[-\],Lb \[-\],status \[-\],rows \[-\],transmission:upper/foot \[rad\],maxabs:foot.omega \[rad/s\]$' "sweep: bare parameters in '-', transmission in rad"
+    has_line "$tmp/out" '^1,38,41.5,ok,' "sweep: a bare value written as its number"
+    grep -q ' $' "$tmp/out" && fail "sweep: a trailing space in the CSV" || pass
+fi
+if run "mech sweep, a value in another dimension" 2 "$MECH" sweep $sc --list l=140mm,2kg; then
+    has_line "$tmp/err" "value '2kg' is in kg, '140mm' in m" "sweep: mixed dimensions refused"
+fi
+if run "mech sweep, a value in the wrong dimension" 2 "$MECH" sweep $sc --list l=2kg; then
+    has_line "$tmp/err" "parameter 'l' replaced by '2kg': a quantity in kg, where the file's '140 mm' is in m" "sweep: the parameter's dimension"
 fi
 
 # ---- bare driver angles are radians (issue 16 item 8) -----------------------

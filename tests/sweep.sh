@@ -15,6 +15,8 @@ metrics="--metric range:E.x --metric maxabs:driver.torque"
 if "$MECH" sweep $file --vary l1=50mm:64mm:$n --vary l2=420mm:440mm:$n $metrics \
         -o "$tmp/all.csv" 2>"$tmp/err"; then
     rows=$(($(wc -l <"$tmp/all.csv") - 1))
+    head -n 1 "$tmp/all.csv" | grep -q '^variant \[-\],l1 \[m\],l2 \[m\],status \[-\],rows \[-\],range:E.x \[m\],maxabs:driver.torque \[N\*m\]$' \
+        && pass || fail "sweep header: $(head -n 1 "$tmp/all.csv")"
     [ "$rows" -eq "$total" ] && pass || fail "sweep: $rows rows, expected $total"
     ok=$(grep -c ',ok,361,' "$tmp/all.csv")
     [ "$ok" -eq "$total" ] && pass || fail "sweep: $ok of $total variants ok"
@@ -30,8 +32,9 @@ for v in 0 $((total / 3)) $((total * 2 / 3 + 7)) $((total - 1)); do
     row=$(grep "^$v," "$tmp/all.csv")
     l1=$(echo "$row" | cut -d, -f2)
     l2=$(echo "$row" | cut -d, -f3)
-    if ! "$MECH" solve $file --set "l1=$l1" --set "l2=$l2" -o "$tmp/one.csv" 2>"$tmp/err"; then
-        fail "mech solve --set l1=$l1 --set l2=$l2: $(head -n 1 "$tmp/err")"
+    # the sweep writes SI values (the header says m): give them with their unit
+    if ! "$MECH" solve $file --set "l1=${l1}m" --set "l2=${l2}m" -o "$tmp/one.csv" 2>"$tmp/err"; then
+        fail "mech solve --set l1=${l1}m --set l2=${l2}m: $(head -n 1 "$tmp/err")"
         continue
     fi
     ex=$(column "$tmp/one.csv" E.x)

@@ -485,6 +485,11 @@ Test(expression_errors, syntax_and_names)
     env_mm_deg(&f);
     eval_fails(&f, "5 furlong", Q_LENGTH, "unknown unit 'furlong'", 2);
     eval_fails(&f, "5 Mm", Q_LENGTH, "unknown unit 'Mm'", 2);
+    /* the case is wrong: the unit of the same letters (issue 22 item 6) */
+    eval_fails(&f, "5 Mm", Q_LENGTH, "unknown unit 'Mm' (did you mean 'mm'?)", 2);
+    eval_fails(&f, "5 MM", Q_LENGTH, "unknown unit 'MM' (did you mean 'mm'?)", 2);
+    eval_fails(&f, "30 RPM", Q_ANGULAR_SPEED, "unknown unit 'RPM' (did you mean 'rpm'?)", 3);
+    eval_fails(&f, "2 MN", Q_FORCE, "unknown unit 'MN' (did you mean 'mN'?)", 2);
     eval_fails(&f, "foo + 1", Q_LENGTH, "unknown name 'foo'", 0);
     eval_fails(&f, "1 + foo", Q_LENGTH, "unknown name 'foo'", 4);
     eval_fails(&f, "mm", Q_LENGTH, "unit 'mm' without a number (write 1 mm)", 0);
