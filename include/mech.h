@@ -294,6 +294,10 @@ typedef struct mech_solve_options {
                           (mech_outputs_parse), or NULL; borrowed for the analysis */
     int friction;      /* MECH_FRICTION_*: how joint friction enters the forces */
     int linear_solver; /* MECH_LINEAR_*: how the Jacobians are factored */
+    void (*progress)(void *ctx, int done, int total); /* when not NULL: called every 4096
+                          driver positions (and after the last) with the rows done
+                          and requested, from the solving thread */
+    void *progress_ctx;
     int limit_rows;    /* 1: a partial sweep also gets a row at each limit of a gap
                           found (mech_gap.from/to with from_limit/to_limit), where
                           the position is not singular (mech solve --range assembly) */

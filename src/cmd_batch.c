@@ -38,7 +38,8 @@ const char cmd_batch_help[] =
     "  --shard K/M       solve only the files with index % M == K (0 <= K < M),\n"
     "                    to split one batch over M machines\n"
     "  --forces          also the force analysis, for every file\n"
-    "  -q, --quiet       no progress bar and no per-file messages, only the table\n"
+    "  -q, --quiet       no progress report (a bar on a terminal, else a line every\n"
+    "                    5 s) and no per-file messages, only the table\n"
     "  -h, --help        show this help\n"
     "\n"
     "exit status: 0 every file solved (and matched its golden), 1 some file could\n"
@@ -64,7 +65,8 @@ typedef struct batch {
     atomic_int done;
     const char *out_dir, *golden_dir;
     compare_options cmp;
-    int forces, progress;
+    int forces;
+    cmd_progress progress;    /* files done, on standard error */
 } batch;
 
 static void base_name(const char *path, char *out, size_t size)
@@ -261,22 +263,11 @@ static int prepare_outputs(batch *b)
     return code;
 }
 
-static void progress(const batch *b, int done)
-{
-    if (!b->progress)
-        return;
-    int width = 40, fill = b->njobs ? done * width / b->njobs : width;
-    fprintf(stderr, "\r[%.*s%*s] %d/%d", fill, "########################################",
-            width - fill, "", done, b->njobs);
-    if (done == b->njobs)
-        fputc('\n', stderr);
-}
-
 static void batch_job(void *ctx, int i)
 {
     batch *b = ctx;
     run_job(b, &b->jobs[i]);
-    progress(b, atomic_fetch_add(&b->done, 1) + 1);
+    cmd_progress_update(&b->progress, atomic_fetch_add(&b->done, 1) + 1, b->njobs);
 }
 
 static void print_table(const batch *b, FILE *out)
@@ -416,8 +407,9 @@ int cmd_batch(int argc, char **argv)
     if (code < 0)
         code = make_jobs(&b, &bo, files, nfiles);
     if (code < 0) {
-        b.progress = !bo.quiet && isatty(STDERR_FILENO);
+        cmd_progress_init(&b.progress, "batch", "files", bo.quiet);
         cmd_run_parallel(b.njobs, bo.nthreads, batch_job, &b);
+        cmd_progress_done(&b.progress);
         code = report_jobs(&b, bo.quiet);
     }
     free(b.jobs);

@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "commands.h"
@@ -156,4 +157,64 @@ void cmd_run_parallel(int njobs, int nthreads, void (*job)(void *ctx, int i), vo
     for (int t = 0; t < started; t++)
         pthread_join(tid[t], NULL);
     free(tid);
+}
+
+/* ---- progress ------------------------------------------------------------- */
+
+static pthread_mutex_t progress_lock = PTHREAD_MUTEX_INITIALIZER;
+
+static double monotonic_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+void cmd_progress_init(cmd_progress *p, const char *command, const char *unit, int quiet)
+{
+    memset(p, 0, sizeof *p);
+    p->command = command;
+    p->unit = unit;
+    p->quiet = quiet;
+    p->tty = isatty(STDERR_FILENO);
+    p->interval = p->tty ? 0.1 : 5.0;
+    const char *env = getenv("MECH_PROGRESS_SECONDS");
+    if (env && *env && !p->tty)
+        p->interval = atof(env);
+    p->start = p->last = monotonic_seconds();
+}
+
+void cmd_progress_update(cmd_progress *p, int done, int total)
+{
+    if (p->quiet)
+        return;
+    pthread_mutex_lock(&progress_lock);
+    double now = monotonic_seconds();
+    if (now - p->last >= p->interval && done < total) {
+        p->last = now;
+        int pct = total > 0 ? (int)(100.0 * done / total) : 100;
+        if (p->tty) {
+            int width = 30, fill = total > 0 ? (int)((double)done * width / total) : width;
+            fprintf(stderr, "\rmech %s: [%.*s%*s] %3d%% (%d of %d %s)", p->command, fill,
+                    "##############################", width - fill, "", pct, done, total, p->unit);
+            p->drawn = 1;
+        } else {
+            fprintf(stderr, "mech %s: %d of %d %s (%d%%), %.0f s\n", p->command, done, total,
+                    p->unit, pct, now - p->start);
+        }
+        fflush(stderr);
+    }
+    pthread_mutex_unlock(&progress_lock);
+}
+
+void cmd_progress_done(cmd_progress *p)
+{
+    if (!p->quiet && p->drawn)
+        fprintf(stderr, "\r\033[K");  /* the bar's line cleared for what follows */
+    p->drawn = 0;
+}
+
+void cmd_progress_callback(void *ctx, int done, int total)
+{
+    cmd_progress_update(ctx, done, total);
 }

@@ -52,6 +52,8 @@ const char cmd_solve_help[] =
     "  --stats             print iterations per step, worst residual, smallest\n"
     "                      rcond and time per step to standard error\n"
     "  --verbose           say which blocks of equations are solved and why\n"
+    "  -q, --quiet         no progress report (long runs show one on standard error:\n"
+    "                      a bar on a terminal, else a line every 5 s)\n"
     "  --all               solve every unknown, also those no output needs\n"
     "  --within-assembly   the request is the part of the range where the mechanism\n"
     "                      assembles: exit 0 when every row there was solved (gaps\n"
@@ -81,7 +83,7 @@ typedef struct solve_args {
     mech_override set[MAX_SET];  /* --set NAME=VALUE: parameters replaced */
     char *set_text[MAX_SET];
     int nset;
-    int steps, stats, verbose;
+    int steps, stats, verbose, quiet;
     int within;                  /* --within-assembly or --range assembly */
     mech_outputs selected;       /* --outputs, parsed (opt.outputs points here) */
     mech_solve_options opt;
@@ -200,6 +202,8 @@ static int parse_args(int argc, char **argv, solve_args *a)
             a->stats = 1;
         else if (strcmp(arg, "--verbose") == 0 || strcmp(arg, "-v") == 0)
             a->verbose = 1;
+        else if (strcmp(arg, "--quiet") == 0 || strcmp(arg, "-q") == 0)
+            a->quiet = 1;
         else if (strcmp(arg, "--diagnostics") == 0)
             a->opt.diagnostics = 1;
         else if (strcmp(arg, "--all") == 0)
@@ -409,7 +413,12 @@ int cmd_solve(int argc, char **argv)
     mech_diag_init(&d);
     mech_table t = {0};
     mech_solve_stats st;
+    cmd_progress pr;
+    cmd_progress_init(&pr, "solve", "rows", a.quiet);
+    a.opt.progress = cmd_progress_callback;
+    a.opt.progress_ctx = &pr;
     int rc = mech_solve(m, &a.opt, &t, &st, &d);
+    cmd_progress_done(&pr);
     mech_diag_print(&d, stderr);
     mech_diag_free(&d);
     if (rc == MECH_ESOLVE) {

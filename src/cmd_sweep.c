@@ -6,6 +6,7 @@
  * over machines (variant index i % M == K) with the index as first column
  * for a deterministic merge (sort -n). */
 #include <math.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -43,6 +44,8 @@ const char cmd_sweep_help[] =
     "  -j, --jobs N      worker threads (default: the number of processors)\n"
     "  --shard K/M       only the variants with index % M == K\n"
     "  --forces          also the force analysis (needed for driver.torque metrics)\n"
+    "  -q, --quiet       no progress report (a bar on a terminal, else a line every\n"
+    "                    5 s)\n"
     "  -h, --help        show this help\n"
     "\n"
     "exit status: 0 the sweep ran and at least one variant was solved, 1 no variant\n"
@@ -86,6 +89,9 @@ typedef struct sweep_run {
     int forces;
     variant *vars;
     int nvars;            /* variants in this shard */
+    int quiet;            /* -q: no progress report */
+    atomic_int done;      /* variants finished */
+    cmd_progress progress;
 } sweep_run;
 
 
@@ -442,6 +448,7 @@ static void sweep_job(void *ctx, int i)
 {
     sweep_run *r = ctx;
     run_variant(r, &r->vars[i]);
+    cmd_progress_update(&r->progress, atomic_fetch_add(&r->done, 1) + 1, r->nvars);
 }
 
 /* ---- output ------------------------------------------------------------ */
@@ -586,6 +593,8 @@ static int parse_sweep_args(int argc, char **argv, sweep_run *r, sweep_opts *so)
             code = sweep_option(r, so, a, v);
         else if (!strcmp(a, "--forces"))
             r->forces = 1;
+        else if (!strcmp(a, "-q") || !strcmp(a, "--quiet"))
+            r->quiet = 1;
         else if (a[0] == '-' && a[1])
             code = cmd_usage_error("sweep", "unknown option '%s'", a);
         else if (r->file)
@@ -631,7 +640,9 @@ static int run_variants(sweep_run *r, const sweep_opts *so, long total)
     for (long i = 0; i < total; i++)
         if (i % so->shard_m == so->shard_k)
             r->vars[r->nvars++].index = (int)i;
+    cmd_progress_init(&r->progress, "sweep", "variants", r->quiet);
     cmd_run_parallel(r->nvars, (int)so->nthreads, sweep_job, r);
+    cmd_progress_done(&r->progress);
     int nok = 0;
     for (int i = 0; i < r->nvars; i++) {
         if (strcmp(r->vars[i].status, "ok") == 0)

@@ -68,4 +68,22 @@ int cmd_sweep(int argc, char **argv);
 extern const char cmd_compare_help[];
 int cmd_compare(int argc, char **argv);
 
+/* cmd_common.c: progress of a long run on standard error: on a terminal a
+ * bar redrawn at most ten times a second, otherwise a line every few
+ * seconds (MECH_PROGRESS_SECONDS overrides: 0 prints every update); quiet
+ * prints nothing. Thread safe (the batch and sweep workers call it). */
+typedef struct cmd_progress {
+    const char *command;  /* "solve" */
+    const char *unit;     /* "rows", "files", "variants" */
+    int quiet, tty;
+    double start, last, interval;
+    int drawn;            /* a bar is on the terminal's line */
+} cmd_progress;
+void cmd_progress_init(cmd_progress *p, const char *command, const char *unit, int quiet);
+void cmd_progress_update(cmd_progress *p, int done, int total);
+/* After the run: ends the bar's line. */
+void cmd_progress_done(cmd_progress *p);
+/* The signature of mech_solve_options.progress (ctx: a cmd_progress). */
+void cmd_progress_callback(void *ctx, int done, int total);
+
 #endif

@@ -412,7 +412,10 @@ static int sweep_rows(run *r, const double *q, int nq)
 {
     int status = MECH_OK, in_gap = 0;
     mech_gap g = {0};
+    const mech_solve_options *o = &r->a->opt;
     for (int row = 0; row < nq; row++) {
+        if (o->progress && row > 0 && (row & 4095) == 0)
+            o->progress(o->progress_ctx, row, nq);
         int rc = solve_row(r, q, row, &g, in_gap);
         if (rc == MECH_OK) {
             if (in_gap && add_gap(r->t, &g) != 0)
@@ -426,6 +429,8 @@ static int sweep_rows(run *r, const double *q, int nq)
         g.last_row = row;
         in_gap = 1;
     }
+    if (o->progress)
+        o->progress(o->progress_ctx, nq, nq);
     if (in_gap) {
         g.to = q[nq - 1];
         g.to_limit = 0;

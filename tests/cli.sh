@@ -442,4 +442,19 @@ if run "mech solve, speed 1e160 rad/s" 1 "$MECH" solve "$tmp/fast.yaml" -o "$tmp
     [ -e "$tmp/fast.csv" ] && fail "solve: non-finite result: a file was written" || pass
 fi
 
+# issue 22 item 4: progress of long runs on standard error, a line every
+# MECH_PROGRESS_SECONDS when it is not a terminal (0: every report); -q none
+if run "mech solve, progress" 0 env MECH_PROGRESS_SECONDS=0 "$MECH" solve mechanisms/fourbar.yaml --steps 10000 -o "$tmp/prog.csv"; then
+    has_line "$tmp/err" '^mech solve: 4096 of 10001 rows (40%), [0-9]* s$' "solve: progress lines"
+fi
+if run "mech solve -q, no progress" 0 env MECH_PROGRESS_SECONDS=0 "$MECH" solve mechanisms/fourbar.yaml --steps 10000 -q -o "$tmp/prog.csv"; then
+    grep -q 'rows (' "$tmp/err" && fail "solve -q: progress printed" || pass
+fi
+if run "mech sweep, progress" 0 env MECH_PROGRESS_SECONDS=0 "$MECH" sweep mechanisms/slider-crank.yaml --vary r=30mm:40mm:3 -j 1 -o "$tmp/prog-sweep.csv"; then
+    has_line "$tmp/err" '^mech sweep: 2 of 3 variants (66%), [0-9]* s$' "sweep: progress lines"
+fi
+if run "mech batch, progress" 0 env MECH_PROGRESS_SECONDS=0 "$MECH" batch -j 1 mechanisms/fourbar.yaml mechanisms/slider-crank.yaml; then
+    has_line "$tmp/err" '^mech batch: 1 of 2 files (50%), [0-9]* s$' "batch: progress lines"
+fi
+
 summary
