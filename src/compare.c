@@ -706,23 +706,33 @@ static int worse(int a, int b)
     return MECH_OK;
 }
 
+/* Compare a (read with status ra, problems in d) against the golden file,
+ * print the problems, free both. */
+static int compare_with_golden(compare_table *a, int ra, const char *out_name,
+                               const char *golden, const compare_options *o, FILE *report,
+                               FILE *errors, mech_diag *d)
+{
+    compare_table b;
+    int rb = compare_read_csv(golden, &b, d);
+    int rc = worse(ra, rb);
+    if (rc == MECH_OK)
+        rc = compare_tables(a, &b, out_name, golden, o, report, d);
+    if (errors)
+        mech_diag_print(d, errors);
+    mech_diag_free(d);
+    compare_table_free(a);
+    compare_table_free(&b);
+    return rc;
+}
+
 int compare_csv_files(const char *out, const char *golden, const compare_options *o,
                       FILE *report, FILE *errors)
 {
     mech_diag d;
     mech_diag_init(&d);
-    compare_table a, b;
+    compare_table a;
     int ra = compare_read_csv(out, &a, &d);
-    int rb = compare_read_csv(golden, &b, &d);
-    int rc = worse(ra, rb);
-    if (rc == MECH_OK)
-        rc = compare_tables(&a, &b, out, golden, o, report, &d);
-    if (errors)
-        mech_diag_print(&d, errors);
-    mech_diag_free(&d);
-    compare_table_free(&a);
-    compare_table_free(&b);
-    return rc;
+    return compare_with_golden(&a, ra, out, golden, o, report, errors, &d);
 }
 
 /* *c = a copy of the solver's table t, as compare_read_csv would read its
@@ -756,20 +766,11 @@ int compare_result_file(const mech_table *out, const char *out_name, const char 
 {
     mech_diag d;
     mech_diag_init(&d);
-    compare_table a, b;
+    compare_table a;
     int ra = table_of_result(out, &a);
     if (ra != MECH_OK)
         diag_error(&d, out_name, (mech_mark){0, 0}, "out of memory");
-    int rb = compare_read_csv(golden, &b, &d);
-    int rc = worse(ra, rb);
-    if (rc == MECH_OK)
-        rc = compare_tables(&a, &b, out_name, golden, o, report, &d);
-    if (errors)
-        mech_diag_print(&d, errors);
-    mech_diag_free(&d);
-    compare_table_free(&a);
-    compare_table_free(&b);
-    return rc;
+    return compare_with_golden(&a, ra, out_name, golden, o, report, errors, &d);
 }
 
 int compare_exit_status(int status)
