@@ -63,6 +63,48 @@ static const char *reserved_name(const char *s)
     return unit_is_name(s, strlen(s)) ? "the unit" : NULL;
 }
 
+/* The value of parameter `name` (key k, value v): the file's definition or
+ * its replacement (mech sweep, --set), which must be a quantity of the same
+ * dimension. 0, or -1 with the problem reported (or echoing one already). */
+static int eval_parameter(loader *ld, const ynode *k, const ynode *v, const char *name,
+                          expr_param *p)
+{
+    char msg[256];
+    size_t pos = 0;
+    const char *text = v->text;
+    for (int o = 0; o < ld->nov; o++)
+        if (strcmp(ld->ov[o].name, name) == 0) {
+            text = ld->ov[o].text;
+            ld->ov_used[o] = 1;
+        }
+    if (text != v->text && quantity_eval_param(text, &ld->env, p, msg, sizeof msg, &pos) < 0) {
+        diag_error(ld->d, ld->file, v->mark, "parameter '%s' replaced by '%s': %s", name, text,
+                   msg);
+        return -1;
+    }
+    expr_param was = {0};
+    if (text != v->text && !p->bare &&
+        quantity_eval_param(v->text, &ld->env, &was, msg, sizeof msg, &pos) == 0 && !was.bare &&
+        !dim_equal(was.d, p->d)) {
+        char du[32], dw[32];
+        dim_format(p->d, du, sizeof du);
+        dim_format(was.d, dw, sizeof dw);
+        diag_error(ld->d, ld->file, v->mark, "parameter '%s' replaced by '%s': a quantity in "
+                   "%s, where the file's '%s' is in %s", name, text, du, v->text, dw);
+        return -1;
+    }
+    if (text == v->text && quantity_eval_param(v->text, &ld->env, p, msg, sizeof msg, &pos) < 0) {
+        int echo = load_uses_bad_param(ld, v->text);
+        if (name_map_put(&ld->bad_params, k->text, 1) < 0 || echo)
+            return -1;
+        mech_mark at = v->mark;
+        at.col += (int)pos + (v->quoted ? 1 : 0);
+        diag_error(ld->d, ld->file, at, "parameter '%s': %s", name, msg);
+        return -1;
+    }
+    return 0;
+}
+
 void load_parameters(loader *ld, const ynode *map)
 {
     if (!load_check_map(ld, map, NULL, 0, "'parameters'", "parameter"))
@@ -96,39 +138,8 @@ void load_parameters(loader *ld, const ynode *map)
         if (!load_want_kind(ld, v, YNODE_SCALAR, "a parameter value"))
             continue;
         expr_param p = {0};
-        char msg[256];
-        size_t pos = 0;
-        const char *text = v->text;
-        for (int o = 0; o < ld->nov; o++)
-            if (strcmp(ld->ov[o].name, name) == 0) {
-                text = ld->ov[o].text;
-                ld->ov_used[o] = 1;
-            }
-        if (text != v->text && quantity_eval_param(text, &ld->env, &p, msg, sizeof msg, &pos) < 0) {
-            diag_error(ld->d, ld->file, v->mark, "parameter '%s' replaced by '%s': %s", name,
-                       text, msg);
+        if (eval_parameter(ld, k, v, name, &p) != 0)
             continue;
-        }
-        expr_param was = {0};
-        if (text != v->text && !p.bare &&
-            quantity_eval_param(v->text, &ld->env, &was, msg, sizeof msg, &pos) == 0 &&
-            !was.bare && !dim_equal(was.d, p.d)) {
-            char du[32], dw[32];
-            dim_format(p.d, du, sizeof du);
-            dim_format(was.d, dw, sizeof dw);
-            diag_error(ld->d, ld->file, v->mark, "parameter '%s' replaced by '%s': a quantity in "
-                       "%s, where the file's '%s' is in %s", name, text, du, v->text, dw);
-            continue;
-        }
-        if (text == v->text && quantity_eval_param(v->text, &ld->env, &p, msg, sizeof msg, &pos) < 0) {
-            int echo = load_uses_bad_param(ld, v->text);
-            if (name_map_put(&ld->bad_params, k->text, 1) < 0 || echo)
-                continue;
-            mech_mark at = v->mark;
-            at.col += (int)pos + (v->quoted ? 1 : 0);
-            diag_error(ld->d, ld->file, at, "parameter '%s': %s", name, msg);
-            continue;
-        }
         mech_param *mp = &m->params[m->nparams];
         mp->name = xstrdup(name);
         if (!mp->name || name_map_put(&ld->param_map, mp->name, m->nparams) < 0) {
