@@ -21,8 +21,7 @@ enum { EXACT_NORM_MAX = 8, HAGER_ITERATIONS = 5, WHOLE_HAGER_ITERATIONS = 2 };
 void blocklu_plan_free(blocklu_plan *b)
 {
     void *blocks[] = {b->P, b->Q, b->R, b->at, b->where, b->op, b->oi};
-    for (size_t i = 0; i < sizeof blocks / sizeof blocks[0]; i++)
-        free(blocks[i]);
+    free_all(blocks, COUNT_OF(blocks));
     memset(b, 0, sizeof *b);
 }
 
@@ -47,8 +46,7 @@ int blocklu_init(blocklu *b, const blocklu_plan *plan)
 void blocklu_free(blocklu *b)
 {
     void *blocks[] = {b->v, b->piv, b->anorm, b->colnorm, b->w};
-    for (size_t i = 0; i < sizeof blocks / sizeof blocks[0]; i++)
-        free(blocks[i]);
+    free_all(blocks, COUNT_OF(blocks));
     memset(b, 0, sizeof *b);
 }
 

@@ -51,18 +51,16 @@ int cont_init(cont *c, const solver_plan *sp, mech_diag *d, mech_solve_stats *st
     size_t ns = (size_t)sp->ns + 1;
     double **arrays[] = {&c->xc, &c->xqc, &c->xqqc, &c->xqq_prev, &c->xpred,
                          &c->x0, &c->xq0, &c->xqq0, &c->xgap, &c->xqgap, &c->xqqgap};
-    for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
-        if (!(*arrays[i] = xcalloc(ns, sizeof(double))))
-            return -1;
+    if (xcalloc_doubles(arrays, NULL, ns, COUNT_OF(arrays)) < 0)
+        return -1;
     return gather_guesses(c);
 }
 
 void cont_free(cont *c)
 {
-    double *arrays[] = {c->xc, c->xqc, c->xqqc, c->xqq_prev, c->xpred, c->x0,
-                        c->xq0, c->xqq0, c->guess, c->xgap, c->xqgap, c->xqqgap};
-    for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
-        free(arrays[i]);
+    void *blocks[] = {c->xc, c->xqc, c->xqqc, c->xqq_prev, c->xpred, c->x0,
+                      c->xq0, c->xqq0, c->guess, c->xgap, c->xqgap, c->xqqgap};
+    free_all(blocks, COUNT_OF(blocks));
     solver_free(&c->sv);
     memset(c, 0, sizeof *c);
 }

@@ -273,8 +273,7 @@ void forces_plan_free(forces_plan *fp)
 {
     linsys_plan_free(&fp->lp);
     void *blocks[] = {fp->kind, fp->joint, fp->jcol, fp->Ap, fp->Ai};
-    for (size_t i = 0; i < sizeof blocks / sizeof blocks[0]; i++)
-        free(blocks[i]);
+    free_all(blocks, COUNT_OF(blocks));
     memset(fp, 0, sizeof *fp);
 }
 
@@ -289,19 +288,17 @@ int forces_init(forces *fc, const forces_plan *fp)
                          &fc->g, &fc->vg, &fc->ag};
     size_t sizes[] = {(size_t)fp->nnz + 1, nc, nr + nc, nr + nc, nr + nc, nr + nc,
                       nr, nr, depth * nr, depth * nr, nr, nl2, nl2, nl2};
-    for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
-        if (!(*arrays[i] = xcalloc(sizes[i], sizeof(double))))
-            return -1;
+    if (xcalloc_doubles(arrays, sizes, 0, COUNT_OF(arrays)) < 0)
+        return -1;
     return linsys_init(&fc->ls, &fp->lp);
 }
 
 void forces_free(forces *fc)
 {
     linsys_free(&fc->ls);
-    double *arrays[] = {fc->Ax, fc->b, fc->y, fc->y0, fc->ynext, fc->fric, fc->cscale,
-                        fc->g, fc->vg, fc->ag, fc->aa_g, fc->aa_r, fc->aa_dg, fc->aa_dr};
-    for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
-        free(arrays[i]);
+    void *blocks[] = {fc->Ax, fc->b, fc->y, fc->y0, fc->ynext, fc->fric, fc->cscale,
+                      fc->g, fc->vg, fc->ag, fc->aa_g, fc->aa_r, fc->aa_dg, fc->aa_dr};
+    free_all(blocks, COUNT_OF(blocks));
     memset(fc, 0, sizeof *fc);
 }
 

@@ -36,6 +36,12 @@ void *xcalloc(size_t n, size_t size);           /* NULL on overflow or failure *
 extern _Thread_local long xalloc_fail_countdown;
 void *xrealloc_array(void *p, size_t n, size_t size);
 char *xstrdup(const char *s);
+/* *arrays[i] = sizes[i] zeroed doubles (size when sizes is NULL), for i < n.
+ * 0, or -1 when out of memory (those allocated stay set: free them). */
+int xcalloc_doubles(double **const *arrays, const size_t *sizes, size_t size, size_t n);
+/* free() each of the n blocks. */
+void free_all(void *const *blocks, size_t n);
+#define COUNT_OF(a) (sizeof(a) / sizeof((a)[0]))
 int edit_distance(const char *a, const char *b); /* Levenshtein, capped at 99 */
 /* Parity of a permutation of 0..n-1 (0 even, 1 odd), by its cycles; seen:
  * n bytes of work. */

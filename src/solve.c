@@ -439,8 +439,7 @@ void solver_plan_free(solver_plan *sp)
     mech_system_free(&sp->sys);
     void *blocks[] = {sp->col, sp->row, sp->Ap, sp->Ai, sp->Ax0, sp->jpos, sp->proot,
                       sp->vroot, sp->aroot};
-    for (size_t i = 0; i < sizeof blocks / sizeof blocks[0]; i++)
-        free(blocks[i]);
+    free_all(blocks, COUNT_OF(blocks));
     memset(sp, 0, sizeof *sp);
 }
 
@@ -457,9 +456,8 @@ int solver_init(solver *sv, const solver_plan *sp)
                          &sv->ft, &sv->dx, &sv->xt, &sv->rhs, &sv->cscale, &sv->Jv, &sv->Ax};
     size_t sizes[] = {n1, n1, n1, ns, ns, ns, nr, nr, ns, ns, nr + ns, ns,
                       (size_t)sp->nnzJ + 1, (size_t)sp->nnz + 1};
-    for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
-        if (!(*arrays[i] = xcalloc(sizes[i], sizeof(double))))
-            return -1;
+    if (xcalloc_doubles(arrays, sizes, 0, COUNT_OF(arrays)) < 0)
+        return -1;
     memcpy(sv->Ax, sp->Ax0, (size_t)sp->nnz * sizeof *sv->Ax);
     if (!(sv->reg = tape_registers_new(&sp->tp)))
         return -1;
@@ -472,10 +470,9 @@ void solver_free(solver *sv)
 {
     linsys_free(&sv->ls);
     kin_state_free(&sv->ks);
-    double *arrays[] = {sv->reg, sv->pos, sv->vel, sv->acc, sv->x, sv->xq, sv->xqq, sv->f,
-                        sv->ft, sv->dx, sv->xt, sv->rhs, sv->cscale, sv->Jv, sv->Ax};
-    for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
-        free(arrays[i]);
+    void *blocks[] = {sv->reg, sv->pos, sv->vel, sv->acc, sv->x, sv->xq, sv->xqq, sv->f,
+                      sv->ft, sv->dx, sv->xt, sv->rhs, sv->cscale, sv->Jv, sv->Ax};
+    free_all(blocks, COUNT_OF(blocks));
     memset(sv, 0, sizeof *sv);
 }
 

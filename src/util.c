@@ -30,6 +30,20 @@ void *xrealloc_array(void *p, size_t n, size_t size)
     return realloc(p, bytes ? bytes : 1);
 }
 
+int xcalloc_doubles(double **const *arrays, const size_t *sizes, size_t size, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        if (!(*arrays[i] = xcalloc(sizes ? sizes[i] : size, sizeof(double))))
+            return -1;
+    return 0;
+}
+
+void free_all(void *const *blocks, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        free(blocks[i]);
+}
+
 char *xstrdup(const char *s)
 {
     if (fail_now())

@@ -319,13 +319,7 @@ static void redundant_errors(const char *initial, double err[3])
              "initial: %s\n"
              "outputs: {points: [F], links: [coupler, rocker, extra]}\n", initial);
     mech_model *m = load_text(text);
-    mech_solve_options o;
-    mech_solve_options_default(&o);
-    mech_diag d;
-    mech_diag_init(&d);
-    mech_table t = {0};
-    int rc = mech_solve(m, &o, &t, NULL, &d);
-    cr_assert_eq(rc, MECH_OK, "rc %d", rc);
+    mech_table t = must_solve(m, NULL);
     cr_assert_eq(t.nrows, 121);
     memset(err, 0, 3 * sizeof *err);
     for (int i = 0; i < t.nrows; i++) {
@@ -349,7 +343,6 @@ static void redundant_errors(const char *initial, double err[3])
         }
     }
     mech_table_free(&t);
-    mech_diag_free(&d);
     mech_model_free(&m);
 }
 
