@@ -67,22 +67,14 @@ const char cmd_solve_help[] =
     "the rows that were solved are written, each gap is listed), 2 invalid file or\n"
     "usage, 3 a file cannot be read or written\n";
 
-enum { MAX_SET = 64 };
-
 /* The smallest --tol: a residual is a sum of products of lengths, rounded
  * to about DBL_EPSILON (2.2e-16) times the largest; below a few times that
  * Newton cannot get (docs/solver.md: 4e-15 or better on every file). */
 #define MIN_TOL 1e-15
-/* The largest driver position on the command line, rad or m: beyond it a
- * step of the sweep is lost in the rounding of the position itself
- * (1e6 rad = 57 million degrees, ulp 1.2e-10 rad). */
-#define MAX_DRIVER 1e6
 
 typedef struct solve_args {
     const char *file, *out, *from, *to, *outputs;
-    mech_override set[MAX_SET];  /* --set NAME=VALUE: parameters replaced */
-    char *set_text[MAX_SET];
-    int nset;
+    cmd_sets set;                /* --set NAME=VALUE: parameters replaced */
     int steps, stats, verbose, quiet;
     int within;                  /* --within-assembly or --range assembly */
     mech_outputs selected;       /* --outputs, parsed (opt.outputs points here) */
@@ -147,16 +139,7 @@ static int parse_valued(solve_args *a, const char *arg, const char *val)
         else
             return cmd_usage_error("solve", "--linear-solver needs auto or klu, not '%s'", val);
     } else if (strcmp(arg, "--set") == 0) {
-        const char *eq = strchr(val, '=');
-        if (!eq || eq == val || !eq[1] || a->nset == MAX_SET)
-            return cmd_usage_error("solve", "--set needs NAME=VALUE (at most 64), not '%s'", val);
-        char *copy = strdup(val);
-        if (!copy)
-            return fprintf(stderr, "mech solve: out of memory\n"), MECH_EXIT_IO;
-        copy[eq - val] = '\0';
-        a->set_text[a->nset] = copy;
-        a->set[a->nset].name = copy;
-        a->set[a->nset++].text = copy + (eq - val) + 1;
+        return cmd_parse_set("solve", val, &a->set);
     } else if (strcmp(arg, "--range") == 0) {
         if (strcmp(val, "assembly") != 0)
             return cmd_usage_error("solve", "--range needs 'assembly', not '%s'", val);
@@ -223,27 +206,7 @@ static int parse_args(int argc, char **argv, solve_args *a)
     }
     if (!a->file)
         return cmd_usage_error("solve", "%s", "no file given (usage: mech solve FILE [-o OUT.csv] ...)");
-    if ((a->from != NULL) != (a->to != NULL))
-        return cmd_usage_error("solve", "%s", "--from and --to go together");
-    return -1;
-}
-
-/* One end of --from/--to into *si: a finite position within MAX_DRIVER, as
- * the file's range must be finite (docs/limits.md). Returns -1 when fine,
- * else the exit status (the problem printed). */
-static int parse_end(const char *opt, const char *text, int is_angle, double *si)
-{
-    char err[256];
-    if (mech_parse_value(text, is_angle, si, err, sizeof err) != MECH_OK)
-        return fprintf(stderr, "mech solve: %s '%s': %s\n", opt, text, err), MECH_EXIT_INPUT;
-    if (!(fabs(*si) <= MAX_DRIVER)) {
-        snprintf(err, sizeof err, "%s '%.40s' is %.3g %s: a driver %s must be within +-%s "
-                 "(beyond, a step is lost in the rounding of the position)", opt, text, *si,
-                 is_angle ? "rad" : "m", is_angle ? "angle" : "displacement",
-                 is_angle ? "1e6 rad (5.7e7 deg)" : "1e6 m");
-        return cmd_usage_error("solve", "%s", err);
-    }
-    return -1;
+    return cmd_check_range_pair("solve", a->from, a->to);
 }
 
 /* --from/--to/--steps and --outputs into the options (the model is not
@@ -251,20 +214,9 @@ static int parse_end(const char *opt, const char *text, int is_angle, double *si
 static int apply_overrides(solve_args *a, const mech_model *m)
 {
     char err[256];
-    int is_angle = m->driver.kind == MECH_DRIVE_ANGLE, code;
-    if (a->from) {
-        if ((code = parse_end("--from", a->from, is_angle, &a->opt.from)) >= 0 ||
-            (code = parse_end("--to", a->to, is_angle, &a->opt.to)) >= 0)
-            return code;
-        a->opt.has_range = 1;
-        a->opt.steps = a->steps > 0 ? a->steps : 360;
-    } else if (a->steps > 0) {
-        /* new spacing over the file's range */
-        a->opt.has_range = 1;
-        a->opt.from = m->driver.values[0];
-        a->opt.to = m->driver.values[m->driver.nvalues - 1];
-        a->opt.steps = a->steps;
-    }
+    int code = cmd_apply_range("solve", a->from, a->to, a->steps, m, &a->opt);
+    if (code >= 0)
+        return code;
     if (a->outputs) {
         if (mech_outputs_parse(m, a->outputs, &a->selected, err, sizeof err) != MECH_OK)
             return fprintf(stderr, "mech solve: --outputs: %s\n", err), MECH_EXIT_INPUT;
@@ -391,16 +343,14 @@ int cmd_solve(int argc, char **argv)
     solve_args a = {0};
     int code = parse_args(argc, argv, &a);
     if (code >= 0) {
-        for (int i = 0; i < a.nset; i++)
-            free(a.set_text[i]);
+        cmd_sets_free(&a.set);
         return code;
     }
     mech_model *m = NULL;
     code = cmd_refuse_input("solve", a.out, &a.file, 1);
     if (code < 0)
-        code = cmd_load_checked_with(a.file, a.set, a.nset, &m);
-    for (int i = 0; i < a.nset; i++)
-        free(a.set_text[i]);
+        code = cmd_load_checked_with(a.file, a.set.set, a.set.n, &m);
+    cmd_sets_free(&a.set);
     if (code != MECH_EXIT_OK)
         return code;
     if ((code = apply_overrides(&a, m)) >= 0) {
