@@ -218,24 +218,6 @@ int plot_plan(const mech_model *m, const mech_table *t, plot_figure *figs, int m
 /* ------------------------------------------------------------------ */
 /* One figure.                                                         */
 
-static const char *const series_colour[PLOT_MAX_SERIES] = {
-    "#1f4e99", "#c0392b", "#1e7b3c", "#7d3c98", "#b86e00", "#0f7c8c", "#404040", "#a0306a"};
-static const char *const series_dash[4] = {"", "7,4", "2,3", "9,3,2,3"};
-/* markers centred on 0,0: circle, square, triangle, diamond */
-static const char *const marker_path[4] = {
-    "M-3.5,0a3.5,3.5 0 1 0 7,0a3.5,3.5 0 1 0-7,0z", "M-3.2-3.2h6.4v6.4h-6.4z",
-    "M0-4.3L3.9,2.7H-3.9z", "M0-4.5L4.5,0 0,4.5-4.5,0z"};
-
-/* Style s: colour s, marker shape s % 4 (open for s < 4, filled after),
- * dash (s + s / 4) % 4, so that no two of the 8 styles share shape, fill and dash. */
-static void style_of(int s, const char **colour, const char **dash, int *shape, int *filled)
-{
-    *colour = series_colour[s % PLOT_MAX_SERIES];
-    *dash = series_dash[(s + s / 4) % 4];
-    *shape = s % 4;
-    *filled = s >= 4;
-}
-
 typedef struct fig_ctx {
     const mech_model *m;
     const mech_table *t;
@@ -316,7 +298,7 @@ static void fig_head(FILE *f, const fig_ctx *c)
     plot_put_text(f, fg->title);
     fputs("</title>\n<defs>", f);
     for (int k = 0; k < 4; k++)
-        fprintf(f, "<path id=\"m%d\" d=\"%s\"/>", k, marker_path[k]);
+        fprintf(f, "<path id=\"m%d\" d=\"%s\"/>", k, plot_marker_path[k]);
     fprintf(f, "<clipPath id=\"plot\"><rect x=\"%d\" y=\"%d\" width=\"%d\" height=\"%d\"/>"
                "</clipPath></defs>\n", AX_L, AX_T, AX_R - AX_L, AX_B - AX_T);
     fprintf(f, "<rect width=\"%d\" height=\"%d\" fill=\"#fff\"/>\n", FIG_W, FIG_H);
@@ -351,37 +333,63 @@ static void fig_frame(FILE *f, const fig_ctx *c, const plot_axis *ax, const plot
     fputs("</text>\n", f);
 }
 
+/* Series s of a figure as page pixels (plot_vertex_fn). */
+typedef struct curve_ctx {
+    const fig_ctx *c;
+    const plot_axis *ax, *ay;
+    int s;
+} curve_ctx;
+
+static int curve_vertex(const void *vctx, int r, double *px, double *py)
+{
+    const curve_ctx *k = vctx;
+    double x = xval(k->c, r), y = mech_table_get(k->c->t, r, k->c->f->col[k->s]) * k->c->f->yscale;
+    *px = px_of(k->ax, x);
+    *py = py_of(k->ay, y);
+    return isfinite(x) && isfinite(y);
+}
+
+/* A curve of more than 4 points per pixel column, that the thinning to
+ * PLOT_THIN_TOL cannot bring to that many vertices (a scribble at the scale
+ * of the pixels): each column keeps its first, lowest, highest and last
+ * point, in row order, so the curve covers the same pixels. */
+static void curve_columns(plot_pen *p, const curve_ctx *k, int nrows)
+{
+    plot_run run = {0};
+    for (int r = 0; r < nrows; r++) {
+        double px, py;
+        if (!curve_vertex(k, r, &px, &py)) {
+            plot_run_flush(&run, p);
+            p->state = 0;
+            continue;
+        }
+        plot_run_add(&run, p, r, px, py, (long)floor(px - AX_L));
+    }
+    plot_run_flush(&run, p);
+}
+
 /* The curve of series s: a path broken at non-finite values. */
 static void fig_curve(FILE *f, const fig_ctx *c, const plot_axis *ax, const plot_axis *ay,
                       int s, const char *colour, const char *dash)
 {
     const mech_table *t = c->t;
-    const plot_figure *fg = c->f;
     fprintf(f, "<path stroke=\"%s\"%s%s%s d=\"", colour, *dash ? " stroke-dasharray=\"" : "",
             dash, *dash ? "\"" : "");
-    /* A 10^6-step sweep would write 10^6 vertices (350 MB of SVG) that
-     * land on 504 pixel columns: past THIN_FROM rows each column keeps
-     * its first, lowest, highest and last point, in row order. Every
-     * point dropped lies in its column between the kept extremes, on a
-     * stretch the kept vertices span, so the drawn curve is the same
-     * to the pixel, spikes included. */
-    plot_pen p = {f, 0};
-    plot_run run = {0};
-    int thin = t->nrows > THIN_FROM;
-    for (int r = 0; r < t->nrows; r++) {
-        double x = xval(c, r), y = mech_table_get(t, r, fg->col[s]) * fg->yscale;
-        if (!isfinite(x) || !isfinite(y)) {
-            plot_run_flush(&run, &p);
-            p.state = 0;
-            continue;
-        }
-        double px = px_of(ax, x), py = py_of(ay, y);
-        if (thin)
-            plot_run_add(&run, &p, r, px, py, (long)floor(px - AX_L));
+    /* A 10^6-step sweep would write 10^6 vertices (350 MB of SVG) on 504
+     * pixel columns: past THIN_FROM rows the curve is thinned to within
+     * PLOT_THIN_TOL px of every row (extremes kept), or, when that leaves
+     * more than THIN_FROM vertices, to its pixel columns. */
+    curve_ctx k = {c, ax, ay, s};
+    plot_pen p = {f, 0, 2, 0};
+    if (t->nrows <= THIN_FROM) {
+        plot_draw_all(&p, curve_vertex, &k, t->nrows);
+    } else {
+        plot_pen count = {NULL, 0, 2, 0};
+        if (plot_thin_draw(&count, PLOT_THIN_TOL, curve_vertex, &k, t->nrows) <= THIN_FROM)
+            plot_thin_draw(&p, PLOT_THIN_TOL, curve_vertex, &k, t->nrows);
         else
-            plot_pen_to(&p, px, py);
+            curve_columns(&p, &k, t->nrows);
     }
-    plot_run_flush(&run, &p);
     fputs("\"/>\n", f);
 }
 
@@ -394,7 +402,7 @@ static void fig_markers(FILE *f, const fig_ctx *c, const plot_axis *ax, const pl
     const char *colour, *dash;
     int shape, filled;
     char b1[32], b2[32];
-    style_of(s, &colour, &dash, &shape, &filled);
+    plot_style(s, &colour, &dash, &shape, &filled);
     fprintf(f, "<g stroke=\"%s\" fill=\"%s\">", colour, filled ? colour : "#fff");
     for (int r = (s * every) / (fg->nseries > 0 ? fg->nseries : 1); r < t->nrows; r += every) {
         double x = xval(c, r), y = mech_table_get(t, r, fg->col[s]) * fg->yscale;
@@ -415,7 +423,7 @@ static void fig_series(FILE *f, const fig_ctx *c, const plot_axis *ax, const plo
     for (int s = 0; s < fg->nseries; s++) {
         const char *colour, *dash;
         int shape, filled;
-        style_of(s, &colour, &dash, &shape, &filled);
+        plot_style(s, &colour, &dash, &shape, &filled);
         fig_curve(f, c, ax, ay, s, colour, dash);
         fig_markers(f, c, ax, ay, s, every);
     }
@@ -432,7 +440,7 @@ static void fig_legend(FILE *f, const fig_ctx *c)
     for (int s = 0; s < fg->nseries; s++) {
         const char *colour, *dash;
         int shape, filled;
-        style_of(s, &colour, &dash, &shape, &filled);
+        plot_style(s, &colour, &dash, &shape, &filled);
         int y = ly + 17 + 22 * s;
         fprintf(f, "<path d=\"M%d,%dh36\" fill=\"none\" stroke=\"%s\" stroke-width=\"1.6\"%s%s%s/>",
                 lx + 8, y, colour, *dash ? " stroke-dasharray=\"" : "", dash, *dash ? "\"" : "");
@@ -447,6 +455,8 @@ static void fig_legend(FILE *f, const fig_ctx *c)
 static int emit_figure(FILE *f, const void *vctx)
 {
     const fig_ctx *c = vctx;
+    if (c->f->kind == PLOT_PATH)
+        return plot_path_svg(f, c->m, c->t, c->f, c->subtitle);
     plot_axis ax, ay;
     fig_axes(c, &ax, &ay);
     fig_head(f, c);

@@ -18,7 +18,12 @@
 
 #define PLOT_MAX_SERIES 8   /* series per figure: 8 line styles (dash x marker) */
 
-/* One figure: up to PLOT_MAX_SERIES columns of a table against column 0 (q). */
+/* What a figure draws: series against the driver, or paths (y against x). */
+typedef enum { PLOT_AGAINST_DRIVER = 0, PLOT_PATH = 1 } plot_kind;
+
+/* One figure: up to PLOT_MAX_SERIES columns of a table against column 0 (q),
+ * or (kind PLOT_PATH) the paths of up to PLOT_MAX_SERIES points: column
+ * ycol[s] against column col[s]. A zeroed figure is PLOT_AGAINST_DRIVER. */
 typedef struct plot_figure {
     char name[96];                    /* file stem, e.g. "points-position-1" */
     char title[160];                  /* "Point positions: D, L, J" */
@@ -28,6 +33,8 @@ typedef struct plot_figure {
     int col[PLOT_MAX_SERIES];         /* [nseries] table columns */
     char label[PLOT_MAX_SERIES][48];  /* [nseries] legend texts */
     int nseries;
+    plot_kind kind;
+    int ycol[PLOT_MAX_SERIES];        /* [nseries] PLOT_PATH: the y column of series s */
 } plot_figure;
 
 /* The figures a table calls for, in order: points (positions, velocities,
@@ -37,6 +44,14 @@ typedef struct plot_figure {
  * force. Groups with more than PLOT_MAX_SERIES series are split evenly.
  * Returns the number of figures written to figs[0 .. max-1] (at most max). */
 int plot_plan(const mech_model *m, const mech_table *t, plot_figure *figs, int max);
+
+/* The path (coupler-curve) figures of a table, defined in src/plot_path.c:
+ * the output points of m that move and have position columns in t, at most
+ * PLOT_MAX_SERIES per figure ("paths", or "paths-1", "paths-2", ... split
+ * evenly). Each is kind PLOT_PATH, written by plot_figure_write: y against
+ * x in mm on equal axes, a start marker, arrows in the direction of motion.
+ * Returns the number of figures written to figs[0 .. max-1]. */
+int plot_path_plan(const mech_model *m, const mech_table *t, plot_figure *figs, int max);
 
 /* Write one figure of table t as a standalone SVG document to `path`
  * (a temporary file beside it, renamed when complete; "-" = stdout).
