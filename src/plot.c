@@ -153,7 +153,18 @@ static void plan_sliders(plan *p, const mech_model *m)
               a_, none, 1);
 }
 
-/* Forces: one figure per joint, with and without friction when both exist. */
+/* The links a joint's reaction acts on and comes from (docs/forces.md,
+ * "Sign conventions"): a revolute's is the force on the later link in the
+ * file from the earlier one; a slider's, on the sliding link from the guide. */
+static void reaction_links(const mech_joint *jt, int *on, int *from)
+{
+    int later = jt->kind != MECH_JOINT_SLIDER && jt->link[1] > jt->link[0];
+    *on = later ? jt->link[1] : jt->link[0];
+    *from = later ? jt->link[0] : jt->link[1];
+}
+
+/* Forces: one figure per joint, with and without friction when both exist;
+ * the title and the legend say which link the force acts on. */
 static void plan_forces(plan *p, const mech_model *m)
 {
     static const char *const fxy[] = {".Fx", ".Fy", ".Fx.nofriction", ".Fy.nofriction"};
@@ -161,19 +172,27 @@ static void plan_forces(plan *p, const mech_model *m)
     for (int j = 0; j < m->njoints; j++) {
         const mech_joint *jt = &m->joints[j];
         char stem[96], title[160], nf[96];
+        int on, from, n0 = p->n;
+        reaction_links(jt, &on, &from);
         snprintf(nf, sizeof nf, "%s.Fx.nofriction", jt->name);
         int per = mech_table_column(p->t, nf) >= 0 ? 4 : 2;
         snprintf(stem, sizeof stem, "force-%s", jt->name);
-        snprintf(title, sizeof title, "Reaction at %s joint %s (%s-%s)",
+        snprintf(title, sizeof title, "Reaction at %s joint %s: force on %s from %s",
                  jt->kind == MECH_JOINT_SLIDER ? "slider" : "revolute", jt->name,
-                 m->links[jt->link[0]].name, m->links[jt->link[1]].name);
+                 m->links[on].name, m->links[from].name);
         const char *it[1] = {jt->name}, *lb[1] = {""};
         add_group(p, stem, title, "force", it, lb, 1, fxy, fxy_l, per);
+        for (int k = n0; k < p->n; k++) {
+            snprintf(p->figs[k].note[0], sizeof p->figs[k].note[0], "%s: force on %s",
+                     jt->name, m->links[on].name);
+            snprintf(p->figs[k].note[1], sizeof p->figs[k].note[1], "from %s",
+                     m->links[from].name);
+        }
     }
 }
 
 /* The driver torque (or force), with and without friction when both exist. */
-static void plan_driver(plan *p)
+static void plan_driver(plan *p, const mech_model *m)
 {
     const mech_table *t = p->t;
     const char *drv = mech_table_column(t, "driver.torque") >= 0 ? "driver.torque"
@@ -190,9 +209,20 @@ static void plan_driver(plan *p)
     static const char *const sfx_one[] = {""};
     const char *it[1] = {drv};
     const char *lb[1] = {both ? "" : torque ? "driver torque" : "driver force"};
+    int n0 = p->n;
     add_group(p, torque ? "driver-torque" : "driver-force",
               torque ? "Driver torque" : "Driver force", torque ? "torque" : "force", it, lb,
               1, sfx, both ? sfx_both : sfx_one, both ? 2 : 1);
+    /* applied by the ground to the driver link (docs/forces.md); a driving
+       slider's force acts along its guide on the sliding link */
+    int on = !m->has_driver ? -1 : torque ? m->driver.index
+             : m->joints[m->driver.index].link[0];
+    for (int k = n0; k < p->n && on >= 0; k++) {
+        snprintf(p->figs[k].note[0], sizeof p->figs[k].note[0], "%s on %s",
+                 torque ? "torque" : "force", m->links[on].name);
+        snprintf(p->figs[k].note[1], sizeof p->figs[k].note[1], "from %s",
+                 torque ? m->links[0].name : "the guide");
+    }
 }
 
 int plot_plan(const mech_model *m, const mech_table *t, plot_figure *figs, int max)
@@ -207,7 +237,7 @@ int plot_plan(const mech_model *m, const mech_table *t, plot_figure *figs, int m
         plan_links(&p, m);
         plan_sliders(&p, m);
         plan_forces(&p, m);
-        plan_driver(&p);
+        plan_driver(&p, m);
     }
     free(p.items);
     free(p.labels);
@@ -430,13 +460,25 @@ static void fig_series(FILE *f, const fig_ctx *c, const plot_axis *ax, const plo
     fputs("</g>\n", f);
 }
 
-/* The legend, right of the plot: each series' style and name. */
+/* The legend, right of the plot: its heading (fg->note: which link a force
+ * acts on), then each series' style and name. */
 static void fig_legend(FILE *f, const fig_ctx *c)
 {
     const plot_figure *fg = c->f;
     int lx = AX_R + 14, ly = AX_T;
+    int nnote = (fg->note[0][0] != '\0') + (fg->note[1][0] != '\0');
     fprintf(f, "<rect x=\"%d\" y=\"%d\" width=\"%d\" height=\"%d\" fill=\"#fff\" "
-               "stroke=\"#999\"/>\n", lx, ly, FIG_W - lx - 6, 12 + 22 * fg->nseries);
+               "stroke=\"#999\"/>\n", lx, ly, FIG_W - lx - 6,
+            12 + 22 * fg->nseries + 16 * nnote + (nnote ? 4 : 0));
+    for (int k = 0, y = ly + 16; k < 2; k++)
+        if (fg->note[k][0]) {
+            fprintf(f, "<text x=\"%d\" y=\"%d\" font-size=\"11\" class=\"legend-note\">",
+                    lx + 8, y);
+            plot_put_text(f, fg->note[k]);
+            fputs("</text>\n", f);
+            y += 16;
+        }
+    ly += 16 * nnote + (nnote ? 4 : 0);
     for (int s = 0; s < fg->nseries; s++) {
         const char *colour, *dash;
         int shape, filled;

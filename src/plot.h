@@ -35,6 +35,8 @@ typedef struct plot_figure {
     int nseries;
     plot_kind kind;
     int ycol[PLOT_MAX_SERIES];        /* [nseries] PLOT_PATH: the y column of series s */
+    char note[2][48];                 /* legend heading lines, e.g. "B: force on rocker",
+                                         "from coupler" (empty: none) */
 } plot_figure;
 
 /* The figures a table calls for, in order: points (positions, velocities,
@@ -46,10 +48,11 @@ typedef struct plot_figure {
 int plot_plan(const mech_model *m, const mech_table *t, plot_figure *figs, int max);
 
 /* The path (coupler-curve) figures of a table, defined in src/plot_path.c:
- * the output points of m that move and have position columns in t, at most
- * PLOT_MAX_SERIES per figure ("paths", or "paths-1", "paths-2", ... split
- * evenly). Each is kind PLOT_PATH, written by plot_figure_write: y against
- * x in mm on equal axes, a start marker, arrows in the direction of motion.
+ * one per output point of m that moves and has position columns in t
+ * ("path-P", in the order of the outputs), so each curve fills its figure.
+ * Each is kind PLOT_PATH, written by plot_figure_write: y against x in mm
+ * on equal axes, a start marker, arrows in the direction of motion (a
+ * PLOT_PATH figure may hold up to PLOT_MAX_SERIES paths, on one scale).
  * Returns the number of figures written to figs[0 .. max-1]. */
 int plot_path_plan(const mech_model *m, const mech_table *t, plot_figure *figs, int max);
 

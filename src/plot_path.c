@@ -1,6 +1,7 @@
 /* src/plot_path.c: the path (coupler-curve) figures of mech plot: which
  * points are traced (plot_path_plan: the output points that move) and each
- * figure (plot_path_svg, called by plot_figure_write): y against x in mm on
+ * figure (plot_path_svg, called by plot_figure_write; it draws up to
+ * PLOT_MAX_SERIES paths, the plan gives one per point): y against x in mm on
  * equal axes (1 mm in x is 1 mm in y on the page), a start marker and arrows
  * in the direction of motion, curves thinned past THIN_FROM rows to within
  * PLOT_THIN_TOL px. docs/plots.md, "Path figures". */
@@ -37,45 +38,30 @@ static int moves(const mech_table *t, int cx, int cy)
 
 int plot_path_plan(const mech_model *m, const mech_table *t, plot_figure *figs, int max)
 {
-    int n = m->outputs.npoints, nkeep = 0, nfig_done = 0;
-    int *keep = xcalloc((size_t)n + 1, sizeof *keep);
-    if (!keep)
-        return 0;
     char name[160];
-    for (int i = 0; i < n; i++) {
+    int nfig = 0;
+    for (int i = 0; i < m->outputs.npoints && nfig < max; i++) {
         const char *pn = m->point_names[m->outputs.points[i]];
         snprintf(name, sizeof name, "%s.x", pn);
         int cx = mech_table_column(t, name);
         snprintf(name, sizeof name, "%s.y", pn);
         int cy = mech_table_column(t, name);
-        if (cx >= 0 && cy >= 0 && moves(t, cx, cy))
-            keep[nkeep++] = i;
-    }
-    int nfig = (nkeep + PLOT_MAX_SERIES - 1) / PLOT_MAX_SERIES;
-    for (int fi = 0; fi < nfig && nfig_done < max; fi++) {
-        plot_figure *f = &figs[nfig_done++];
+        if (cx < 0 || cy < 0 || !moves(t, cx, cy))
+            continue;
+        plot_figure *f = &figs[nfig++];
         memset(f, 0, sizeof *f);
         f->kind = PLOT_PATH;
-        snprintf(f->name, sizeof f->name, nfig > 1 ? "paths-%d" : "paths", fi + 1);
-        if (nfig > 1)
-            snprintf(f->title, sizeof f->title, "Paths of the points (%d of %d)", fi + 1, nfig);
-        else
-            snprintf(f->title, sizeof f->title, "Paths of the points");
+        snprintf(f->name, sizeof f->name, "path-%s", pn);
+        snprintf(f->title, sizeof f->title, "Path of point %s", pn);
         snprintf(f->ylabel, sizeof f->ylabel, "y");
         snprintf(f->yunit, sizeof f->yunit, "mm");
         f->yscale = 1e3;
-        for (int k = fi * nkeep / nfig; k < (fi + 1) * nkeep / nfig; k++) {
-            const char *pn = m->point_names[m->outputs.points[keep[k]]];
-            snprintf(name, sizeof name, "%s.x", pn);
-            f->col[f->nseries] = mech_table_column(t, name);
-            snprintf(name, sizeof name, "%s.y", pn);
-            f->ycol[f->nseries] = mech_table_column(t, name);
-            snprintf(f->label[f->nseries], sizeof f->label[0], "%s", pn);
-            f->nseries++;
-        }
+        f->col[0] = cx;
+        f->ycol[0] = cy;
+        snprintf(f->label[0], sizeof f->label[0], "%s", pn);
+        f->nseries = 1;
     }
-    free(keep);
-    return nfig_done;
+    return nfig;
 }
 
 /* ------------------------------------------------------------------ */
