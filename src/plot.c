@@ -316,14 +316,18 @@ static void fig_axes(const fig_ctx *c, plot_axis *ax, plot_axis *ay)
 
 /* The document's start: root element, title, markers and clip path,
  * background, the figure's title and subtitle. */
-static void fig_head(FILE *f, const fig_ctx *c)
+static void fig_head(FILE *f, const fig_ctx *c, const plot_axis *ax, const plot_axis *ay)
 {
     const plot_figure *fg = c->f;
+    /* data-mech-axes "sx ox sy oy": page x = ox + sx X, y = oy - sy Y for X, Y
+       in the axes' display units (what px_of, py_of compute; for tests) */
+    double sx = (AX_R - AX_L) / (ax->hi - ax->lo), sy = (AX_B - AX_T) / (ay->hi - ay->lo);
     fprintf(f, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
                "<svg xmlns=\"http://www.w3.org/2000/svg\" "
                "xmlns:xlink=\"http://www.w3.org/1999/xlink\" width=\"%d\" height=\"%d\" "
                "viewBox=\"0 0 %d %d\" font-family=\"DejaVu Sans,Arial,Helvetica,sans-serif\" "
-               "font-size=\"12\">\n", FIG_W, FIG_H, FIG_W, FIG_H);
+               "font-size=\"12\" data-mech-axes=\"%.12g %.12g %.12g %.12g\">\n", FIG_W, FIG_H,
+            FIG_W, FIG_H, sx, AX_L - ax->lo * sx, sy, AX_B + ay->lo * sy);
     fputs("<title>", f);
     plot_put_text(f, fg->title);
     fputs("</title>\n<defs>", f);
@@ -501,7 +505,7 @@ static int emit_figure(FILE *f, const void *vctx)
         return plot_path_svg(f, c->m, c->t, c->f, c->subtitle);
     plot_axis ax, ay;
     fig_axes(c, &ax, &ay);
-    fig_head(f, c);
+    fig_head(f, c, &ax, &ay);
     fig_frame(f, c, &ax, &ay);
     fig_series(f, c, &ax, &ay);
     fig_legend(f, c);
