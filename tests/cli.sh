@@ -342,6 +342,59 @@ if run "mech plot --steps 200000" 0 "$MECH" plot mechanisms/fourbar.yaml --steps
     [ "$kb" -lt 3000 ] && pass || fail "plot of 200 000 steps: $kb KB of SVG, expected under 3 MB"
 fi
 
+# --set, --from, --to: the semantics and messages of mech solve
+if run "mech plot --set --from --to" 0 "$MECH" plot mechanisms/slider-crank.yaml --set 'r=50 mm' --from 0 --to 180 --steps 4 --outputs B --out "$tmp/pst"; then
+    has_line "$tmp/out" "/slider-crank-path-B.svg\$" "plot: a path figure for the moving point B"
+    # the path of B, through data-mech-transform, ends at l - r = 90 mm (r = 50 mm, 180 deg)
+    tr=$(sed -n 's/.*data-mech-transform="\([^"]*\)".*/\1/p' "$tmp/pst/slider-crank-path-B.svg")
+    last=$(sed -n 's/.*<path stroke="#1f4e99" d="\([^"]*\)".*/\1/p' "$tmp/pst/slider-crank-path-B.svg" | awk '{print $NF}')
+    echo "$tr $last" | awk '{ split($4, v, ","); x = (v[1] - $2) / $1; exit !(x > 0.08999 && x < 0.09001) }' && pass ||
+        fail "plot --set r=50mm --to 180: path of B ends at $last (transform $tr), not at x = 90 mm"
+    "$MECH" solve mechanisms/slider-crank.yaml --set 'r=50 mm' --from 0 --to 180 --steps 4 --outputs B --level positions -o "$tmp/pst.csv" &&
+        has_line "$tmp/pst.csv" '^3.14159[0-9]*,0.09[0-9]*,' "solve --set r=50mm --to 180: B.x = l - r = 90 mm"
+fi
+for cmd in plot animate; do
+    if run "mech $cmd --from without --to" 2 "$MECH" $cmd mechanisms/fourbar.yaml --from 10; then
+        has_line "$tmp/err" "^mech $cmd: --from and --to go together (see 'mech $cmd --help')$" "$cmd --from alone"
+    fi
+    if run "mech $cmd --set without =" 2 "$MECH" $cmd mechanisms/fourbar.yaml --set r; then
+        has_line "$tmp/err" "^mech $cmd: --set needs NAME=VALUE (at most 64), not 'r' (see 'mech $cmd --help')$" "$cmd --set r"
+    fi
+    if run "mech $cmd --set unknown parameter" 2 "$MECH" $cmd mechanisms/slider-crank.yaml --set rr=4mm; then
+        has_line "$tmp/err" "no parameter 'rr'" "$cmd --set rr="
+    fi
+    if run "mech $cmd --from not a number" 2 "$MECH" $cmd mechanisms/fourbar.yaml --from ten --to 20; then
+        has_line "$tmp/err" "^mech $cmd: --from 'ten': " "$cmd --from ten"
+    fi
+    if run "mech $cmd --to too far" 2 "$MECH" $cmd mechanisms/fourbar.yaml --from 0 --to 1e9; then
+        has_line "$tmp/err" "^mech $cmd: --to '1e9' is 1.75e+07 rad: a driver angle must be within" "$cmd --to 1e9"
+    fi
+done
+# the same words as mech solve
+"$MECH" solve mechanisms/fourbar.yaml --from ten --to 20 2>"$tmp/e1" >/dev/null
+"$MECH" plot mechanisms/fourbar.yaml --from ten --to 20 --out "$tmp/f2" 2>"$tmp/e2" >/dev/null
+[ "$(sed 's/^mech solve/mech X/' "$tmp/e1")" = "$(sed 's/^mech plot/mech X/' "$tmp/e2")" ] && pass ||
+    fail "plot --from ten: '$(cat "$tmp/e2")' is not solve's '$(cat "$tmp/e1")'"
+# animate --outputs: the traced points
+if run "mech animate --outputs" 0 "$MECH" animate mechanisms/fourbar.yaml --outputs P --frame 3 -o "$tmp/tr.svg"; then
+    [ "$(grep -c 'data-trace=' "$tmp/tr.svg")" -eq 1 ] && grep -q 'data-trace="P"' "$tmp/tr.svg" && pass ||
+        fail "animate --outputs P: traces $(grep -o 'data-trace="[^"]*"' "$tmp/tr.svg" | paste -sd' ' -)"
+    grep -q 'data-mech-scale-bar=' "$tmp/tr.svg" && pass || fail "animate: no scale bar"
+fi
+if run "mech animate --outputs link" 2 "$MECH" animate mechanisms/fourbar.yaml --outputs P,coupler -o "$tmp/tr2.svg"; then
+    has_line "$tmp/err" "^mech animate: --outputs: 'coupler' is a link, not a point: the animation traces the paths of points$" "animate --outputs coupler"
+    [ ! -e "$tmp/tr2.svg" ] && pass || fail "animate --outputs coupler wrote $tmp/tr2.svg"
+fi
+if run "mech animate --outputs unknown" 2 "$MECH" animate mechanisms/fourbar.yaml --outputs Q -o "$tmp/tr2.svg"; then
+    has_line "$tmp/err" "^mech animate: --outputs: 'Q' is not a point" "animate --outputs Q"
+fi
+# 10^6 steps: every figure of bounded size (the paths and the curves thinned)
+if run "mech plot --steps 1000000" 0 "$MECH" plot mechanisms/fourbar.yaml --steps 1000000 --outputs P,coupler --out "$tmp/fig6"; then
+    big=$(find "$tmp/fig6" -name '*.svg' -size +200k | head -n 1)
+    [ -z "$big" ] && pass || fail "plot of 10^6 steps: $big is over 200 kB"
+    [ -s "$tmp/fig6/fourbar-path-P.svg" ] && pass || fail "plot of 10^6 steps: no path figure"
+fi
+
 # ---- mech sweep -----------------------------------------------------------
 
 if run "mech sweep" 0 "$MECH" sweep mechanisms/slider-crank.yaml --vary r=30mm:60mm:4 --list l=45mm,140mm --metric range:x_B.s -j 2 -o "$tmp/sw.csv"; then
