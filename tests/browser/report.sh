@@ -14,7 +14,7 @@
 #      shown are row K of `mech solve`'s CSV bit for bit, that every point
 #      drawn is at row K's position (`mech solve --outputs <all points>
 #      --level positions`), and, in a screenshot, that each disc's pixel
-#      centroid is within 2 px of row K's position; between K1 and K2 the
+#      centroid is within 1 px of row K's position; between K1 and K2 the
 #      discs moved;
 #   3. a screenshot of the whole page (device scale 0.5): the animation and
 #      every figure (as many as `mech plot` draws) are drawn, not blank.
@@ -67,7 +67,7 @@ anim_bottom() {
         head -n 1 | awk '{ printf "%d\n", $1 + $2 + 20 }'
 }
 
-for name in stirling offset-slider-crank; do
+for name in ${REPORT_MECHS:-stirling offset-slider-crank}; do
     yaml=mechanisms/$name.yaml
     dir=$OUT/$name
     mkdir -p "$dir"
