@@ -86,6 +86,10 @@ int cmd_batch(int argc, char **argv);
 extern const char cmd_sweep_help[];
 int cmd_sweep(int argc, char **argv);
 
+/* `mech report FILE -o OUT.html` (cmd_report.c, docs/report.md). */
+extern const char cmd_report_help[];
+int cmd_report(int argc, char **argv);
+
 /* `mech compare [options] OUT.csv GOLDEN.csv` (cmd_compare.c): argv[0] is
  * "compare"; returns the exit code. */
 extern const char cmd_compare_help[];
