@@ -63,6 +63,9 @@ int cmd_batch(int argc, char **argv);
 extern const char cmd_sweep_help[];
 int cmd_sweep(int argc, char **argv);
 
+extern const char cmd_codegen_help[];
+int cmd_codegen(int argc, char **argv);
+
 /* `mech compare [options] OUT.csv GOLDEN.csv` (cmd_compare.c): argv[0] is
  * "compare"; returns the exit code. */
 extern const char cmd_compare_help[];
