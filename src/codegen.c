@@ -104,12 +104,12 @@ static int plan_solver(codegen *g, mech_diag *d)
         return rc;
     const solver_plan *sp = &g->sp;
     if (sp->aug)
-        return diag_error(d, g->m->file, (mech_mark){0, 0},
+        return diag_error(d, g->m->file, g->m->driver.mark,
                           "codegen: the loops have redundant constraints (%d equations for %d "
                           "unknowns), solved in the least-squares sense: not supported by the "
                           "code generator", sp->sys->m, sp->n);
     if (sp->ns > CODEGEN_MAX_UNKNOWNS)
-        return diag_error(d, g->m->file, (mech_mark){0, 0},
+        return diag_error(d, g->m->file, g->m->driver.mark,
                           "codegen: %d unknowns to solve, more than the code generator's limit "
                           "of %d", sp->ns, CODEGEN_MAX_UNKNOWNS);
     g->unk_col = xcalloc((size_t)sp->n + 1, sizeof *g->unk_col);

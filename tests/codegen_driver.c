@@ -3,6 +3,7 @@
  * together with cc -std=c11 -Wall -Wextra -Werror -pedantic).
  *
  *   codegen-driver REF.csv [TOL]
+ *   codegen-driver --at Q [X0 X1 ...]
  *
  * REF.csv is `mech solve`'s table of the same file. For each of its rows,
  * in order, gen_solve solves the row's q (the file's driver speed and
@@ -12,7 +13,9 @@
  * must agree within TOL (default 1e-13) times the largest magnitude in that
  * column of REF. Prints the worst error against that bound; exit 0 when
  * every value agrees, 1 otherwise (or when a row does not solve), 2 for a
- * malformed REF. */
+ * malformed REF. With --at, one position Q (SI) from gen_init's guesses, or
+ * from X0 X1 ... (SI): prints "status S iterations I rcond R branch B" and
+ * the output columns, exit 0. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -84,8 +87,23 @@ static double *read_rows(FILE *f, int ncols, int *nrows)
     return rows;
 }
 
+static int solve_at(int argc, char **argv)
+{
+    static gen_state s;
+    gen_init(&s);
+    for (int i = 3; i < argc && i - 3 < GEN_NX; i++)
+        s.x[i - 3] = strtod(argv[i], NULL);
+    int st = gen_solve(&s, strtod(argv[2], NULL), GEN_DRIVER_SPEED, GEN_DRIVER_ACCEL);
+    printf("status %d iterations %d rcond %.3g branch %d\n", st, s.iterations, s.rcond, s.branch);
+    for (int c = 0; c < GEN_NOUT && st == GEN_OK; c++)
+        printf("%s %.17g\n", gen_column_names[c], s.out[c]);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
+    if (argc > 2 && strcmp(argv[1], "--at") == 0)
+        return solve_at(argc, argv);
     if (argc < 2) {
         fprintf(stderr, "usage: codegen-driver REF.csv [TOL]\n");
         return 2;
