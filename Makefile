@@ -135,6 +135,7 @@ test: deps
 	MECH=$(BUILD)/mech sh tests/files.sh
 	MECH=$(BUILD)/mech sh tests/golden.sh
 	MECH=$(BUILD)/mech MECH_SANITIZE=$(if $(SAN),1,) sh tests/sweep.sh
+	MECH=$(BUILD)/mech MECH_SANITIZE=$(if $(SAN),1,) sh tests/codegen.sh
 	@$(MAKE) --no-print-directory test-install test-python
 
 # make install into a temporary prefix, then the example of docs/api.md

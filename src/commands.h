@@ -89,6 +89,8 @@ int cmd_sweep(int argc, char **argv);
 /* `mech report FILE -o OUT.html` (cmd_report.c, docs/report.md). */
 extern const char cmd_report_help[];
 int cmd_report(int argc, char **argv);
+extern const char cmd_codegen_help[];
+int cmd_codegen(int argc, char **argv);
 
 /* `mech compare [options] OUT.csv GOLDEN.csv` (cmd_compare.c): argv[0] is
  * "compare"; returns the exit code. */

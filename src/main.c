@@ -32,6 +32,8 @@ static const command commands[] = {
     {"animate", cmd_animate, "write an animated SVG of the mechanism", cmd_animate_help},
     {"report", cmd_report, "write a self-contained HTML report: structure, equations,\n"
      "             figures, animation with a slider, diagnostics", cmd_report_help},
+    {"codegen", cmd_codegen, "write a standalone C solver for one mechanism (docs/codegen.md)",
+     cmd_codegen_help},
 };
 #define NCOMMANDS (sizeof commands / sizeof commands[0])
 

@@ -26,6 +26,9 @@ check() {  # check LABEL ARGS...: valgrind must report nothing (exit 99 on error
 for f in mechanisms/*.yaml tests/solve/*.yaml tests/hard/*.yaml; do
     check "mech solve --forces $f" solve "$f" --forces --friction both -o "$tmp/x.csv"
 done
+for f in mechanisms/*.yaml tests/hard/redundant-parallelogram.yaml; do
+    check "mech codegen $f" codegen "$f" -o "$tmp/gen.c" --header "$tmp/gen.h"
+done
 check "mech batch" batch -j 2 -q mechanisms/*.yaml tests/solve/*.yaml
 check "mech sweep" sweep mechanisms/slider-crank.yaml --list l=45mm,140mm --metric range:x_B.s -j 2
 check "mech plot" plot mechanisms/fourbar.yaml --out "$tmp/plots"

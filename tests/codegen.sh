@@ -1,0 +1,121 @@
+#!/bin/sh
+# tests/codegen.sh: `mech codegen` (docs/codegen.md). For every file in
+# mechanisms/: the generated source and header compile with
+# cc -std=c11 -Wall -Wextra -Werror -pedantic (and -lm alone) together with
+# tests/codegen_driver.c, which sweeps the rows of `mech solve`'s CSV with
+# the generated solver (warm started by its predictor) and requires every
+# output column to agree to 1e-13 of the column's largest magnitude; the
+# source includes nothing but the C library's headers and allocates
+# nothing. Then the status codes (no assembly, singular, branch), the
+# default names, and bad input: errors with exit status 2 or 3, the input
+# never overwritten.
+# Run from the repository root:  MECH=build/mech sh tests/codegen.sh
+NAME=codegen . tests/lib.sh
+CC=${CC:-cc}
+CFLAGS_GEN="-std=c11 -Wall -Wextra -Werror -pedantic -O2"
+# under a sanitizer build, the generated code runs under one too
+[ -n "$MECH_SANITIZE" ] && CFLAGS_GEN="$CFLAGS_GEN -fsanitize=address,undefined -fno-sanitize-recover=all"
+
+# build DIR FILE [OPTIONS]: generate DIR/gen.c, DIR/gen.h and the driver DIR/drv
+build() {
+    dir=$1 file=$2
+    shift 2
+    rm -rf "$dir"
+    mkdir -p "$dir"
+    if ! "$MECH" codegen "$file" -o "$dir/gen.c" --header "$dir/gen.h" --prefix gen "$@" \
+            2>"$dir/err"; then
+        fail "mech codegen $file: $(head -n 1 "$dir/err")"
+        return 1
+    fi
+    if ! $CC $CFLAGS_GEN -I"$dir" -o "$dir/drv" "$dir/gen.c" tests/codegen_driver.c -lm \
+            2>"$dir/cc"; then
+        fail "cc $file's generated code: $(head -n 3 "$dir/cc")"
+        return 1
+    fi
+    pass
+}
+
+for file in mechanisms/*.yaml; do
+    base=$(basename "$file" .yaml)
+    dir=$tmp/$base
+    build "$dir" "$file" || continue
+    # standalone: the C library's headers only, no allocation
+    others=$(grep '^#include' "$dir/gen.c" | grep -v -e '<float.h>' -e '<math.h>' \
+             -e '<string.h>' -e '"gen.h"')
+    [ -z "$others" ] && pass || fail "$base: the generated source includes $others"
+    grep -q -E '\b(malloc|calloc|realloc|free)\b' "$dir/gen.c" "$dir/gen.h" \
+        && fail "$base: the generated code allocates" || pass
+    if ! "$MECH" solve "$file" -q -o "$dir/ref.csv" 2>"$dir/err"; then
+        fail "mech solve $file: $(head -n 1 "$dir/err")"
+        continue
+    fi
+    if "$dir/drv" "$dir/ref.csv" 1e-13 >"$dir/out" 2>"$dir/err"; then
+        pass
+        echo "  $base: $(cat "$dir/out")"
+    else
+        fail "$base: the generated solver against mech solve: $(cat "$dir/out" "$dir/err" | head -n 2)"
+    fi
+done
+
+# the same code from the same file, byte for byte
+"$MECH" codegen mechanisms/stirling.yaml -o "$tmp/again.c" --header "$tmp/again.h" --prefix gen \
+    2>/dev/null && sed 's/again\.h/gen.h/' "$tmp/again.c" | cmp -s - "$tmp/stirling/gen.c" \
+    && pass || fail "codegen of stirling.yaml twice: the sources differ"
+
+# ---- status codes: one position from the file's guesses, or given ones ----
+# at: FILE Q [X...]: the driver's first line for that position
+at() {
+    file=$1
+    shift
+    build "$tmp/at" "$file" >/dev/null && "$tmp/at/drv" --at "$@" | head -n 1
+}
+# the non-Grashof crank does not assemble at 180 degrees
+out=$(at tests/hard/non-grashof-crank.yaml 3.14159265358979)
+case $out in "status 1 "*) pass ;; *) fail "non-grashof-crank at 180 deg: '$out', expected status 1" ;; esac
+# the slider-driven crank's dead centre at 130 mm is singular
+out=$(at tests/hard/dead-centre-slider.yaml 0.130)
+case $out in "status 2 "*) pass ;; *) fail "dead-centre-slider at 130 mm: '$out', expected status 2" ;; esac
+# the four-bar from guesses on the crossed assembly: branch condition 0 fails
+out=$(at mechanisms/fourbar.yaml 0.5 -0.5 -1.5)
+case $out in "status 3 "*"branch 0") pass ;; *) fail "fourbar, crossed: '$out', expected status 3, branch 0" ;; esac
+# and from the file's guesses it is solved, with the closed-form crank pin
+"$tmp/at/drv" --at 0.5 >"$tmp/one" 2>&1
+ax=$(awk '$1 == "A.x" { print $2 }' "$tmp/one")
+awk -v v="$ax" 'BEGIN { d = v - 0.02 * cos(0.5); exit !(d < 1e-17 && d > -1e-17) }' \
+    && pass || fail "fourbar at q = 0.5: A.x = '$ax', expected 0.02 cos(0.5)"
+
+# ---- names ----
+# without --prefix the names come from the output's base name; without
+# --header the source declares everything itself and compiles alone
+if "$MECH" codegen mechanisms/fourbar.yaml -o "$tmp/four-bar 2.c" 2>"$tmp/err" &&
+        $CC $CFLAGS_GEN -c -o "$tmp/fb.o" "$tmp/four-bar 2.c" 2>"$tmp/cc"; then
+    nm "$tmp/fb.o" | grep -q ' T four_bar_2_solve$' && pass \
+        || fail "the default prefix: no four_bar_2_solve in $(nm "$tmp/fb.o" | grep ' T ')"
+else
+    fail "codegen without --header: $(cat "$tmp/err" "$tmp/cc" | head -n 2)"
+fi
+
+# ---- bad input ----
+run "unknown file" 3 "$MECH" codegen "$tmp/no-such.yaml" -o "$tmp/x.c" && pass
+run "invalid file" 2 "$MECH" codegen tests/bad/25-loop-unknown-point.yaml -o "$tmp/x.c" &&
+    has_line "$tmp/err" '25-loop-unknown-point.yaml:[0-9]*:[0-9]*: error' "invalid file"
+run "unwritable output" 3 "$MECH" codegen mechanisms/fourbar.yaml -o "$tmp/no/dir/x.c" &&
+    has_line "$tmp/err" "no/dir" "unwritable output"
+cp mechanisms/fourbar.yaml "$tmp/input.yaml"
+run "output is the input" 2 "$MECH" codegen "$tmp/input.yaml" -o "$tmp/input.yaml" &&
+    has_line "$tmp/err" "is the input file" "output is the input"
+run "header is the input" 2 "$MECH" codegen "$tmp/input.yaml" -o "$tmp/y.c" --header "$tmp/input.yaml"
+cmp -s mechanisms/fourbar.yaml "$tmp/input.yaml" && pass || fail "the input was changed"
+[ ! -e "$tmp/y.c" ] && pass || fail "a refused run wrote its source"
+run "header is the source" 2 "$MECH" codegen mechanisms/fourbar.yaml -o "$tmp/z.c" --header "$tmp/z.c" && pass
+run "no output" 2 "$MECH" codegen mechanisms/fourbar.yaml && pass
+run "no file" 2 "$MECH" codegen -o "$tmp/x.c" && pass
+run "bad prefix" 2 "$MECH" codegen mechanisms/fourbar.yaml -o "$tmp/x.c" --prefix 9lives &&
+    has_line "$tmp/err" "not a C identifier" "bad prefix"
+run "unknown option" 2 "$MECH" codegen mechanisms/fourbar.yaml -o "$tmp/x.c" --fast && pass
+run "redundant constraints" 2 "$MECH" codegen tests/hard/redundant-parallelogram.yaml -o "$tmp/x.c" &&
+    has_line "$tmp/err" "redundant constraints" "redundant constraints"
+[ ! -e "$tmp/x.c" ] && pass || fail "a failed run left $tmp/x.c"
+run "help" 0 "$MECH" codegen --help && has_line "$tmp/out" "--header" "help"
+
+summary
