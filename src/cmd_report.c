@@ -33,7 +33,7 @@ const char cmd_report_help[] =
     "  --outputs LIST      comma-separated point, link and slider names to report\n"
     "                      instead of the file's outputs\n"
     "  --forces            also the forces (as 'outputs: {forces: true}')\n"
-    "  --friction MODE     on, off or both (default: both when a joint has friction)\n"
+    "  --friction MODE     on (default), off or both, as mech solve\n"
     "  --frames N          slider positions (animation frames) at most, evenly\n"
     "                      spread over the rows (default 1000)\n"
     "  --duration S        seconds for one pass of the animation (default 4)\n"
@@ -51,7 +51,7 @@ typedef struct report_args {
     const char *file, *out, *from, *to, *outputs;
     mech_override set[REPORT_MAX_SET];
     char *set_text[REPORT_MAX_SET];
-    int nset, steps, forces, friction;  /* friction: -1 = default */
+    int nset, steps, forces, friction;  /* friction: -1 = mech solve's default */
     plot_anim_options anim;
 } report_args;
 
@@ -188,14 +188,6 @@ static int apply_range(const report_args *a, const mech_model *m, mech_solve_opt
     return -1;
 }
 
-static int any_friction(const mech_model *m)
-{
-    for (int j = 0; j < m->njoints; j++)
-        if (m->joints[j].friction > 0)
-            return 1;
-    return 0;
-}
-
 /* Outputs of the animation: every point name and every moving link, no
  * forces (*all, freed by the caller with mech_outputs_free). */
 static int select_everything(const mech_model *m, mech_outputs *all)
@@ -286,10 +278,8 @@ static int solve_both(report_run *r)
         return fprintf(stderr, "mech report: out of memory\n"), MECH_EXIT_IO;
     r->view_all.outputs = r->all;
     r->o.forces = r->a.forces;
-    if (r->a.friction >= 0)
+    if (r->a.friction >= 0)  /* else mech solve's default: the values are its CSV's */
         r->o.friction = r->a.friction;
-    else if ((r->a.forces || r->view.outputs.forces) && any_friction(m))
-        r->o.friction = MECH_FRICTION_BOTH;
     int rc = mech_solve(&r->view, &r->o, &r->t, &r->stats, &r->d);
     if (rc == MECH_OK) {
         mech_solve_options po = r->o;  /* the animation: positions only, as mech animate */

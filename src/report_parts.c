@@ -70,7 +70,9 @@ static void row_text(FILE *f, const char *key, const char *value)
     fputs("</td></tr>\n", f);
 }
 
-static void driver_text(const mech_model *m, char *buf, size_t n)
+/* The driver as `mech check` says it (src/cmd_check.c); range: its range
+ * and speed. */
+static void driver_text(const mech_model *m, int range, char *buf, size_t n)
 {
     if (!m->has_driver) {
         snprintf(buf, n, "none");
@@ -79,11 +81,14 @@ static void driver_text(const mech_model *m, char *buf, size_t n)
     const mech_driver *dr = &m->driver;
     int angle = dr->kind == MECH_DRIVE_ANGLE;
     double k = angle ? RAD2DEG_R : 1e3;
-    snprintf(buf, n, "%s '%s', %d position%s from %.6g to %.6g %s, speed %.6g %s",
-             angle ? "angle of link" : "displacement of slider",
-             angle ? m->links[dr->index].name : m->joints[dr->index].name, dr->nvalues,
-             dr->nvalues == 1 ? "" : "s", dr->values[0] * k, dr->values[dr->nvalues - 1] * k,
-             angle ? "deg" : "mm", dr->speed, angle ? "rad/s" : "m/s");
+    if (range)
+        snprintf(buf, n, "from %.6g to %.6g %s, speed %.6g %s", dr->values[0] * k,
+                 dr->values[dr->nvalues - 1] * k, angle ? "deg" : "mm", dr->speed,
+                 angle ? "rad/s" : "m/s");
+    else
+        snprintf(buf, n, "%s '%s', %d position%s", angle ? "angle of link" :
+                 "displacement of slider", angle ? m->links[dr->index].name :
+                 m->joints[dr->index].name, dr->nvalues, dr->nvalues == 1 ? "" : "s");
 }
 
 /* The lines of `mech check` (src/cmd_check.c). */
@@ -106,8 +111,12 @@ static void put_summary(FILE *f, const mech_model *m, const mech_summary *s)
     snprintf(b, sizeof b, "%d = 3*(%d-1) - 2*%d - %d, drivers %d", s->mobility, s->nlinks,
              s->nrevolute + s->nprismatic, s->npin_in_slot, s->ndrivers);
     row_text(f, "mobility", b);
-    driver_text(m, b, sizeof b);
+    driver_text(m, 0, b, sizeof b);
     row_text(f, "driver", b);
+    if (m->has_driver) {
+        driver_text(m, 1, b, sizeof b);
+        row_text(f, "driver range", b);
+    }
     snprintf(b, sizeof b, "%d points, %d links, %d sliders%s", m->outputs.npoints,
              m->outputs.nlinks, m->outputs.nsliders, m->outputs.forces ? ", forces" : "");
     row_text(f, "outputs", b);
