@@ -292,9 +292,6 @@ static int solve_both(report_run *r)
             mech_diag_print(&ad, stderr);
         mech_diag_free(&ad);
     }
-    if (rc == MECH_ESOLVE)
-        fprintf(stderr, "mech report: %d of the sweep's %d positions were solved; "
-                "nothing written\n", r->t.nrows, r->t.nrequested);
     return cmd_exit_status(rc);
 }
 
@@ -373,6 +370,9 @@ int cmd_report(int argc, char **argv)
         if (code == MECH_EXIT_OK)
             code = animation(&r);
         mech_diag_print(&r.d, stderr);
+        if (code == MECH_EXIT_SOLVE)
+            fprintf(stderr, "mech report: %d of the sweep's %d positions were solved; "
+                    "nothing written\n", r.t.nrows, r.t.nrequested);
         if (code == MECH_EXIT_OK)
             code = write_page(&r);
     }
