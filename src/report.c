@@ -339,6 +339,12 @@ static int emit_page(FILE *f, const void *ctx)
 {
     const report_input *in = ctx;
     put_header(f, in);
+    if (in->ngaps > 0)
+        fprintf(f, "<p class=\"error\" id=\"partial\"><b>Not every driver position was "
+                   "solved:</b> %d of the %d requested (%d gap%s, listed under "
+                   "<a href=\"#diagnostics\">Diagnostics</a>). The slider, the values and "
+                   "the figures show the positions solved; the curves break at the gaps.</p>\n",
+                in->t->nrows, in->t->nrequested, in->ngaps, in->ngaps == 1 ? "" : "s");
     put_animation(f, in);
     report_put_structure(f, in);
     report_put_diagnostics(f, in);

@@ -250,8 +250,17 @@ void report_put_diagnostics(FILE *f, const report_input *in)
     fputs("<section id=\"diagnostics\">\n<h2>Diagnostics</h2>\n"
           "<p>How the solve went, as <code>mech solve --stats</code> prints it:</p>\n", f);
     put_stats(f, in->m, in->stats);
+    if (in->ngaps > 0) {
+        fprintf(f, "<h3>Gaps (%d)</h3>\n<ul id=\"gaps\">\n", in->ngaps);
+        for (int i = 0; i < in->ngaps; i++) {
+            fputs("<li class=\"error\">gap: ", f);
+            report_put_text(f, in->gaps[i]);
+            fputs("</li>\n", f);
+        }
+        fputs("</ul>\n", f);
+    }
     const mech_diag *d = in->diag;
-    fprintf(f, "<h3>Warnings and notes (%zu)</h3>\n", d ? d->count : (size_t)0);
+    fprintf(f, "<h3>Errors, warnings and notes (%zu)</h3>\n", d ? d->count : (size_t)0);
     if (!d || d->count == 0) {
         fputs("<p>None.</p>\n</section>\n", f);
         return;
