@@ -4,7 +4,7 @@
 #   make run        deps + build + the main job: solve the Stirling engine
 #   make test       deps + build + the full test suite
 #   make test-san   the test suite built with -fsanitize=address,undefined
-#   make test-browser  figures and animation rendered by headless chromium
+#   make test-browser  figures, animation and report rendered by headless chromium
 #   make bench      optimised benchmarks, printed as tables
 #   make golden     regenerate tests/golden/*.csv (review the diff by hand)
 #   make install PREFIX=/usr/local   mech, libmech.so/.a, mech.h, mech.pc, mech.1,
@@ -136,6 +136,7 @@ test: deps
 	MECH=$(BUILD)/mech sh tests/golden.sh
 	MECH=$(BUILD)/mech MECH_SANITIZE=$(if $(SAN),1,) sh tests/sweep.sh
 	MECH=$(BUILD)/mech MECH_SANITIZE=$(if $(SAN),1,) sh tests/codegen.sh
+	MECH=$(BUILD)/mech sh tests/report.sh
 	@$(MAKE) --no-print-directory test-install test-python
 
 # make install into a temporary prefix, then the example of docs/api.md
@@ -169,9 +170,11 @@ fuzz-replay:
 test-valgrind: $(BUILD)/mech
 	MECH=$(BUILD)/mech sh tests/valgrind.sh
 
-# Figures and animation seen by headless chromium (docs/plots.md).
+# Figures, animation and the HTML report seen by headless chromium
+# (docs/plots.md, docs/report.md).
 test-browser: $(BUILD)/mech
 	MECH=$(BUILD)/mech OUT=$(BUILD)/browser sh tests/browser/run.sh
+	MECH=$(BUILD)/mech OUT=$(BUILD)/browser-report sh tests/browser/report.sh
 
 # Benchmarks: optimised, no sanitizers; prints tables and writes them, with
 # the plots, into docs/performance.md (bench/report.sh).

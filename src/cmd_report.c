@@ -33,7 +33,7 @@ const char cmd_report_help[] =
     "  --outputs LIST      comma-separated point, link and slider names to report\n"
     "                      instead of the file's outputs\n"
     "  --forces            also the forces (as 'outputs: {forces: true}')\n"
-    "  --friction MODE     on, off or both (default: both when a joint has friction)\n"
+    "  --friction MODE     on (default), off or both, as mech solve\n"
     "  --frames N          slider positions (animation frames) at most, evenly\n"
     "                      spread over the rows (default 1000)\n"
     "  --duration S        seconds for one pass of the animation (default 4)\n"
@@ -42,7 +42,8 @@ const char cmd_report_help[] =
     "  -h, --help          show this help\n"
     "\n"
     "exit status: 0 written, 1 the mechanism cannot be solved somewhere in the range\n"
-    "(nothing written), 2 invalid file or usage, 3 a file cannot be read or written\n";
+    "(the page shows the positions solved and lists the gaps; none solved: nothing\n"
+    "written), 2 invalid file or usage, 3 a file cannot be read or written\n";
 
 enum { REPORT_MAX_SET = 64 };
 #define REPORT_MAX_DRIVER 1e6  /* rad or m, as mech solve (cmd_solve.c) */
@@ -51,7 +52,7 @@ typedef struct report_args {
     const char *file, *out, *from, *to, *outputs;
     mech_override set[REPORT_MAX_SET];
     char *set_text[REPORT_MAX_SET];
-    int nset, steps, forces, friction;  /* friction: -1 = default */
+    int nset, steps, forces, friction;  /* friction: -1 = mech solve's default */
     plot_anim_options anim;
 } report_args;
 
@@ -188,14 +189,6 @@ static int apply_range(const report_args *a, const mech_model *m, mech_solve_opt
     return -1;
 }
 
-static int any_friction(const mech_model *m)
-{
-    for (int j = 0; j < m->njoints; j++)
-        if (m->joints[j].friction > 0)
-            return 1;
-    return 0;
-}
-
 /* Outputs of the animation: every point name and every moving link, no
  * forces (*all, freed by the caller with mech_outputs_free). */
 static int select_everything(const mech_model *m, mech_outputs *all)
@@ -235,6 +228,8 @@ typedef struct report_run {
     char *animation;
     int *frame_rows;
     int nframes;
+    int partial;                 /* some requested rows are missing (t.gaps) */
+    char **gap_lines;            /* [t.ngaps] each gap as mech solve prints it */
 } report_run;
 
 static void run_free(report_run *r)
@@ -249,6 +244,7 @@ static void run_free(report_run *r)
     report_free_strings(r->figures, r->nfigures);
     free(r->animation);
     free(r->frame_rows);
+    report_free_strings(r->gap_lines, r->t.ngaps);
     mech_model_free(&r->m);
     mech_diag_free(&r->d);
 }
@@ -286,25 +282,23 @@ static int solve_both(report_run *r)
         return fprintf(stderr, "mech report: out of memory\n"), MECH_EXIT_IO;
     r->view_all.outputs = r->all;
     r->o.forces = r->a.forces;
-    if (r->a.friction >= 0)
+    if (r->a.friction >= 0)  /* else mech solve's default: the values are its CSV's */
         r->o.friction = r->a.friction;
-    else if ((r->a.forces || r->view.outputs.forces) && any_friction(m))
-        r->o.friction = MECH_FRICTION_BOTH;
     int rc = mech_solve(&r->view, &r->o, &r->t, &r->stats, &r->d);
-    if (rc == MECH_OK) {
+    r->partial = rc == MECH_ESOLVE && r->t.nrows > 0;
+    if (rc == MECH_OK || r->partial) {
         mech_solve_options po = r->o;  /* the animation: positions only, as mech animate */
         po.want = MECH_WANT_POSITION;
         po.forces = -1;
         mech_diag ad;  /* its warnings repeat the first solve's */
         mech_diag_init(&ad);
         rc = mech_solve(&r->view_all, &po, &r->t_all, NULL, &ad);
+        if (rc == MECH_ESOLVE && r->partial)  /* the same gaps: checked in animation() */
+            rc = MECH_OK;
         if (rc != MECH_OK)
             mech_diag_print(&ad, stderr);
         mech_diag_free(&ad);
     }
-    if (rc == MECH_ESOLVE)
-        fprintf(stderr, "mech report: %d of the sweep's %d positions were solved; "
-                "nothing written\n", r->t.nrows, r->t.nrequested);
     return cmd_exit_status(rc);
 }
 
@@ -330,10 +324,13 @@ static int equations(report_run *r)
  * drawn with exactly those frames. */
 static int animation(report_run *r)
 {
-    int n = r->t.nrows;
-    if (n < 1 || r->t_all.nrows != n) {
-        fprintf(stderr, "mech report: internal: the animation's sweep has %d rows, the "
-                "outputs' %d\n", r->t_all.nrows, n);
+    int n = r->t.nrows, same = n >= 1 && r->t_all.nrows == n;
+    for (int i = 0; i < n && same; i++)  /* the same driver positions, bit for bit */
+        same = mech_table_get(&r->t, i, 0) == mech_table_get(&r->t_all, i, 0);
+    if (!same) {
+        fprintf(stderr, "mech report: the sweep of every point and link (the animation) "
+                "solved other driver positions than the sweep of the outputs (%d and %d "
+                "rows); nothing written\n", r->t_all.nrows, n);
         return MECH_EXIT_SOLVE;
     }
     int nf = n < r->a.anim.max_frames ? n : r->a.anim.max_frames;
@@ -349,16 +346,129 @@ static int animation(report_run *r)
                                             &r->animation, &r->d));
 }
 
+/* ---- A partial sweep: the gaps said as mech solve says them
+ * (src/cmd_solve.c, print_gaps), and figures whose curves break there. */
+
+/* Requested driver position i (as mech_analysis_new lists them). */
+static double requested_q(const report_run *r, int i)
+{
+    if (!r->o.has_range)
+        return r->m->driver.values[i];
+    int steps = r->o.steps > 0 ? r->o.steps : 1;
+    return i == steps ? r->o.to : r->o.from + (r->o.to - r->o.from) * i / steps;
+}
+
+/* A driver position in deg or mm with `decimals` decimals. */
+static void q_text(const mech_model *m, double q, int decimals, char *buf, size_t size)
+{
+    int angle = m->driver.kind == MECH_DRIVE_ANGLE;
+    snprintf(buf, size, "%.*f %s", decimals, angle ? q * 57.295779513082321 : q * 1e3,
+             angle ? "deg" : "mm");
+}
+
+/* Decimals a limit found to 1e-12 of the row spacing h deserves, bounded by
+ * the position's own rounding (as mech solve). */
+static int limit_decimals(const mech_model *m, double q, double h)
+{
+    double unit = m->driver.kind == MECH_DRIVE_ANGLE ? 57.295779513082321 : 1e3;
+    double acc = fmax(1e-12 * fabs(h), 1e-11 * fmax(fabs(q), fabs(h))) * unit;
+    int d = (int)floor(-log10(acc));
+    return d < 0 ? 0 : d > 12 ? 12 : d;
+}
+
+static const char *gap_words(mech_gap_kind k)
+{
+    switch (k) {
+    case MECH_GAP_NO_ASSEMBLY: return "the mechanism does not assemble";
+    case MECH_GAP_DEAD_POINT: return "a dead point or limit position the driver cannot pass";
+    case MECH_GAP_CHANGE_POINT: return "a change point, where two assembly branches cross";
+    case MECH_GAP_BRANCH: return "the mechanism leaves the declared branch";
+    default: return "the solution jumps to another assembly";
+    }
+}
+
+/* One line per gap into r->gap_lines, printed on stderr as mech solve
+ * prints them ("mech report: gap: ..."). */
+static int gap_lines(report_run *r)
+{
+    const mech_table *t = &r->t;
+    int n = t->nrequested;
+    if (t->ngaps == 0)
+        return MECH_EXIT_OK;
+    if (!(r->gap_lines = calloc((size_t)t->ngaps, sizeof *r->gap_lines)))
+        return fprintf(stderr, "mech report: out of memory\n"), MECH_EXIT_IO;
+    double h = n > 1 ? fabs(requested_q(r, n - 1) - requested_q(r, 0)) / (n - 1) : 1.0;
+    for (int i = 0; i < t->ngaps; i++) {
+        const mech_gap *g = &t->gaps[i];
+        char q1[64], q2[64], l1[64] = "", l2[64] = "", rows[200], line[600];
+        q_text(r->m, requested_q(r, g->first_row), 6, q1, sizeof q1);
+        q_text(r->m, requested_q(r, g->last_row), 6, q2, sizeof q2);
+        if (g->from_limit)
+            q_text(r->m, g->from, limit_decimals(r->m, g->from, h), l1, sizeof l1);
+        if (g->to_limit)
+            q_text(r->m, g->to, limit_decimals(r->m, g->to, h), l2, sizeof l2);
+        if (g->first_row == g->last_row)
+            snprintf(rows, sizeof rows, "row %d of %d (driver at %s)", g->first_row + 1, n, q1);
+        else
+            snprintf(rows, sizeof rows, "rows %d to %d of %d (driver at %s to %s)",
+                     g->first_row + 1, g->last_row + 1, n, q1, q2);
+        snprintf(line, sizeof line, "%s not solved: %s%s%s%s%s%s", rows, gap_words(g->kind),
+                 l1[0] || l2[0] ? "; limits found: " : "", l1[0] ? "from " : "", l1,
+                 l1[0] && l2[0] ? " to " : l2[0] ? "to " : "", l2);
+        fprintf(stderr, "mech report: gap: %s\n", line);
+        if (!(r->gap_lines[i] = strdup(line)))
+            return fprintf(stderr, "mech report: out of memory\n"), MECH_EXIT_IO;
+    }
+    return MECH_EXIT_OK;
+}
+
+/* The table of the figures: t with a row of NaN where a gap lies between
+ * solved rows, so every curve breaks there instead of bridging it
+ * (plot_figure_write starts a new stroke after a value that is not
+ * finite). g->values is malloc'ed; the columns are t's (borrowed). */
+static int gapped_table(const mech_table *t, mech_table *g)
+{
+    *g = *t;
+    g->gaps = NULL;
+    g->ngaps = 0;
+    size_t nc = (size_t)t->ncolumns;
+    g->values = malloc(((size_t)t->nrows + (size_t)t->ngaps) * nc * sizeof *g->values);
+    if (!g->values)
+        return -1;
+    int k = 0, missing = 0, out = 0;
+    for (int i = 0; i <= t->nrows; i++) {
+        while (k < t->ngaps && t->gaps[k].first_row - missing == i) {
+            if (i > 0 && i < t->nrows)  /* a gap at either end breaks nothing */
+                for (size_t c = 0; c < nc; c++)
+                    g->values[(size_t)out * nc + c] = NAN;
+            out += i > 0 && i < t->nrows;
+            missing += t->gaps[k].last_row - t->gaps[k].first_row + 1;
+            k++;
+        }
+        if (i < t->nrows)
+            memcpy(g->values + (size_t)out++ * nc, t->values + (size_t)i * nc,
+                   nc * sizeof *g->values);
+    }
+    g->nrows = out;
+    return 0;
+}
+
 static int write_page(report_run *r)
 {
     mech_diag wd;
     mech_diag_init(&wd);
-    int rc = report_figures(&r->view, &r->t, &r->figures, &r->nfigures, &wd);
+    mech_table gt;
+    int rc = gapped_table(&r->t, &gt) == 0 ? MECH_OK : MECH_ENOMEM;
+    if (rc == MECH_OK)
+        rc = report_figures(&r->view, &gt, &r->figures, &r->nfigures, &wd);
+    else
+        fprintf(stderr, "mech report: out of memory\n");
+    free(gt.values);
     report_input in = {
         .m = r->m, .summary = &r->summary, .equations = r->equations, .t = &r->t,
         .stats = &r->stats, .diag = &r->d, .figures = r->figures, .nfigures = r->nfigures,
         .animation = r->animation, .frame_rows = r->frame_rows, .nframes = r->nframes,
-        .duration = r->a.anim.duration,
+        .duration = r->a.anim.duration, .gaps = r->gap_lines, .ngaps = r->t.ngaps,
     };
     if (rc == MECH_OK)
         rc = report_write(&in, r->a.out ? r->a.out : "-", &wd);
@@ -384,7 +494,17 @@ int cmd_report(int argc, char **argv)
             code = animation(&r);
         mech_diag_print(&r.d, stderr);
         if (code == MECH_EXIT_OK)
+            code = gap_lines(&r);
+        if (code == MECH_EXIT_SOLVE)
+            fprintf(stderr, "mech report: %d of the sweep's %d positions were solved; "
+                    "nothing written\n", r.t.nrows, r.t.nrequested);
+        if (code == MECH_EXIT_OK)
             code = write_page(&r);
+        if (code == MECH_EXIT_OK && r.partial) {
+            fprintf(stderr, "mech report: %d of the sweep's %d positions were solved; the "
+                    "page shows them and lists the gaps\n", r.t.nrows, r.t.nrequested);
+            code = MECH_EXIT_SOLVE;
+        }
     }
     run_free(&r);
     return code < 0 ? MECH_EXIT_OK : code;

@@ -200,7 +200,8 @@ static const char page_script[] =
     "  var row = data.rows[k];\n"
     "  for (var c = 0; c < data.columns.length; c++) {\n"
     "    var v = row[c + 1], u = data.columns[c].unit;\n"
-    "    document.getElementById('v' + c).textContent = v === null ? 'n/a' : String(v);\n"
+    "    document.getElementById('v' + c).textContent = v === null ? 'n/a'\n"
+    "      : Object.is(v, -0) ? '-0' : String(v);\n"
     "    document.getElementById('d' + c).textContent = shown(v, u);\n"
     "  }\n"
     "  where.textContent = 'position ' + k + ' of ' + (nf - 1) + ' (row ' + row[0] + '), '\n"
@@ -338,6 +339,12 @@ static int emit_page(FILE *f, const void *ctx)
 {
     const report_input *in = ctx;
     put_header(f, in);
+    if (in->ngaps > 0)
+        fprintf(f, "<p class=\"error\" id=\"partial\"><b>Not every driver position was "
+                   "solved:</b> %d of the %d requested (%d gap%s, listed under "
+                   "<a href=\"#diagnostics\">Diagnostics</a>). The slider, the values and "
+                   "the figures show the positions solved; the curves break at the gaps.</p>\n",
+                in->t->nrows, in->t->nrequested, in->ngaps, in->ngaps == 1 ? "" : "s");
     put_animation(f, in);
     report_put_structure(f, in);
     report_put_diagnostics(f, in);

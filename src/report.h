@@ -26,6 +26,9 @@ typedef struct report_input {
     const int *frame_rows;        /* [nframes] row of t shown by animation frame k */
     int nframes;
     double duration;              /* seconds of one pass of the animation */
+    char *const *gaps;            /* [ngaps] requested rows not solved, as mech solve
+                                     says them ("rows 112 to 251 of 361 ... not solved: ...") */
+    int ngaps;
 } report_input;
 
 /* Write the page to `path` whole (write_file_whole; "-" = stdout).

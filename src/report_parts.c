@@ -70,7 +70,9 @@ static void row_text(FILE *f, const char *key, const char *value)
     fputs("</td></tr>\n", f);
 }
 
-static void driver_text(const mech_model *m, char *buf, size_t n)
+/* The driver as `mech check` says it (src/cmd_check.c); range: its range
+ * and speed. */
+static void driver_text(const mech_model *m, int range, char *buf, size_t n)
 {
     if (!m->has_driver) {
         snprintf(buf, n, "none");
@@ -79,11 +81,14 @@ static void driver_text(const mech_model *m, char *buf, size_t n)
     const mech_driver *dr = &m->driver;
     int angle = dr->kind == MECH_DRIVE_ANGLE;
     double k = angle ? RAD2DEG_R : 1e3;
-    snprintf(buf, n, "%s '%s', %d position%s from %.6g to %.6g %s, speed %.6g %s",
-             angle ? "angle of link" : "displacement of slider",
-             angle ? m->links[dr->index].name : m->joints[dr->index].name, dr->nvalues,
-             dr->nvalues == 1 ? "" : "s", dr->values[0] * k, dr->values[dr->nvalues - 1] * k,
-             angle ? "deg" : "mm", dr->speed, angle ? "rad/s" : "m/s");
+    if (range)
+        snprintf(buf, n, "from %.6g to %.6g %s, speed %.6g %s", dr->values[0] * k,
+                 dr->values[dr->nvalues - 1] * k, angle ? "deg" : "mm", dr->speed,
+                 angle ? "rad/s" : "m/s");
+    else
+        snprintf(buf, n, "%s '%s', %d position%s", angle ? "angle of link" :
+                 "displacement of slider", angle ? m->links[dr->index].name :
+                 m->joints[dr->index].name, dr->nvalues, dr->nvalues == 1 ? "" : "s");
 }
 
 /* The lines of `mech check` (src/cmd_check.c). */
@@ -106,8 +111,12 @@ static void put_summary(FILE *f, const mech_model *m, const mech_summary *s)
     snprintf(b, sizeof b, "%d = 3*(%d-1) - 2*%d - %d, drivers %d", s->mobility, s->nlinks,
              s->nrevolute + s->nprismatic, s->npin_in_slot, s->ndrivers);
     row_text(f, "mobility", b);
-    driver_text(m, b, sizeof b);
+    driver_text(m, 0, b, sizeof b);
     row_text(f, "driver", b);
+    if (m->has_driver) {
+        driver_text(m, 1, b, sizeof b);
+        row_text(f, "driver range", b);
+    }
     snprintf(b, sizeof b, "%d points, %d links, %d sliders%s", m->outputs.npoints,
              m->outputs.nlinks, m->outputs.nsliders, m->outputs.forces ? ", forces" : "");
     row_text(f, "outputs", b);
@@ -241,8 +250,17 @@ void report_put_diagnostics(FILE *f, const report_input *in)
     fputs("<section id=\"diagnostics\">\n<h2>Diagnostics</h2>\n"
           "<p>How the solve went, as <code>mech solve --stats</code> prints it:</p>\n", f);
     put_stats(f, in->m, in->stats);
+    if (in->ngaps > 0) {
+        fprintf(f, "<h3>Gaps (%d)</h3>\n<ul id=\"gaps\">\n", in->ngaps);
+        for (int i = 0; i < in->ngaps; i++) {
+            fputs("<li class=\"error\">gap: ", f);
+            report_put_text(f, in->gaps[i]);
+            fputs("</li>\n", f);
+        }
+        fputs("</ul>\n", f);
+    }
     const mech_diag *d = in->diag;
-    fprintf(f, "<h3>Warnings and notes (%zu)</h3>\n", d ? d->count : (size_t)0);
+    fprintf(f, "<h3>Errors, warnings and notes (%zu)</h3>\n", d ? d->count : (size_t)0);
     if (!d || d->count == 0) {
         fputs("<p>None.</p>\n</section>\n", f);
         return;
