@@ -163,6 +163,7 @@ void codegen_free(codegen *g)
     free(g->unk_ident);
     free(g->phase);
     free(g->keep);
+    free(g->driver_only);
     free(g->unk_col);
     columns_free(&g->cols);
     blocklu_plan_free(&g->bp);

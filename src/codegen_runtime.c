@@ -287,6 +287,7 @@ const char *const codegen_runtime[] = {
     "        s->rcond = 1.0;",
     "        return CG_OK;",
     "    }",
+    "    eval_driver(q, s->keep);",
     "    double r = evaluate(s, s->x, q, s->f), prev_step = HUGE_VAL, xtol = 1e-2 * TOL;",
     "    for (int it = 0;; it++) {",
     "        if (!isfinite(r))",
