@@ -199,11 +199,11 @@ int codegen_expr_emit(const codegen *g, FILE *f)
     const solver_plan *sp = &g->sp;
     int rc = 0;
     fprintf(f, "/* What depends on the driver position q alone (once per position) */\n"
-               "static void eval_driver(double q, double *k)\n{\n    (void)q, (void)k;\n");
+               "static void eval_driver(double q, double *restrict k)\n{\n    (void)q, (void)k;\n");
     rc |= emit_nodes(g, f, PH_DRIVER);
     fprintf(f, "}\n\n/* f(x, q) and the nonzeros of J = df/dx (CSC order), after eval_driver "
-               "at q */\nstatic void eval_position(const double *x, double q, double *f, "
-               "double *Jv, double *k)\n{\n    (void)x, (void)q, (void)f, (void)Jv, (void)k;\n");
+               "at q */\nstatic void eval_position(const double *restrict x, double q, "
+               "double *restrict f, double *restrict Jv, double *restrict k)\n{\n    (void)x, (void)q, (void)f, (void)Jv, (void)k;\n");
     rc |= emit_phase(g, f, PH_POSITION, sp->proot, sp->nr, "f");
     for (int i = 0; i < sp->nnzJ; i++) {
         char a[48];
@@ -211,12 +211,12 @@ int codegen_expr_emit(const codegen *g, FILE *f)
         fprintf(f, "    Jv[%d] = %s;\n", i, a);
     }
     fprintf(f, "}\n\n/* b = -df/dq, the velocity right-hand side for q' = 1 (after eval_position "
-               "at x, q) */\nstatic void eval_velocity(const double *x, double q, double *k, "
-               "double *b)\n{\n    (void)x, (void)q, (void)k, (void)b;\n");
+               "at x, q) */\nstatic void eval_velocity(const double *restrict x, double q, "
+               "double *restrict k, double *restrict b)\n{\n    (void)x, (void)q, (void)k, (void)b;\n");
     rc |= emit_phase(g, f, PH_VELOCITY, sp->vroot, sp->nr, "b");
     fprintf(f, "}\n\n/* c, the acceleration right-hand side for x' = xd, q' = 1, q'' = 0 (after "
-               "eval_velocity) */\nstatic void eval_accel(const double *x, double q, const "
-               "double *xd, const double *k, double *c)\n{\n"
+               "eval_velocity) */\nstatic void eval_accel(const double *restrict x, double q, "
+               "const double *restrict xd, const double *restrict k, double *restrict c)\n{\n"
                "    (void)x, (void)q, (void)xd, (void)k, (void)c;\n");
     rc |= emit_phase(g, f, PH_ACCELERATION, sp->aroot, sp->nr, "c");
     fprintf(f, "}\n\n");
