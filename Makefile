@@ -185,6 +185,7 @@ bench:
 	{ build/bench/bench-eval mechanisms/*.yaml && \
 	  build/bench/bench-solve mechanisms/*.yaml && \
 	  build/bench/bench-hand mechanisms && \
+	  MECH=build/bench/mech BUILD=build/bench sh bench/bench_codegen.sh && \
 	  build/bench/bench-accuracy mechanisms build/bench && \
 	  build/bench/bench-scale build/bench && \
 	  MECH=build/bench/mech sh bench/bench_batch.sh && \

@@ -163,6 +163,7 @@ void codegen_free(codegen *g)
     free(g->unk_ident);
     free(g->phase);
     free(g->keep);
+    free(g->driver_only);
     free(g->unk_col);
     columns_free(&g->cols);
     blocklu_plan_free(&g->bp);
@@ -254,6 +255,7 @@ static void emit_state(const codegen *g, FILE *f)
             "    double out[%d];   /* output columns (%s_COL_*) */\n"
             "    double residual;  /* |f|inf at the solution, m */\n"
             "    double rcond;     /* reciprocal condition of the Jacobian's worst block */\n"
+            "    double rcond_whole; /* and of the whole Jacobian (Newton's rounding floor) */\n"
             "    int iterations;   /* Newton iterations of the last solve */\n"
             "    int branch;       /* %s_BRANCH: the condition that failed (0-based, in the\n"
             "                         file's order), else -1 */\n"
@@ -265,11 +267,12 @@ static void emit_state(const codegen *g, FILE *f)
             "    double xc[%d], xqq_prev[%d]; /* x at q_last, xqq at q_prev */\n"
             "    /* work (private) */\n"
             "    double xe[%d], f[%d], ft[%d], dx[%d], xt[%d], r[%d], y[%d], w[%d], cs[%d];\n"
+            "    double colnorm[%d], hx[%d], hy[%d], hz[%d];\n"
             "    double keep[%d], Jv[%d], Ax[%d], lu[%d];\n"
             "    int piv[%d];\n"
             "} %s_state;\n\n",
             g->lower, g->lower, g->lower, nx, g->upper, nx, nx, nx, nx, g->cols.ncols, g->upper,
-            g->upper, g->lower, g->lower, g->lower, nx, nx, nx, nx, nx, nx, nx, nx, nx, nx, nx, nk,
+            g->upper, g->lower, g->lower, g->lower, nx, nx, nx, nx, nx, nx, nx, nx, nx, nx, nx, nx, nx, nx, nx, nk,
             nz, nz, nd, nx, g->lower);
 }
 

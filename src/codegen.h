@@ -35,11 +35,12 @@ typedef struct codegen {
     char **col_ident;        /* [cols.ncols] enum identifier of each column */
     char **unk_ident;        /* [sp.ns] enum identifier of each solved unknown */
     /* expression emission (codegen_expr.c) */
-    int *phase;              /* [DAG nodes] phase (0 position, 1 velocity, 2 acceleration)
-                                whose function computes the node, -1: not needed */
+    int *phase;              /* [DAG nodes] phase (0 driver alone, 1 position, 2 velocity,
+                                3 acceleration) whose function computes the node, -1: none */
     int *keep;               /* [DAG nodes] slot in the state's keep[] for a node used by a
                                 later phase, -1: none */
     int nkeep;
+    int *driver_only;        /* [DAG nodes] 1: depends on the driver q alone, 0 not, -1 unknown */
     int *unk_col;            /* [n] solved column of each unknown of the system, -1: not solved */
 } codegen;
 
@@ -60,7 +61,7 @@ int codegen_emit_source(FILE *f, const void *ctx);
  * MECH_OK, MECH_EINPUT (an unknown node kind or a variable outside the
  * solved set, with the message in d) or MECH_ENOMEM. */
 int codegen_expr_plan(codegen *g, mech_diag *d);
-/* The functions eval_position, eval_velocity, eval_accel; 0 or -1. */
+/* The functions eval_driver, eval_position, eval_velocity, eval_accel; 0 or -1. */
 int codegen_expr_emit(const codegen *g, FILE *f);
 /* The function kinematics: link frames, output columns, branch values. */
 int codegen_kin_emit(const codegen *g, FILE *f);

@@ -1,10 +1,11 @@
 /* src/codegen_expr.c: the expression DAG and the link frames as C
  * statements for `mech codegen` (codegen.h). Every DAG node the three
  * phases need becomes one `const double tN = ...;` in the function of the
- * first phase that needs it, in the tape's operation order (so the
- * generated code computes the interpreter's values bit for bit); a node a
- * later phase reuses is kept in the state's keep[] array, as the tape keeps
- * it in its registers. The kinematics mirror src/kinematics.c formula for
+ * first phase that needs it, with the tape's operations (so the generated
+ * code computes the interpreter's values bit for bit); what depends on the
+ * driver alone is computed once per position (eval_driver, tape_hoist's
+ * part); a node a later phase reuses is kept in the state's keep[] array,
+ * as the tape keeps it in its registers. The kinematics mirror src/kinematics.c formula for
  * formula. */
 #include <math.h>
 #include <stdlib.h>
@@ -12,7 +13,10 @@
 
 #include "codegen.h"
 
-enum { PH_POSITION, PH_VELOCITY, PH_ACCELERATION, NPH };
+/* The functions the phases become: eval_driver (what depends on the
+ * driver position alone, run once per position as tape_hoist does), then
+ * eval_position (f, J), eval_velocity, eval_accel. */
+enum { PH_DRIVER, PH_POSITION, PH_VELOCITY, PH_ACCELERATION, NPH };
 
 void codegen_number(char *buf, size_t size, double v)
 {
@@ -49,34 +53,51 @@ static int var_allowed(const codegen *g, int var, int ph)
     return ph == PH_ACCELERATION && g->unk_col[var - n - 1] >= 0;
 }
 
-static int visit(codegen *g, ex e, int ph, mech_diag *d)
+/* Does e depend on nothing but constants and the driver q? (memo: -1
+ * unknown, 0 no, 1 yes) */
+static int driver_only(codegen *g, ex e)
+{
+    const expr_node *nd = expr_at(&g->sp.sys->ex, e);
+    if (nd->op == EX_CONST)
+        return 1;
+    if (nd->op == EX_VAR)
+        return nd->var == SYS_VAR_Q(g->sp.n);
+    if (g->driver_only[e] < 0)
+        g->driver_only[e] = driver_only(g, nd->a) &&
+                            (nd->op != EX_ADD && nd->op != EX_MUL ? 1 : driver_only(g, nd->b));
+    return g->driver_only[e];
+}
+
+/* Give e (used by a node or root of phase `user`, under a root of phase
+ * `root`) its phase, and a keep slot when a later phase uses it. */
+static int visit(codegen *g, ex e, int user, int root, mech_diag *d)
 {
     const expr_node *nd = expr_at(&g->sp.sys->ex, e);
     switch (nd->op) {
     case EX_CONST:
         return MECH_OK;
     case EX_VAR:
-        if (var_allowed(g, nd->var, ph))
+        if (var_allowed(g, nd->var, root))
             return MECH_OK;
-        return diag_error(d, g->m->file, (mech_mark){0, 0},
+        return diag_error(d, g->m->file, g->m->driver.mark,
                           "codegen: an equation uses '%s', which is not solved",
                           g->sp.sys->names[nd->var]);
     case EX_ADD: case EX_MUL: case EX_NEG: case EX_SIN: case EX_COS:
         break;
     default:
-        return diag_error(d, g->m->file, (mech_mark){0, 0},
+        return diag_error(d, g->m->file, g->m->driver.mark,
                           "codegen: expression node kind %d is not supported by the "
                           "code generator (src/codegen_expr.c)", (int)nd->op);
     }
-    if (g->phase[e] >= 0) {
-        if (g->phase[e] < ph && g->keep[e] < 0)
-            g->keep[e] = g->nkeep++;
-        return MECH_OK;
+    int rc = MECH_OK;
+    if (g->phase[e] < 0) {
+        g->phase[e] = root == PH_POSITION && driver_only(g, e) ? PH_DRIVER : root;
+        rc = visit(g, nd->a, g->phase[e], root, d);
+        if (rc == MECH_OK && (nd->op == EX_ADD || nd->op == EX_MUL))
+            rc = visit(g, nd->b, g->phase[e], root, d);
     }
-    g->phase[e] = ph;
-    int rc = visit(g, nd->a, ph, d);
-    if (rc == MECH_OK && (nd->op == EX_ADD || nd->op == EX_MUL))
-        rc = visit(g, nd->b, ph, d);
+    if (g->phase[e] < user && g->keep[e] < 0)
+        g->keep[e] = g->nkeep++;
     return rc;
 }
 
@@ -86,16 +107,17 @@ int codegen_expr_plan(codegen *g, mech_diag *d)
     size_t count = sp->sys->ex.count;
     g->phase = malloc((count + 1) * sizeof *g->phase);
     g->keep = malloc((count + 1) * sizeof *g->keep);
-    if (!g->phase || !g->keep)
+    g->driver_only = malloc((count + 1) * sizeof *g->driver_only);
+    if (!g->phase || !g->keep || !g->driver_only)
         return diag_error(d, g->m->file, (mech_mark){0, 0}, "out of memory"), MECH_ENOMEM;
     for (size_t i = 0; i < count; i++)
-        g->phase[i] = g->keep[i] = -1;
-    const ex *roots[NPH] = {sp->proot, sp->vroot, sp->aroot};
-    int nroots[NPH] = {sp->nr + sp->nnzJ, sp->nr, sp->nr};
+        g->phase[i] = g->keep[i] = g->driver_only[i] = -1;
+    const ex *roots[NPH] = {NULL, sp->proot, sp->vroot, sp->aroot};
+    int nroots[NPH] = {0, sp->nr + sp->nnzJ, sp->nr, sp->nr};
     int rc = MECH_OK;
-    for (int ph = 0; ph < NPH && rc == MECH_OK; ph++)
+    for (int ph = PH_POSITION; ph < NPH && rc == MECH_OK; ph++)
         for (int i = 0; i < nroots[ph] && rc == MECH_OK; i++)
-            rc = visit(g, roots[ph][i], ph, d);
+            rc = visit(g, roots[ph][i], ph, ph, d);
     return rc;
 }
 
@@ -131,41 +153,41 @@ static void operand(const codegen *g, ex e, int ph, char *buf, size_t size)
         snprintf(buf, size, "t%d", e);
 }
 
-/* The nodes of phase ph under e, operands first, each once (done). */
-static int emit_nodes(const codegen *g, FILE *f, ex e, int ph, unsigned char *done)
+/* The nodes of phase ph, in index order (a node's operands are made
+ * before it, so this is an order of evaluation). */
+static int emit_nodes(const codegen *g, FILE *f, int ph)
 {
-    const expr_node *nd = expr_at(&g->sp.sys->ex, e);
-    if (nd->op == EX_CONST || nd->op == EX_VAR || g->phase[e] != ph || done[e])
-        return 0;
-    done[e] = 1;
-    int binary = nd->op == EX_ADD || nd->op == EX_MUL;
-    if (emit_nodes(g, f, nd->a, ph, done) < 0 || (binary && emit_nodes(g, f, nd->b, ph, done) < 0))
-        return -1;
-    char a[48], b[48] = "";
-    operand(g, nd->a, ph, a, sizeof a);
-    if (binary)
-        operand(g, nd->b, ph, b, sizeof b);
-    switch (nd->op) {
-    case EX_ADD: fprintf(f, "    const double t%d = %s + %s;\n", e, a, b); break;
-    case EX_MUL: fprintf(f, "    const double t%d = %s * %s;\n", e, a, b); break;
-    case EX_NEG: fprintf(f, "    const double t%d = -%s;\n", e, a); break;
-    case EX_SIN: fprintf(f, "    const double t%d = sin(%s);\n", e, a); break;
-    case EX_COS: fprintf(f, "    const double t%d = cos(%s);\n", e, a); break;
-    default: return -1;  /* codegen_expr_plan has reported it */
+    for (size_t i = 0; i < g->sp.sys->ex.count; i++) {
+        ex e = (ex)i;
+        if (g->phase[e] != ph)
+            continue;
+        const expr_node *nd = expr_at(&g->sp.sys->ex, e);
+        char a[48], b[48] = "";
+        operand(g, nd->a, ph, a, sizeof a);
+        if (nd->op == EX_ADD || nd->op == EX_MUL)
+            operand(g, nd->b, ph, b, sizeof b);
+        switch (nd->op) {
+        case EX_ADD: fprintf(f, "    const double t%d = %s + %s;\n", e, a, b); break;
+        case EX_MUL: fprintf(f, "    const double t%d = %s * %s;\n", e, a, b); break;
+        case EX_NEG: fprintf(f, "    const double t%d = -%s;\n", e, a); break;
+        case EX_SIN: fprintf(f, "    const double t%d = sin(%s);\n", e, a); break;
+        case EX_COS: fprintf(f, "    const double t%d = cos(%s);\n", e, a); break;
+        default: return -1;  /* codegen_expr_plan has reported it */
+        }
+        if (g->keep[e] >= 0)
+            fprintf(f, "    k[%d] = t%d;\n", g->keep[e], e);
     }
-    if (g->keep[e] >= 0)
-        fprintf(f, "    k[%d] = t%d;\n", g->keep[e], e);
     return 0;
 }
 
-/* out[i] = root i, for i < nroots, after the nodes they need. */
-static int emit_roots(const codegen *g, FILE *f, const ex *roots, int nroots, int ph,
-                      const char *out, unsigned char *done)
+/* The nodes of phase ph, then out[i] = root i, for i < nroots. */
+static int emit_phase(const codegen *g, FILE *f, int ph, const ex *roots, int nroots,
+                      const char *out)
 {
     char a[48];
+    if (emit_nodes(g, f, ph) < 0)
+        return -1;
     for (int i = 0; i < nroots; i++) {
-        if (emit_nodes(g, f, roots[i], ph, done) < 0)
-            return -1;
         operand(g, roots[i], ph, a, sizeof a);
         fprintf(f, "    %s[%d] = %s;\n", out, i, a);
     }
@@ -175,29 +197,31 @@ static int emit_roots(const codegen *g, FILE *f, const ex *roots, int nroots, in
 int codegen_expr_emit(const codegen *g, FILE *f)
 {
     const solver_plan *sp = &g->sp;
-    unsigned char *done = calloc(sp->sys->ex.count + 1, 1);
-    if (!done)
-        return -1;
     int rc = 0;
-    fprintf(f, "/* f(x, q) and the nonzeros of J = df/dx (CSC order); keeps what the rates reuse */\n"
-               "static void eval_position(const double *x, double q, double *f, double *Jv, "
-               "double *k)\n{\n    (void)x, (void)q, (void)f, (void)Jv, (void)k;\n");
-    rc |= emit_roots(g, f, sp->proot, sp->nr, PH_POSITION, "f", done);
-    rc |= emit_roots(g, f, sp->proot + sp->nr, sp->nnzJ, PH_POSITION, "Jv", done);
+    fprintf(f, "/* What depends on the driver position q alone (once per position) */\n"
+               "static void eval_driver(double q, double *restrict k)\n{\n    (void)q, (void)k;\n");
+    rc |= emit_nodes(g, f, PH_DRIVER);
+    fprintf(f, "}\n\n/* f(x, q) and the nonzeros of J = df/dx (CSC order), after eval_driver "
+               "at q */\nstatic void eval_position(const double *restrict x, double q, "
+               "double *restrict f, double *restrict Jv, double *restrict k)\n{\n    (void)x, (void)q, (void)f, (void)Jv, (void)k;\n");
+    rc |= emit_phase(g, f, PH_POSITION, sp->proot, sp->nr, "f");
+    for (int i = 0; i < sp->nnzJ; i++) {
+        char a[48];
+        operand(g, sp->proot[sp->nr + i], PH_POSITION, a, sizeof a);
+        fprintf(f, "    Jv[%d] = %s;\n", i, a);
+    }
     fprintf(f, "}\n\n/* b = -df/dq, the velocity right-hand side for q' = 1 (after eval_position "
-               "at x, q) */\nstatic void eval_velocity(const double *x, double q, double *k, "
-               "double *b)\n{\n    (void)x, (void)q, (void)k, (void)b;\n");
-    rc |= emit_roots(g, f, sp->vroot, sp->nr, PH_VELOCITY, "b", done);
+               "at x, q) */\nstatic void eval_velocity(const double *restrict x, double q, "
+               "double *restrict k, double *restrict b)\n{\n    (void)x, (void)q, (void)k, (void)b;\n");
+    rc |= emit_phase(g, f, PH_VELOCITY, sp->vroot, sp->nr, "b");
     fprintf(f, "}\n\n/* c, the acceleration right-hand side for x' = xd, q' = 1, q'' = 0 (after "
-               "eval_velocity) */\nstatic void eval_accel(const double *x, double q, const "
-               "double *xd, const double *k, double *c)\n{\n"
+               "eval_velocity) */\nstatic void eval_accel(const double *restrict x, double q, "
+               "const double *restrict xd, const double *restrict k, double *restrict c)\n{\n"
                "    (void)x, (void)q, (void)xd, (void)k, (void)c;\n");
-    rc |= emit_roots(g, f, sp->aroot, sp->nr, PH_ACCELERATION, "c", done);
+    rc |= emit_phase(g, f, PH_ACCELERATION, sp->aroot, sp->nr, "c");
     fprintf(f, "}\n\n");
-    free(done);
     return rc;
 }
-
 /* ---- kinematics ------------------------------------------------------------ */
 
 /* The C text of variable var (0..n, n the driver) at derivative level lv
