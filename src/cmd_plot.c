@@ -248,8 +248,7 @@ static int write_figures(const plot_args *a, const mech_model *m, const mech_tab
         free(paths);
         return MECH_EXIT_IO;
     }
-    int n = plot_plan(m, t, figs, MAXFIG);
-    n += plot_path_plan(m, t, figs + n, MAXFIG - n);
+    int n = plot_plan_all(m, t, figs, MAXFIG);
     if (n == 0)
         fprintf(stderr, "mech plot: %s: nothing to plot (no outputs)\n", a->file);
     char stem[256];

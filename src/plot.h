@@ -56,6 +56,11 @@ int plot_plan(const mech_model *m, const mech_table *t, plot_figure *figs, int m
  * Returns the number of figures written to figs[0 .. max-1]. */
 int plot_path_plan(const mech_model *m, const mech_table *t, plot_figure *figs, int max);
 
+/* Every figure `mech plot` draws, in its order: plot_plan's figures, then
+ * plot_path_plan's (defined in src/plot_path.c). The report (src/report.c)
+ * uses this too, so both always draw the same set. */
+int plot_plan_all(const mech_model *m, const mech_table *t, plot_figure *figs, int max);
+
 /* Write one figure of table t as a standalone SVG document to `path`
  * (a temporary file beside it, renamed when complete; "-" = stdout).
  * `subtitle` (the mechanism's name, may be NULL) is printed under the title.

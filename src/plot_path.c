@@ -301,3 +301,9 @@ int plot_path_svg(FILE *f, const mech_model *m, const mech_table *t, const plot_
     fputs("</svg>\n", f);
     return ferror(f) ? -1 : 0;
 }
+
+int plot_plan_all(const mech_model *m, const mech_table *t, plot_figure *figs, int max)
+{
+    int n = plot_plan(m, t, figs, max);
+    return n + plot_path_plan(m, t, figs + n, max - n);
+}

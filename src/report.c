@@ -101,7 +101,7 @@ int report_figures(const mech_model *m, const mech_table *t, char ***svgs, int *
         free(out);
         return rc;
     }
-    int nf = plot_plan(m, t, figs, MAXFIG), k = 0;
+    int nf = plot_plan_all(m, t, figs, MAXFIG), k = 0;
     for (; k < nf && rc == MECH_OK; k++) {
         rc = plot_figure_write(m, t, &figs[k], m->name, s.path, d);
         if (rc == MECH_OK)
