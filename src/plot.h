@@ -1,9 +1,9 @@
 /* src/plot.h: SVG figures of a solved sweep and an animated SVG of the
  * mechanism (docs/plots.md). Used by src/cmd_plot.c (`mech plot`,
  * `mech animate`). Defined in src/plot.c (plot_plan, plot_figure_write),
- * src/plot_anim.c (plot_anim_options_default, plot_animation_write) and
- * src/plot_svg.c (plot_nice_step, plot_fmt); src/plot_svg.h is private to
- * those three files.
+ * src/plot_path.c (plot_path_plan), src/plot_anim.c
+ * (plot_anim_options_default, plot_animation_write) and src/plot_svg.c
+ * (plot_nice_step, plot_fmt); src/plot_svg.h is private to those files.
  *
  * Display units (docs/plots.md, "Units"): lengths mm, angles deg, linear
  * velocities m/s and accelerations m/s^2, angular velocities rad/s and

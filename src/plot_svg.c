@@ -1,7 +1,9 @@
-/* src/plot_svg.c: the SVG pieces the figures (plot.c) and the animation
- * (plot_anim.c) share: numbers without noise (plot_fmt), 1-2-5 tick steps,
- * text escaping, axes (range, ticks, labels, titles) and the path data of a
- * curve, thinned past THIN_FROM rows to four vertices per pixel column.
+/* src/plot_svg.c: the SVG pieces the figures (plot.c, plot_path.c) and the
+ * animation (plot_anim.c) share: numbers without noise (plot_fmt), 1-2-5
+ * tick steps, text escaping, axes (range, ticks, labels, titles), series
+ * styles, and the path data of a curve: whole, thinned to within a
+ * tolerance in page px (plot_thin_draw, the sleeve), or to four vertices
+ * per pixel column.
  * Declarations: src/plot_svg.h (private), src/plot.h (plot_fmt,
  * plot_nice_step). docs/plots.md, "Axes, units, styles". */
 #include <math.h>
