@@ -236,6 +236,7 @@ static void run_free(report_run *r)
 {
     for (int i = 0; i < r->a.nset; i++)
         free(r->a.set_text[i]);
+    report_free_strings(r->gap_lines, r->t.ngaps);  /* before t: its ngaps counts them */
     mech_table_free(&r->t);
     mech_table_free(&r->t_all);
     mech_outputs_free(&r->selected);
@@ -244,7 +245,6 @@ static void run_free(report_run *r)
     report_free_strings(r->figures, r->nfigures);
     free(r->animation);
     free(r->frame_rows);
-    report_free_strings(r->gap_lines, r->t.ngaps);
     mech_model_free(&r->m);
     mech_diag_free(&r->d);
 }
