@@ -340,8 +340,10 @@ static int animation(report_run *r)
     for (int k = 0; k < nf; k++)
         r->frame_rows[k] = nf > 1 ? (int)((long long)k * (n - 1) / (nf - 1)) : 0;
     r->nframes = nf;
+    /* the traced paths, unless a gap lies in the sweep: the animation's
+       polyline would bridge it (the page says so) */
     r->a.anim.trace = r->view.outputs.points;
-    r->a.anim.ntrace = r->view.outputs.npoints;
+    r->a.anim.ntrace = r->partial ? 0 : r->view.outputs.npoints;
     return cmd_exit_status(report_animation(&r->view_all, &r->t_all, &r->a.anim,
                                             &r->animation, &r->d));
 }

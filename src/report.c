@@ -350,7 +350,8 @@ static int emit_page(FILE *f, const void *ctx)
         fprintf(f, "<p class=\"error\" id=\"partial\"><b>Not every driver position was "
                    "solved:</b> %d of the %d requested (%d gap%s, listed under "
                    "<a href=\"#diagnostics\">Diagnostics</a>). The slider, the values and "
-                   "the figures show the positions solved; the curves break at the gaps.</p>\n",
+                   "the figures show the positions solved; the curves break at the gaps; the "
+                   "animation traces no paths (they would bridge the gaps).</p>\n",
                 in->t->nrows, in->t->nrequested, in->ngaps, in->ngaps == 1 ? "" : "s");
     put_animation(f, in);
     report_put_structure(f, in);

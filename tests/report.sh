@@ -188,6 +188,10 @@ grep -q "warning" "$tmp/warnings/solve.err" && pass || fail "redundant-parallelo
 WANT=1 page_of partial tests/hard/non-grashof-crank.yaml
 has_line "$tmp/err" "220 of the sweep's 361 positions were solved; the page shows them" "partial"
 WANT=1 page_of two-intervals tests/hard/non-grashof-two-intervals.yaml
+# the animation traces paths (dashed polylines) only when no gap would be bridged
+traces() { grep -c '<polyline fill="none"[^>]*stroke-dasharray' "$1"; }
+[ "$(traces "$tmp/fourbar/page.html")" -gt 0 ] && pass || fail "the four-bar's page traces no path"
+[ "$(traces "$tmp/partial/page.html")" = 0 ] && pass || fail "a partial page traces paths across its gap"
 # --set: the page is that of the file with the parameter replaced
 sed 's/^  l: 140 mm /  l: 150 mm /' mechanisms/slider-crank.yaml >"$tmp/slider-crank-150.yaml"
 grep -q "l: 150 mm" "$tmp/slider-crank-150.yaml" && pass || fail "slider-crank.yaml has no 'l: 140 mm'"
