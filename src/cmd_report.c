@@ -236,6 +236,7 @@ static void run_free(report_run *r)
 {
     for (int i = 0; i < r->a.nset; i++)
         free(r->a.set_text[i]);
+    report_free_strings(r->gap_lines, r->t.ngaps);  /* before t: its ngaps counts them */
     mech_table_free(&r->t);
     mech_table_free(&r->t_all);
     mech_outputs_free(&r->selected);
@@ -244,7 +245,6 @@ static void run_free(report_run *r)
     report_free_strings(r->figures, r->nfigures);
     free(r->animation);
     free(r->frame_rows);
-    report_free_strings(r->gap_lines, r->t.ngaps);
     mech_model_free(&r->m);
     mech_diag_free(&r->d);
 }
@@ -340,8 +340,10 @@ static int animation(report_run *r)
     for (int k = 0; k < nf; k++)
         r->frame_rows[k] = nf > 1 ? (int)((long long)k * (n - 1) / (nf - 1)) : 0;
     r->nframes = nf;
+    /* the traced paths, unless a gap lies in the sweep: the animation's
+       polyline would bridge it (the page says so) */
     r->a.anim.trace = r->view.outputs.points;
-    r->a.anim.ntrace = r->view.outputs.npoints;
+    r->a.anim.ntrace = r->partial ? 0 : r->view.outputs.npoints;
     return cmd_exit_status(report_animation(&r->view_all, &r->t_all, &r->a.anim,
                                             &r->animation, &r->d));
 }

@@ -176,10 +176,13 @@ static const char page_style[] =
 
 /* The slider: frame k of the animation is SMIL time k / (nf - 1) of its
    duration (the values of every <animate> are evenly spaced); the values
-   shown are those of the JSON row of that frame. The page's address may
-   say #row=K (the slider is moved there through its input event) and
-   #test (the positions drawn and the values shown are written into
-   <pre id="mech-test"> for tests/browser/report.sh). */
+   shown are those of the JSON row of that frame. Play runs the animation
+   and moves the slider along (a timer, not requestAnimationFrame: headless
+   chromium's virtual time stalls SMIL under a frame loop). The page's
+   address may say #row=K (the slider is moved there through its input
+   event), #play (Play is clicked) and #test (what the page shows is
+   written into <pre id="mech-test"> for tests/browser/report.sh: 100 ms
+   later, or 1 s into playing). */
 static const char page_script[] =
     "<script>//<![CDATA[\n"
     "(function () {\n"
@@ -188,7 +191,7 @@ static const char page_script[] =
     "var svg = document.querySelector('#anim svg');\n"
     "var slider = document.getElementById('slider'), where = document.getElementById('where');\n"
     "var play = document.getElementById('play');\n"
-    "var nf = data.rows.length, dur = data.duration, playing = false;\n"
+    "var nf = data.rows.length, dur = data.duration, timer = null;\n"
     "function fmt(x) { return Number(x.toPrecision(6)).toString(); }\n"
     "function shown(v, u) {\n"
     "  if (v === null) return 'n/a';\n"
@@ -212,18 +215,21 @@ static const char page_script[] =
     "  if (svg && svg.pauseAnimations) { svg.pauseAnimations(); svg.setCurrentTime(time(k)); }\n"
     "  values(k);\n"
     "}\n"
-    "function stop() { playing = false; play.textContent = 'Play'; }\n"
-    "function tick() {\n"
-    "  if (!playing) return;\n"
+    "function stop() {\n"
+    "  if (timer !== null) window.clearInterval(timer);\n"
+    "  timer = null; play.textContent = 'Play';\n"
+    "}\n"
+    "function tick() {  /* while playing, 20 times a second: the slider follows */\n"
     "  var t = svg.getCurrentTime() % dur, k = Math.round(t / dur * (nf - 1));\n"
     "  slider.value = k; values(k);\n"
-    "  window.requestAnimationFrame(tick);\n"
     "}\n"
     "slider.addEventListener('input', function () { stop(); show(+slider.value); });\n"
     "play.addEventListener('click', function () {\n"
-    "  if (playing) { stop(); svg.pauseAnimations(); return; }\n"
-    "  playing = nf > 1; play.textContent = 'Pause';\n"
-    "  svg.setCurrentTime(time(+slider.value)); svg.unpauseAnimations(); tick();\n"
+    "  if (timer !== null) { stop(); svg.pauseAnimations(); return; }\n"
+    "  if (nf < 2) return;\n"
+    "  play.textContent = 'Pause';\n"
+    "  svg.setCurrentTime(time(+slider.value)); svg.unpauseAnimations();\n"
+    "  timer = window.setInterval(tick, 50);\n"
     "});\n"
     "function box(e) {\n"
     "  var r = e.getBoundingClientRect();\n"
@@ -245,14 +251,15 @@ static const char page_script[] =
     "  for (var j = 0; j < fs.length; j++) out.figures.push(box(fs[j]));\n"
     "  document.getElementById('mech-test').textContent = JSON.stringify(out);\n"
     "}\n"
-    "function start() {\n"
-    "  var m = /row=([0-9]+)/.exec(window.location.hash);\n"
+    "function start() {  /* once loaded: the address's hooks */\n"
+    "  var h = window.location.hash, m = /row=([0-9]+)/.exec(h);\n"
     "  if (m) { slider.value = m[1]; slider.dispatchEvent(new Event('input')); }\n"
     "  else show(+slider.value);\n"
-    "  if (/test/.test(window.location.hash))  /* after the drawing has followed */\n"
-    "    window.setTimeout(report, 100);\n"
+    "  if (/play/.test(h)) play.click();\n"
+    "  if (/test/.test(h))  /* after the drawing has followed */\n"
+    "    window.setTimeout(report, /play/.test(h) ? 1000 : 100);\n"
     "}\n"
-    "start();\n"
+    "show(+slider.value);\n"
     "window.addEventListener('load', start);\n"
     "})();\n"
     "//]]></script>\n";
@@ -343,7 +350,8 @@ static int emit_page(FILE *f, const void *ctx)
         fprintf(f, "<p class=\"error\" id=\"partial\"><b>Not every driver position was "
                    "solved:</b> %d of the %d requested (%d gap%s, listed under "
                    "<a href=\"#diagnostics\">Diagnostics</a>). The slider, the values and "
-                   "the figures show the positions solved; the curves break at the gaps.</p>\n",
+                   "the figures show the positions solved; the curves break at the gaps; the "
+                   "animation traces no paths (they would bridge the gaps).</p>\n",
                 in->t->nrows, in->t->nrequested, in->ngaps, in->ngaps == 1 ? "" : "s");
     put_animation(f, in);
     report_put_structure(f, in);

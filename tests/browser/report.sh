@@ -16,7 +16,10 @@
 #      --level positions`), and, in a screenshot, that each disc's pixel
 #      centroid is within 1 px of row K's position; between K1 and K2 the
 #      discs moved;
-#   3. a screenshot of the whole page (device scale 0.5): the animation and
+#   3. Play (REPORT.html#play&test: the button clicked through the DOM): 1 s
+#      into the 4 s pass the slider is at a quarter of the rows (+-5 %) and
+#      the values shown are that row's;
+#   4. a screenshot of the whole page (device scale 0.5): the animation and
 #      every figure (as many as `mech plot` draws) are drawn, not blank.
 #
 # Needs (Debian): chromium, libxml2-utils (xmllint), python3, fonts-dejavu-core.
@@ -103,7 +106,12 @@ for name in ${REPORT_MECHS:-stirling offset-slider-crank}; do
     $CHECK moved "$dir/slider0.txt" "$dir/slider$((rows / 3)).txt" 10 ||
         fail "$name: the drawing did not follow the slider"
 
-    # 3. the whole page, every figure drawn
+    # Play: 1 s of the 4 s pass later the slider has followed the animation
+    browse "file://$page#play&test" 1400,1000 1 --virtual-time-budget=4000 --dump-dom \
+        >"$dir/dom-play.html" 2>"$dir/chromium.log" || fail "$name: chromium --dump-dom (play)"
+    $CHECK play "$dir/dom-play.html" "$dir/solve.csv" "$rows" || fail "$name: Play"
+
+    # 4. the whole page, every figure drawn
     nfig=$("$MECH" plot "$yaml" --out "$dir/plot" | wc -l)
     height=$(page_height "$dir/dom0.html")
     if [ -n "$height" ] && browse "file://$page" "1400,$height" 0.5 \
