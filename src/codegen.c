@@ -207,17 +207,21 @@ static void emit_enums(const codegen *g, FILE *f)
                "does not hold */\n};\n\n", g->lower, P, P, P, sp->opt.min_rcond, P);
     fprintf(f, "/* The unknowns: indices into x, xd, xdd, xq, xqq (link angles in rad, "
                "slider\n * displacements in m). */\nenum {\n");
-    for (int k = 0; k < sp->ns; k++)
-        fprintf(f, "    %s = %d,%s\n", g->unk_ident[k], k,
-                k + 1 < sp->ns ? "" : "");
+    for (int k = 0; k < sp->ns; k++) {
+        char item[160];
+        snprintf(item, sizeof item, "%s = %d,", g->unk_ident[k], k);
+        fprintf(f, "    %-40s /* %s */\n", item, sp->sys->names[sp->col[k]]);
+    }
     if (sp->ns == 0)
         fprintf(f, "    %s_X_NONE = 0\n", P);
     fprintf(f, "};\n\n/* The output columns: indices into out, in the order of `mech solve`'s "
                "CSV\n * (without forces), SI units. */\nenum {\n");
-    for (int c = 0; c < g->cols.ncols; c++)
-        fprintf(f, "    %s = %d,%*s/* %s [%s] */\n", g->col_ident[c], c,
-                (int)(strlen(g->col_ident[c]) < 36 ? 36 - strlen(g->col_ident[c]) : 1), "",
-                g->cols.cols[c].name, g->cols.cols[c].unit);
+    for (int c = 0; c < g->cols.ncols; c++) {
+        char item[160];
+        snprintf(item, sizeof item, "%s = %d,", g->col_ident[c], c);
+        fprintf(f, "    %-40s /* %s [%s] */\n", item, g->cols.cols[c].name,
+                g->cols.cols[c].unit);
+    }
     fprintf(f, "};\n\n");
 }
 
