@@ -261,6 +261,8 @@ static void emit_state(const codegen *g, FILE *f)
             "    double rcond;     /* reciprocal condition of the Jacobian's worst block */\n"
             "    double rcond_whole; /* and of the whole Jacobian (Newton's rounding floor) */\n"
             "    int iterations;   /* Newton iterations of the last solve */\n"
+            "    int det_sign;     /* sign of det J at the solution (+1, -1): a change between\n"
+            "                         two positions means a singular one was crossed */\n"
             "    int branch;       /* %s_BRANCH: the condition that failed (0-based, in the\n"
             "                         file's order), else -1 */\n"
             "    int first;        /* 1: the next solve is a first position (conditions with\n"
@@ -273,7 +275,7 @@ static void emit_state(const codegen *g, FILE *f)
             "    double xe[%d], f[%d], ft[%d], dx[%d], xt[%d], r[%d], y[%d], w[%d], cs[%d];\n"
             "    double colnorm[%d], hx[%d], hy[%d], hz[%d];\n"
             "    double keep[%d], Jv[%d], Ax[%d], lu[%d];\n"
-            "    int piv[%d];\n"
+            "    int piv[%d], swap_parity;\n"
             "} %s_state;\n\n",
             g->lower, g->lower, g->lower, nx, g->upper, nx, nx, nx, nx, g->cols.ncols, g->upper,
             g->upper, g->lower, g->lower, g->lower, nx, nx, nx, nx, nx, nx, nx, nx, nx, nx, nx, nx, nx, nx, nx, nk,
@@ -381,9 +383,10 @@ static int emit_pattern(const codegen *g, FILE *f)
                "#define NDENSE %d  /* their dense storage */\n"
                "#define TOL %s\n#define FTOL %s   /* residual tolerance: TOL * LREF, m */\n"
                "#define LREF %s   /* largest length of the mechanism, m */\n"
-               "#define MIN_RCOND %s\n#define MAX_ITER %d\n\n",
+               "#define MIN_RCOND %s\n#define MAX_ITER %d\n"
+               "#define PQ_PARITY %d  /* parity of the block form's permutations */\n\n",
             ns, nz, nb, b->ndense, tol, ftol, lref, minr,
-            sp->opt.max_iter > 0 ? sp->opt.max_iter : 50);
+            sp->opt.max_iter > 0 ? sp->opt.max_iter : 50, ns > 0 ? b->pq_parity : 0);
     int_table(f, "col_start", sp->Ap, ns + 1);   /* J's columns (CSC), as eval_position fills Jv */
     int_table(f, "dense_slot", slot, nz);
     int_table(f, "entry_row", row, nz);
@@ -449,6 +452,7 @@ static void emit_solve(const codegen *g, FILE *f)
             "    s->branch = -1;\n"
             "    int status = newton(s, q);\n"
             "    if (status != CG_OK)\n        return status;\n"
+            "    s->det_sign = det_sign(s);\n"
             "    if (s->nsolved++ > 0) {\n"
             "        s->q_prev = s->q_last;\n"
             "        for (int i = 0; i < NX; i++)\n"

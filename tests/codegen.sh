@@ -102,11 +102,15 @@ case $out in "status 1 "*) pass ;; *) fail "non-grashof-crank at 180 deg: '$out'
 # the slider-driven crank's dead centre at 130 mm is singular
 out=$(at tests/hard/dead-centre-slider.yaml 0.130)
 case $out in "status 2 "*) pass ;; *) fail "dead-centre-slider at 130 mm: '$out', expected status 2" ;; esac
-# the four-bar from guesses on the crossed assembly: branch condition 0 fails
+# the four-bar from guesses on the crossed assembly: branch condition 0
+# fails, and det J has the other sign than on the open assembly
 out=$(at mechanisms/fourbar.yaml 0.5 -0.5 -1.5)
-case $out in "status 3 "*"branch 0") pass ;; *) fail "fourbar, crossed: '$out', expected status 3, branch 0" ;; esac
-# and from the file's guesses it is solved, with the closed-form crank pin
+case $out in "status 3 "*"branch 0 det "*) pass ;; *) fail "fourbar, crossed: '$out', expected status 3, branch 0" ;; esac
 "$tmp/at/drv" --at 0.5 >"$tmp/one" 2>&1
+open_det=$(head -n 1 "$tmp/one" | sed 's/.* det //')
+[ "$open_det" = 1 -o "$open_det" = -1 ] && [ "${out##* det }" = $((-open_det)) ] && pass \
+    || fail "det J sign: open assembly '$open_det', crossed '${out##* det }': expected +-1 and the other"
+# and from the file's guesses it is solved, with the closed-form crank pin
 ax=$(awk '$1 == "A.x" { print $2 }' "$tmp/one")
 awk -v v="$ax" 'BEGIN { d = v - 0.02 * cos(0.5); exit !(d < 1e-17 && d > -1e-17) }' \
     && pass || fail "fourbar at q = 0.5: A.x = '$ax', expected 0.02 cos(0.5)"
