@@ -14,7 +14,8 @@ NAME=codegen . tests/lib.sh
 CC=${CC:-cc}
 CFLAGS_GEN="-std=c11 -Wall -Wextra -Werror -pedantic -O2"
 # under a sanitizer build, the generated code runs under one too
-[ -n "$MECH_SANITIZE" ] && CFLAGS_GEN="$CFLAGS_GEN -fsanitize=address,undefined -fno-sanitize-recover=all"
+[ -n "$MECH_SANITIZE" ] && CFLAGS_GEN="-std=c11 -Wall -Wextra -Werror -pedantic -O1 \
+    -fsanitize=address,undefined -fno-sanitize-recover=all"
 
 # build DIR FILE [OPTIONS]: generate DIR/gen.c, DIR/gen.h and the driver DIR/drv
 build() {
