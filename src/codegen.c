@@ -207,17 +207,21 @@ static void emit_enums(const codegen *g, FILE *f)
                "does not hold */\n};\n\n", g->lower, P, P, P, sp->opt.min_rcond, P);
     fprintf(f, "/* The unknowns: indices into x, xd, xdd, xq, xqq (link angles in rad, "
                "slider\n * displacements in m). */\nenum {\n");
-    for (int k = 0; k < sp->ns; k++)
-        fprintf(f, "    %s = %d,%s\n", g->unk_ident[k], k,
-                k + 1 < sp->ns ? "" : "");
+    for (int k = 0; k < sp->ns; k++) {
+        char item[160];
+        snprintf(item, sizeof item, "%s = %d,", g->unk_ident[k], k);
+        fprintf(f, "    %-40s /* %s */\n", item, sp->sys->names[sp->col[k]]);
+    }
     if (sp->ns == 0)
         fprintf(f, "    %s_X_NONE = 0\n", P);
     fprintf(f, "};\n\n/* The output columns: indices into out, in the order of `mech solve`'s "
                "CSV\n * (without forces), SI units. */\nenum {\n");
-    for (int c = 0; c < g->cols.ncols; c++)
-        fprintf(f, "    %s = %d,%*s/* %s [%s] */\n", g->col_ident[c], c,
-                (int)(strlen(g->col_ident[c]) < 36 ? 36 - strlen(g->col_ident[c]) : 1), "",
-                g->cols.cols[c].name, g->cols.cols[c].unit);
+    for (int c = 0; c < g->cols.ncols; c++) {
+        char item[160];
+        snprintf(item, sizeof item, "%s = %d,", g->col_ident[c], c);
+        fprintf(f, "    %-40s /* %s [%s] */\n", item, g->cols.cols[c].name,
+                g->cols.cols[c].unit);
+    }
     fprintf(f, "};\n\n");
 }
 
@@ -257,6 +261,8 @@ static void emit_state(const codegen *g, FILE *f)
             "    double rcond;     /* reciprocal condition of the Jacobian's worst block */\n"
             "    double rcond_whole; /* and of the whole Jacobian (Newton's rounding floor) */\n"
             "    int iterations;   /* Newton iterations of the last solve */\n"
+            "    int det_sign;     /* sign of det J at the solution (+1, -1): a change between\n"
+            "                         two positions means a singular one was crossed */\n"
             "    int branch;       /* %s_BRANCH: the condition that failed (0-based, in the\n"
             "                         file's order), else -1 */\n"
             "    int first;        /* 1: the next solve is a first position (conditions with\n"
@@ -269,7 +275,7 @@ static void emit_state(const codegen *g, FILE *f)
             "    double xe[%d], f[%d], ft[%d], dx[%d], xt[%d], r[%d], y[%d], w[%d], cs[%d];\n"
             "    double colnorm[%d], hx[%d], hy[%d], hz[%d];\n"
             "    double keep[%d], Jv[%d], Ax[%d], lu[%d];\n"
-            "    int piv[%d];\n"
+            "    int piv[%d], swap_parity;\n"
             "} %s_state;\n\n",
             g->lower, g->lower, g->lower, nx, g->upper, nx, nx, nx, nx, g->cols.ncols, g->upper,
             g->upper, g->lower, g->lower, g->lower, nx, nx, nx, nx, nx, nx, nx, nx, nx, nx, nx, nx, nx, nx, nx, nk,
@@ -377,9 +383,10 @@ static int emit_pattern(const codegen *g, FILE *f)
                "#define NDENSE %d  /* their dense storage */\n"
                "#define TOL %s\n#define FTOL %s   /* residual tolerance: TOL * LREF, m */\n"
                "#define LREF %s   /* largest length of the mechanism, m */\n"
-               "#define MIN_RCOND %s\n#define MAX_ITER %d\n\n",
+               "#define MIN_RCOND %s\n#define MAX_ITER %d\n"
+               "#define PQ_PARITY %d  /* parity of the block form's permutations */\n\n",
             ns, nz, nb, b->ndense, tol, ftol, lref, minr,
-            sp->opt.max_iter > 0 ? sp->opt.max_iter : 50);
+            sp->opt.max_iter > 0 ? sp->opt.max_iter : 50, ns > 0 ? b->pq_parity : 0);
     int_table(f, "col_start", sp->Ap, ns + 1);   /* J's columns (CSC), as eval_position fills Jv */
     int_table(f, "dense_slot", slot, nz);
     int_table(f, "entry_row", row, nz);
@@ -445,6 +452,7 @@ static void emit_solve(const codegen *g, FILE *f)
             "    s->branch = -1;\n"
             "    int status = newton(s, q);\n"
             "    if (status != CG_OK)\n        return status;\n"
+            "    s->det_sign = det_sign(s);\n"
             "    if (s->nsolved++ > 0) {\n"
             "        s->q_prev = s->q_last;\n"
             "        for (int i = 0; i < NX; i++)\n"

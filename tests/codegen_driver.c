@@ -14,7 +14,7 @@
  * column of REF. Prints the worst error against that bound; exit 0 when
  * every value agrees, 1 otherwise (or when a row does not solve), 2 for a
  * malformed REF. With --at, one position Q (SI) from gen_init's guesses, or
- * from X0 X1 ... (SI): prints "status S iterations I rcond R branch B" and
+ * from X0 X1 ... (SI): prints "status S iterations I rcond R branch B det D" and
  * the output columns, exit 0. */
 #include <math.h>
 #include <stdio.h>
@@ -94,7 +94,8 @@ static int solve_at(int argc, char **argv)
     for (int i = 3; i < argc && i - 3 < GEN_NX; i++)
         s.x[i - 3] = strtod(argv[i], NULL);
     int st = gen_solve(&s, strtod(argv[2], NULL), GEN_DRIVER_SPEED, GEN_DRIVER_ACCEL);
-    printf("status %d iterations %d rcond %.3g branch %d\n", st, s.iterations, s.rcond, s.branch);
+    printf("status %d iterations %d rcond %.3g branch %d det %d\n", st, s.iterations, s.rcond,
+           s.branch, s.det_sign);
     for (int c = 0; c < GEN_NOUT && st == GEN_OK; c++)
         printf("%s %.17g\n", gen_column_names[c], s.out[c]);
     return 0;
