@@ -63,6 +63,10 @@ int cmd_batch(int argc, char **argv);
 extern const char cmd_sweep_help[];
 int cmd_sweep(int argc, char **argv);
 
+/* `mech merge -o OUT SHARD...` (cmd_merge.c): shards of a sweep or batch. */
+extern const char cmd_merge_help[];
+int cmd_merge(int argc, char **argv);
+
 /* `mech compare [options] OUT.csv GOLDEN.csv` (cmd_compare.c): argv[0] is
  * "compare"; returns the exit code. */
 extern const char cmd_compare_help[];
