@@ -92,12 +92,16 @@ static char *slurp(const char *path)
     return buf;
 }
 
-/* The index at the start of a row ("12," for a sweep, "12 " for a batch). */
+/* The index of a row: its first field in a sweep ("12,"), its last in a
+ * batch's table (" 12"). */
 static long row_index(const merge *g, const char *row)
 {
+    const char *s = row;
+    if (g->batch && (s = strrchr(row, ' ')))
+        s++;
     char *end;
-    long idx = strtol(row, &end, 10);
-    return end == row || *end != (g->batch ? ' ' : ',') ? -1 : idx;
+    long idx = s ? strtol(s, &end, 10) : -1;
+    return !s || end == s || *end != (g->batch ? '\0' : ',') ? -1 : idx;
 }
 
 /* "shard K/M (path)" */
@@ -275,9 +279,8 @@ static void check_out_dir(merge *g)
     if (manifest_option(g->shards[0].man.args, "--out-dir", dir, sizeof dir) != 0)
         return;
     for (long i = 0; i < g->total; i++) {
-        long idx;
         int steps = -1;
-        if (!g->rows[i] || sscanf(g->rows[i], "%ld %255s %15s %d", &idx, name_, status, &steps) < 3 ||
+        if (!g->rows[i] || sscanf(g->rows[i], "%255s %15s %d", name_, status, &steps) < 2 ||
             (strcmp(status, "ok") != 0 && strcmp(status, "kept") != 0))
             continue;
         snprintf(path, sizeof path, "%s/%s.csv", dir, name_);
@@ -297,18 +300,22 @@ static void check_out_dir(merge *g)
     }
 }
 
-/* A batch row without its index (the summary table of mech batch alone). */
-static const char *unindexed(const merge *g, const char *row)
+/* A line without a batch table's index (as mech batch alone writes it). */
+static void put_unindexed(const merge *g, const char *line, FILE *f)
 {
-    return g->batch ? strchr(row, ' ') + 1 : row;
+    const char *cut = g->batch ? strrchr(line, ' ') : NULL;
+    if (cut && g->batch && line == g->shards[0].header)
+        while (cut > line && cut[-1] == ' ')
+            cut--;  /* the header's "golden " padding */
+    fprintf(f, "%.*s\n", cut ? (int)(cut - line) : (int)strlen(line), line);
 }
 
 static int emit_merged(FILE *f, const void *ctx)
 {
     const merge *g = ctx;
-    fprintf(f, "%s\n", unindexed(g, g->shards[0].header));
+    put_unindexed(g, g->shards[0].header, f);
     for (long i = 0; i < g->total; i++)
-        fprintf(f, "%s\n", unindexed(g, g->rows[i]));
+        put_unindexed(g, g->rows[i], f);
     return ferror(f) ? -1 : 0;
 }
 

@@ -152,4 +152,54 @@ seq 0 $((m - 1)) | xargs -P $m -I K "$MECH" batch -q -j 1 --shard K/$m --out-dir
     mechanisms/*.yaml >/dev/null 2>&1
 diff -r "$tmp/b1" "$tmp/b2" >/dev/null && pass || fail "batch shards differ from one batch"
 
+# batch --files-from: a frozen list (a file or standard input), sharded,
+# each shard's table with its manifest, merged and checked against the CSVs
+ls mechanisms/*.yaml >"$tmp/list"
+"$MECH" batch -q -j 1 --files-from "$tmp/list" >"$tmp/sum.txt" 2>/dev/null
+"$MECH" batch -q -j 1 mechanisms/*.yaml >"$tmp/sum-args.txt" 2>/dev/null
+# the table less its timing column (us/step)
+untimed() { awk '{ $5 = ""; print }' "$1"; }
+[ "$(untimed "$tmp/sum.txt")" = "$(untimed "$tmp/sum-args.txt")" ] && pass || fail "batch --files-from: another table than the same files as arguments"
+for k in 0 1 2; do
+    "$MECH" batch -q -j 1 --shard $k/3 --out-dir "$tmp/b3" --files-from - <"$tmp/list" >"$tmp/bsum.$k.txt" 2>/dev/null
+done
+has_line "$tmp/bsum.1.txt" '^# mech-manifest version=[0-9.]* command=batch shard=1/3 rows=3 total=10 ' "batch shard: manifest"
+has_line "$tmp/bsum.1.txt" "^double-crank  *ok .* 1\$" "batch shard: rows with their index"
+if run "merge batch summaries" 0 "$MECH" merge -o "$tmp/bmerged.txt" "$tmp"/bsum.*.txt; then
+    [ "$(untimed "$tmp/bmerged.txt")" = "$(untimed "$tmp/sum.txt")" ] && pass || fail "merged batch summaries differ from one batch's table"
+fi
+merge_refused "a batch shard missing" '^mech merge: shard 1/3 missing$' "$tmp/bsum.0.txt" "$tmp/bsum.2.txt"
+mv "$tmp/b3/jansen.csv" "$tmp/jansen.csv"
+merge_refused "a batch CSV missing" 'index 3 (jansen) is ok in its summary, but .*b3/jansen.csv cannot be read' "$tmp"/bsum.*.txt
+head -n 5 "$tmp/jansen.csv" >"$tmp/b3/jansen.csv"
+merge_refused "a batch CSV cut off" 'index 3 (jansen): .*b3/jansen.csv has 4 rows, its summary says' "$tmp"/bsum.*.txt
+ls tests/solve/*.yaml | head -n 3 >"$tmp/list2"
+"$MECH" batch -q -j 1 --shard 1/3 --out-dir "$tmp/b3" --files-from "$tmp/list2" >"$tmp/sum2.txt" 2>/dev/null
+merge_refused "summaries of two lists" 'shard 1/3 (.*sum2.txt) is not from the same run as shard 0/3 .*: its input file (its contents) differs' "$tmp/bsum.0.txt" "$tmp/sum2.txt" "$tmp/bsum.2.txt"
+mkdir -p "$tmp/a" "$tmp/b"; cp mechanisms/fourbar.yaml "$tmp/a/m.yaml"
+cp mechanisms/slider-crank.yaml "$tmp/b/m.yaml"
+printf '%s\n%s\n' "$tmp/a/m.yaml" "$tmp/b/m.yaml" >"$tmp/dups"
+if run "batch --files-from, same names" 2 "$MECH" batch -q --shard 0/2 --out-dir "$tmp/bd" --files-from "$tmp/dups"; then
+    has_line "$tmp/err" 'a/m.yaml and .*b/m.yaml would both be written to' "batch --files-from, same names: message"
+    [ ! -e "$tmp/bd/m.csv" ] && pass || fail "batch --files-from, same names: a CSV was written"
+fi
+: >"$tmp/empty"
+run "batch --files-from an empty list" 2 "$MECH" batch -q --files-from "$tmp/empty" && pass
+run "batch --files-from a missing list" 3 "$MECH" batch -q --files-from "$tmp/nosuch" && has_line "$tmp/err" 'cannot read the list' "batch --files-from missing: message"
+
+# batch --skip-existing: a CSV already there is kept (not solved, not written)
+echo marker >"$tmp/b3/jansen.csv"
+if run "batch --skip-existing" 0 "$MECH" batch -j 1 --shard 0/3 --out-dir "$tmp/b3" --files-from "$tmp/list" --skip-existing; then
+    has_line "$tmp/out" "^jansen  *kept .* 3\$" "batch --skip-existing: status kept"
+    [ "$(cat "$tmp/b3/jansen.csv")" = marker ] && pass || fail "batch --skip-existing: the existing CSV was rewritten"
+fi
+run "batch --skip-existing without --out-dir" 2 "$MECH" batch --skip-existing mechanisms/fourbar.yaml && pass
+
+# batch --unsolvable-ok: a mechanism that cannot be solved is a result
+run "batch, an unsolvable file" 1 "$MECH" batch -q mechanisms/fourbar.yaml tests/solve/non-grashof.yaml && pass
+if run "batch --unsolvable-ok" 0 "$MECH" batch -q --unsolvable-ok mechanisms/fourbar.yaml tests/solve/non-grashof.yaml; then
+    has_line "$tmp/out" '^non-grashof  *FAILED' "batch --unsolvable-ok: the row"
+fi
+run "batch --unsolvable-ok, an invalid file" 2 "$MECH" batch -q --unsolvable-ok tests/solve/non-grashof.yaml tests/bad/01-bad-indentation.yaml && pass
+
 summary
