@@ -111,6 +111,10 @@ $(BUILD)/unit-tests: $(TEST_OBJ) $(BUILD)/obj/cmd_compare.o $(BUILD)/libmech.a
 $(BUILD)/pool-fail: tests/pool/pool_fail.c $(BUILD)/obj/cmd_common.o $(BUILD)/libmech.a $(HEADERS)
 	$(CC) $(CFLAGS) -Isrc -o $@ $< $(BUILD)/obj/cmd_common.o $(BUILD)/libmech.a $(LDLIBS)
 
+# the default -j of batch and sweep under a restricted CPU affinity mask
+$(BUILD)/affinity: tests/pool/affinity.c $(BUILD)/obj/cmd_common.o $(BUILD)/libmech.a $(HEADERS)
+	$(CC) $(CFLAGS) -Isrc -o $@ $< $(BUILD)/obj/cmd_common.o $(BUILD)/libmech.a $(LDLIBS)
+
 $(BUILD)/obj $(BUILD)/pic $(BUILD)/tests:
 	mkdir -p $@
 
@@ -130,6 +134,8 @@ test: deps
 	$(BUILD)/unit-tests --jobs 2
 	@$(MAKE) --no-print-directory $(BUILD)/pool-fail
 	$(BUILD)/pool-fail
+	@$(MAKE) --no-print-directory $(BUILD)/affinity
+	$(BUILD)/affinity
 	MECH=$(BUILD)/mech sh tests/cli.sh
 	MECH=$(BUILD)/mech sh tests/cli_compare.sh
 	MECH=$(BUILD)/mech sh tests/files.sh

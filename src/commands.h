@@ -44,7 +44,7 @@ int cmd_refuse_input(const char *command, const char *out, const char *const *in
 int cmd_make_dir(const char *dir);
 /* "K/M" with 0 <= K < M: 0, or -1 when malformed. */
 int cmd_parse_shard(const char *s, int *k, int *mod);
-int cmd_default_jobs(void);  /* processors online */
+int cmd_default_jobs(void);  /* the CPUs of the affinity mask (else those online) */
 /* job(ctx, i) for i = 0 .. njobs-1 on up to nthreads threads (each i once). */
 void cmd_run_parallel(int njobs, int nthreads, void (*job)(void *ctx, int i), void *ctx);
 
