@@ -5,6 +5,7 @@
 #   make test       deps + build + the full test suite
 #   make test-san   the test suite built with -fsanitize=address,undefined
 #   make test-browser  figures and animation rendered by headless chromium
+#   make test-slurm    docs/batch.md's Slurm recipes on a single-node Slurm (root)
 #   make bench      optimised benchmarks, printed as tables
 #   make golden     regenerate tests/golden/*.csv (review the diff by hand)
 #   make install PREFIX=/usr/local   mech, libmech.so/.a, mech.h, mech.pc, mech.1,
@@ -51,7 +52,7 @@ LIB_OBJ  = $(LIB_SRC:src/%.c=$(BUILD)/pic/%.o)
 TEST_SRC = $(wildcard tests/unit/*.c)
 TEST_OBJ = $(TEST_SRC:tests/unit/%.c=$(BUILD)/tests/%.o)
 
-.PHONY: all lib python deps run test test-san test-valgrind test-browser test-install test-python \
+.PHONY: all lib python deps run test test-san test-valgrind test-browser test-install test-python test-slurm \
         fuzz fuzz-replay bench golden install clean
 
 all: $(BUILD)/mech lib
@@ -141,7 +142,15 @@ test: deps
 	MECH=$(BUILD)/mech sh tests/files.sh
 	MECH=$(BUILD)/mech sh tests/golden.sh
 	MECH=$(BUILD)/mech MECH_SANITIZE=$(if $(SAN),1,) sh tests/sweep.sh
+	MECH=$(BUILD)/mech sh tests/parallel/recipes.sh
 	@$(MAKE) --no-print-directory test-install test-python
+
+# The Slurm recipes of docs/batch.md run as written against a single-node
+# Slurm that tests/slurm/recipes.sh starts on localhost and stops (root,
+# Debian slurm-wlm and munge).
+test-slurm: $(BUILD)/mech
+	@sh tools/deps.sh slurm-wlm munge
+	MECH=$(BUILD)/mech sh tests/slurm/recipes.sh
 
 # make install into a temporary prefix, then the example of docs/api.md
 # built with pkg-config alone (shared and --static), its numbers against
