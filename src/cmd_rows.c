@@ -150,8 +150,15 @@ int rows_open(rowfile *rf, const char *command, const char *out, int resume, con
     rf->done = calloc((size_t)count / 8 + 1, 1);
     if (!rf->head || !rf->done)
         return oom(rf);
-    if (out && strcmp(out, "-") != 0)
+    struct stat st;  /* a device, a FIFO, a directory: no OUT.partial beside it */
+    int regular = out && strcmp(out, "-") != 0 && (stat(out, &st) != 0 || S_ISREG(st.st_mode));
+    if (regular)
         return open_partial(rf, out, resume);
+    if (resume) {
+        fprintf(stderr, "mech %s: --resume needs -o FILE, a regular file (%s is not)\n",
+                command, out ? out : "-");
+        return MECH_EXIT_INPUT;
+    }
     if (!(rf->f = tmpfile()) || fputs(head, rf->f) == EOF)
         return io_error(rf, "create", "a temporary file");
     return -1;

@@ -23,8 +23,9 @@ typedef struct rowfile {
 } rowfile;
 
 /* Opens the rows of a run whose file starts with `head` (the manifest line
- * and the CSV header, each with its newline). out NULL or "-": a temporary
- * file. Else OUT.partial: a new file; one that exists is refused unless
+ * and the CSV header, each with its newline). out NULL, "-" or an existing
+ * file that is not a regular one (/dev/null, a FIFO): a temporary file.
+ * Else OUT.partial: a new file; one that exists is refused unless
  * resume, which keeps its complete rows when its head is the same (a row cut
  * by the kill is dropped). Returns -1 when open, else the exit status (the
  * problem printed). */
