@@ -5,6 +5,7 @@
 #   make test       deps + build + the full test suite
 #   make test-san   the test suite built with -fsanitize=address,undefined
 #   make test-browser  figures, animation and report rendered by headless chromium
+#   make test-slurm    docs/batch.md's Slurm recipes on a single-node Slurm (root)
 #   make bench      optimised benchmarks, printed as tables
 #   make golden     regenerate tests/golden/*.csv (review the diff by hand)
 #   make install PREFIX=/usr/local   mech, libmech.so/.a, mech.h, mech.pc, mech.1,
@@ -51,7 +52,7 @@ LIB_OBJ  = $(LIB_SRC:src/%.c=$(BUILD)/pic/%.o)
 TEST_SRC = $(wildcard tests/unit/*.c)
 TEST_OBJ = $(TEST_SRC:tests/unit/%.c=$(BUILD)/tests/%.o)
 
-.PHONY: all lib python deps run test test-san test-valgrind test-browser test-install test-python \
+.PHONY: all lib python deps run test test-san test-valgrind test-browser test-install test-python test-slurm \
         fuzz fuzz-replay bench golden install clean
 
 all: $(BUILD)/mech lib
@@ -111,6 +112,10 @@ $(BUILD)/unit-tests: $(TEST_OBJ) $(BUILD)/obj/cmd_compare.o $(BUILD)/libmech.a
 $(BUILD)/pool-fail: tests/pool/pool_fail.c $(BUILD)/obj/cmd_common.o $(BUILD)/libmech.a $(HEADERS)
 	$(CC) $(CFLAGS) -Isrc -o $@ $< $(BUILD)/obj/cmd_common.o $(BUILD)/libmech.a $(LDLIBS)
 
+# the default -j of batch and sweep under a restricted CPU affinity mask
+$(BUILD)/affinity: tests/pool/affinity.c $(BUILD)/obj/cmd_common.o $(BUILD)/libmech.a $(HEADERS)
+	$(CC) $(CFLAGS) -Isrc -o $@ $< $(BUILD)/obj/cmd_common.o $(BUILD)/libmech.a $(LDLIBS)
+
 $(BUILD)/obj $(BUILD)/pic $(BUILD)/tests:
 	mkdir -p $@
 
@@ -130,6 +135,8 @@ test: deps
 	$(BUILD)/unit-tests --jobs 2
 	@$(MAKE) --no-print-directory $(BUILD)/pool-fail
 	$(BUILD)/pool-fail
+	@$(MAKE) --no-print-directory $(BUILD)/affinity
+	$(BUILD)/affinity
 	MECH=$(BUILD)/mech sh tests/cli.sh
 	MECH=$(BUILD)/mech sh tests/cli_compare.sh
 	MECH=$(BUILD)/mech sh tests/files.sh
@@ -137,7 +144,15 @@ test: deps
 	MECH=$(BUILD)/mech MECH_SANITIZE=$(if $(SAN),1,) sh tests/sweep.sh
 	MECH=$(BUILD)/mech MECH_SANITIZE=$(if $(SAN),1,) sh tests/codegen.sh
 	MECH=$(BUILD)/mech sh tests/report.sh
+	MECH=$(BUILD)/mech sh tests/parallel/recipes.sh
 	@$(MAKE) --no-print-directory test-install test-python
+
+# The Slurm recipes of docs/batch.md run as written against a single-node
+# Slurm that tests/slurm/recipes.sh starts on localhost and stops (root,
+# Debian slurm-wlm and munge).
+test-slurm: $(BUILD)/mech
+	@sh tools/deps.sh slurm-wlm munge
+	MECH=$(BUILD)/mech sh tests/slurm/recipes.sh
 
 # make install into a temporary prefix, then the example of docs/api.md
 # built with pkg-config alone (shared and --static), its numbers against

@@ -28,3 +28,46 @@ for j in 1 2 4 8; do
     awk -v j=$j -v tb="$tb" -v ts="$ts" -v n=$nfiles \
         'BEGIN { printf "%-8s %8.3f %14.1f %10.3f %16.1f\n", j, tb, n / tb, ts, 200 / ts }' 
 done
+
+# Per CPU-second (user + system: what a scheduler's allocation pays for) and
+# peak memory (maximum resident set, GNU time's %M), default -j. The sweep's
+# memory per variant is the slope between two grid sizes: it must stay near
+# the output's own bytes per row (rows are streamed to OUT.partial, then put
+# in order with 8 bytes per variant; docs/batch.md).
+TIME=/usr/bin/time
+if [ ! -x $TIME ]; then
+    echo "(GNU time not installed: no CPU-second and memory table; Debian package time)"
+    exit 0
+fi
+tmp=${TMPDIR:-/tmp}/mech-bench-batch.$$
+mkdir "$tmp" || exit 2
+trap 'rm -rf "$tmp"' EXIT
+measure() {  # measure LABEL ITEMS COMMAND...: one row of the table
+    label=$1 items=$2
+    shift 2
+    $TIME -f "%e %U %S %M" -o "$tmp/time" "$@" >/dev/null 2>&1
+    read -r wall user sys kb <"$tmp/time"
+    awk -v l="$label" -v n="$items" -v w="$wall" -v u="$user" -v s="$sys" -v k="$kb" \
+        'BEGIN { c = u + s; if (c < 0.01) c = 0.01
+                 printf "%-34s %8d %8.2f %8.2f %12.1f %9.1f\n", l, n, w, c, n / c, k / 1024 }'
+    echo "$kb" >"$tmp/kb"
+}
+echo
+echo "throughput per CPU-second and peak memory (default -j: $ncpu)"
+printf "%-34s %8s %8s %8s %12s %9s\n" run items "wall s" "cpu s" "items/cpu-s" "peak MB"
+conv="mechanisms/conveyor.yaml --metric range:E.x --metric maxabs:driver.torque --forces"
+measure "sweep conveyor (variants)" 2000 "$MECH" sweep $conv -q \
+    --vary l1=50mm:64mm:100 --vary l2=420mm:440mm:20 -o "$tmp/c.csv"
+measure "sweep slider-crank (variants)" 2000 "$MECH" sweep mechanisms/slider-crank.yaml -q \
+    --vary r=20mm:60mm:100 --vary l=100mm:200mm:20 --metric range:x_B.s -o "$tmp/s.csv"
+measure "batch mechanisms/*.yaml x10 (files)" "$nfiles" "$MECH" batch -q $files
+measure "sweep conveyor, 1000 variants" 1000 "$MECH" sweep $conv -q \
+    --vary l1=50mm:64mm:50 --vary l2=420mm:440mm:20 -o "$tmp/m1.csv"
+kb1=$(cat "$tmp/kb")
+measure "sweep conveyor, 8000 variants" 8000 "$MECH" sweep $conv -q \
+    --vary l1=50mm:64mm:400 --vary l2=420mm:440mm:20 -o "$tmp/m2.csv"
+kb2=$(cat "$tmp/kb")
+row=$(awk 'NR > 1 { n += length($0) + 1 } END { printf "%.0f", n / (NR - 1) }' "$tmp/m2.csv")
+awk -v a="$kb1" -v b="$kb2" -v r="$row" 'BEGIN {
+    printf "sweep memory per variant: %.0f bytes (peak %.1f MB at 1000, %.1f MB at 8000 variants; a row of the output is %d bytes)\n",
+        (b - a) * 1024 / 7000, a / 1024, b / 1024, r }'

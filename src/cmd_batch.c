@@ -16,12 +16,14 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "cmd_manifest.h"
 #include "commands.h"
 #include "compare.h"
 
 const char cmd_batch_help[] =
     "usage: mech batch FILE... [-j N] [--out-dir DIR] [--golden DIR] [--shard K/M]\n"
-    "                  [--rtol R] [--atol A] [--forces] [-q]\n"
+    "                  [--rtol R] [--atol A] [--forces] [-q] [--files-from LIST]\n"
+    "                  [--skip-existing] [--unsolvable-ok]\n"
     "\n"
     "Solve many mechanism files on N worker threads, each exactly as 'mech solve\n"
     "FILE' would, and print a summary table: file, status, steps, worst residual,\n"
@@ -29,14 +31,24 @@ const char cmd_batch_help[] =
     "change the others. Messages are printed per file, in the order given.\n"
     "\n"
     "options:\n"
-    "  -j, --jobs N      worker threads (default: the number of processors)\n"
+    "  -j, --jobs N      worker threads (default: the processors this process may\n"
+    "                    run on: its CPU affinity, as set by taskset or Slurm)\n"
+    "  --files-from LIST  also the files named in LIST, one path per line ('-':\n"
+    "                    standard input), after those given as arguments\n"
     "  --out-dir DIR     write DIR/NAME.csv for each FILE (NAME = its base name\n"
     "                    without .yaml; DIR created if missing; two files with\n"
     "                    the same NAME are refused); without it nothing is written\n"
     "  --golden DIR      compare each result with DIR/NAME.csv (mech compare)\n"
     "  --rtol R, --atol A  tolerances of the golden comparison (1e-9, 1e-12)\n"
     "  --shard K/M       solve only the files with index % M == K (0 <= K < M),\n"
-    "                    to split one batch over M machines\n"
+    "                    to split one batch over M machines; the table then starts\n"
+    "                    with a '# mech-manifest' line and an index column, for\n"
+    "                    mech merge\n"
+    "  --skip-existing   a file whose DIR/NAME.csv exists is not solved again\n"
+    "                    (status 'kept'; with --out-dir)\n"
+    "  --unsolvable-ok   a file that cannot be solved is a result (FAILED in the\n"
+    "                    table), not a failure: exit 0 unless a file is invalid,\n"
+    "                    unreadable or differs from its golden\n"
     "  --forces          also the force analysis, for every file\n"
     "  -q, --quiet       no progress report (a bar on a terminal, else a line every\n"
     "                    5 s) and no per-file messages, only the table\n"
@@ -52,6 +64,8 @@ typedef struct job {
     char *csv;           /* --out-dir: DIR/NAME.csv, owned */
     char *golden_path;   /* --golden: GOLDEN/NAME.csv, owned */
     int code;            /* exit status of this file */
+    int kept;            /* --skip-existing: DIR/NAME.csv was there, not solved */
+    long index;          /* position in the whole list (before --shard) */
     int steps;
     double worst_residual, us_per_step;
     const char *golden;  /* "-", "match", "DIFFER", "missing", "error" */
@@ -66,6 +80,7 @@ typedef struct batch {
     const char *out_dir, *golden_dir;
     compare_options cmp;
     int forces;
+    int skip_existing;
     cmd_progress progress;    /* files done, on standard error */
 } batch;
 
@@ -112,6 +127,12 @@ static void compare_golden(const batch *b, job *jb, const mech_table *t, const c
 /* One file, start to end; everything it says goes to jb->messages. */
 static void run_job(const batch *b, job *jb)
 {
+    struct stat there;
+    if (b->skip_existing && b->out_dir && stat(jb->csv, &there) == 0 && S_ISREG(there.st_mode)) {
+        jb->kept = 1;  /* solved by an earlier run of this batch */
+        jb->golden = "-";
+        return;
+    }
     FILE *msg = open_memstream(&jb->messages, &jb->msize);
     FILE *out = msg ? msg : stderr;
     mech_diag d;
@@ -270,16 +291,23 @@ static void batch_job(void *ctx, int i)
     cmd_progress_update(&b->progress, atomic_fetch_add(&b->done, 1) + 1, b->njobs);
 }
 
-static void print_table(const batch *b, FILE *out)
+/* The summary table; a shard's (indexed) starts with its manifest line
+ * and ends each row with its index in the whole list, for mech merge. */
+static void print_table(const batch *b, const manifest *mf, FILE *out)
 {
-    fprintf(out, "%-28s %-6s %7s %12s %12s %s\n", "file", "status", "steps", "worst res m",
-            "us/step", "golden");
+    if (mf)
+        manifest_write(mf, out);
+    fprintf(out, "%-28s %-6s %7s %12s %12s %-7s%s\n", "file", "status", "steps", "worst res m",
+            "us/step", "golden", mf ? " index" : "");
     static const char *const words[] = {"ok", "FAILED", "INPUT", "IO"};
     for (int i = 0; i < b->njobs; i++) {
         const job *jb = &b->jobs[i];
-        fprintf(out, "%-28s %-6s %7d %12.3g %12.3g %s\n", jb->name,
-                jb->code >= 0 && jb->code <= 3 ? words[jb->code] : "?", jb->steps,
+        fprintf(out, "%-28s %-6s %7d %12.3g %12.3g %s", jb->name, jb->kept ? "kept"
+                : jb->code >= 0 && jb->code <= 3 ? words[jb->code] : "?", jb->steps,
                 jb->worst_residual, jb->us_per_step, jb->golden ? jb->golden : "-");
+        if (mf)
+            fprintf(out, " %ld", jb->index);
+        fputc('\n', out);
     }
 }
 
@@ -288,6 +316,8 @@ static void print_table(const batch *b, FILE *out)
  * (the problem printed). */
 typedef struct batch_opts {
     int nthreads, quiet, shard_k, shard_m;
+    int sharded, unsolvable_ok;
+    const char *files_from;   /* --files-from LIST */
 } batch_opts;
 
 static int batch_option(batch *b, batch_opts *bo, const char *a, const char *v)
@@ -308,10 +338,23 @@ static int batch_option(batch *b, batch_opts *bo, const char *a, const char *v)
             return cmd_usage_error("batch", "a tolerance must be a number >= 0, not '%s'", v);
         *(a[2] == 'r' ? &b->cmp.rtol : &b->cmp.atol) = x;
     } else if (!strcmp(a, "--shard")) {
+        bo->sharded = 1;
         if (cmd_parse_shard(v, &bo->shard_k, &bo->shard_m) < 0)
             return cmd_usage_error("batch", "--shard needs K/M with 0 <= K < M, not '%s'", v);
+    } else if (!strcmp(a, "--files-from")) {
+        bo->files_from = v;
     }
     return -1;
+}
+
+static int takes_value(const char *a)
+{
+    static const char *const opts[] = {"-j", "--jobs", "--out-dir", "--golden", "--shard",
+                                       "--rtol", "--atol", "--files-from"};
+    for (size_t k = 0; k < sizeof opts / sizeof opts[0]; k++)
+        if (!strcmp(a, opts[k]))
+            return 1;
+    return 0;
 }
 
 static int parse_batch_args(int argc, char **argv, batch *b, batch_opts *bo, const char **files,
@@ -319,9 +362,7 @@ static int parse_batch_args(int argc, char **argv, batch *b, batch_opts *bo, con
 {
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
-        int takes = !strcmp(a, "-j") || !strcmp(a, "--jobs") || !strcmp(a, "--out-dir") ||
-                    !strcmp(a, "--golden") || !strcmp(a, "--shard") || !strcmp(a, "--rtol") ||
-                    !strcmp(a, "--atol");
+        int takes = takes_value(a);
         int code = -1;
         if (cmd_wants_help(a))
             return fputs(cmd_batch_help, stdout), MECH_EXIT_OK;
@@ -333,6 +374,10 @@ static int parse_batch_args(int argc, char **argv, batch *b, batch_opts *bo, con
             b->forces = 1;
         else if (!strcmp(a, "-q") || !strcmp(a, "--quiet"))
             bo->quiet = 1;
+        else if (!strcmp(a, "--skip-existing"))
+            b->skip_existing = 1;
+        else if (!strcmp(a, "--unsolvable-ok"))
+            bo->unsolvable_ok = 1;
         else if (a[0] == '-' && a[1])
             code = cmd_usage_error("batch", "unknown option '%s'", a);
         else
@@ -342,9 +387,87 @@ static int parse_batch_args(int argc, char **argv, batch *b, batch_opts *bo, con
         if (takes)
             i++;
     }
-    if (*nfiles == 0)
+    if (*nfiles == 0 && !bo->files_from)
         return cmd_usage_error("batch", "%s", "no files given (usage: mech batch FILE... [-j N])");
+    if (b->skip_existing && !b->out_dir)
+        return cmd_usage_error("batch", "%s", "--skip-existing needs --out-dir DIR");
     return -1;
+}
+
+/* --files-from LIST: its lines (one path each; blank lines skipped)
+ * appended to *files, which grows; the text stays in *text (owned). -1
+ * when read, else the exit status. */
+static int read_list(const char *list, char **text, const char ***files, int *nfiles)
+{
+    FILE *f = strcmp(list, "-") == 0 ? stdin : fopen(list, "r");
+    size_t size = 0;
+    FILE *mem = f ? open_memstream(text, &size) : NULL;
+    char buf[65536];
+    for (size_t n; mem && (n = fread(buf, 1, sizeof buf, f)) > 0;)
+        fwrite(buf, 1, n, mem);
+    int bad = !f || ferror(f);
+    if (f && f != stdin)
+        fclose(f);
+    if (bad || !mem) {
+        if (mem)
+            fclose(mem);
+        fprintf(stderr, "mech batch: cannot read the list %s: %s\n", list,
+                f ? "read error" : strerror(errno));
+        return MECH_EXIT_IO;
+    }
+    if (fclose(mem) != 0)
+        return fprintf(stderr, "mech batch: out of memory\n"), MECH_EXIT_IO;
+    for (char *line = *text, *nl; *line; line = nl + 1) {
+        nl = line + strcspn(line, "\n");
+        int last = *nl == '\0';
+        *nl = '\0';
+        if (*line) {
+            const char **grown = realloc(*files, (size_t)(*nfiles + 2) * sizeof *grown);
+            if (!grown)
+                return fprintf(stderr, "mech batch: out of memory\n"), MECH_EXIT_IO;
+            *files = grown;
+            (*files)[(*nfiles)++] = line;
+        }
+        if (last)
+            break;
+    }
+    if (*nfiles == 0)
+        return cmd_usage_error("batch", "no files given (the list %s is empty)", list);
+    return -1;
+}
+
+/* The manifest of a shard's table: the whole list (its paths, in order)
+ * as the input hash, the options that change a row as the arguments. */
+static manifest *make_manifest(const batch *b, const batch_opts *bo, int argc, char **argv,
+                               const char **files, int nfiles)
+{
+    manifest *mf = calloc(1, sizeof *mf);
+    if (!mf)
+        return NULL;
+    snprintf(mf->version, sizeof mf->version, "%s", MECH_VERSION);
+    snprintf(mf->command, sizeof mf->command, "batch");
+    mf->shard_k = bo->shard_k;
+    mf->shard_m = bo->shard_m;
+    mf->rows = b->njobs;
+    mf->total = nfiles;
+    mf->input = mf->grid = MANIFEST_HASH0;
+    for (int i = 0; i < nfiles; i++)
+        mf->input = manifest_hash(mf->input, files[i], strlen(files[i]) + 1);
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        int leaves_rows_alone = !strcmp(a, "-j") || !strcmp(a, "--jobs") ||
+                                !strcmp(a, "--shard") || !strcmp(a, "--files-from") ||
+                                !strcmp(a, "-q") || !strcmp(a, "--quiet") ||
+                                !strcmp(a, "--skip-existing") || !strcmp(a, "--unsolvable-ok");
+        int option = a[0] == '-' && a[1], takes = takes_value(a) && i + 1 < argc;
+        if (option && !leaves_rows_alone) {  /* a file is in the list's hash */
+            manifest_add_arg(mf, a);
+            if (takes)
+                manifest_add_arg(mf, argv[i + 1]);
+        }
+        i += takes;
+    }
+    return mf;
 }
 
 /* The jobs of every file given; their outputs checked over all of them, so
@@ -357,6 +480,7 @@ static int make_jobs(batch *b, const batch_opts *bo, const char **files, int nfi
         return fprintf(stderr, "mech batch: out of memory\n"), MECH_EXIT_IO;
     for (int i = 0; i < nfiles; i++) {
         job *jb = &b->jobs[b->njobs++];
+        jb->index = i;
         jb->path = files[i];
         base_name(files[i], jb->name, sizeof jb->name);
     }
@@ -375,8 +499,9 @@ static int make_jobs(batch *b, const batch_opts *bo, const char **files, int nfi
 /* Each job's messages, then the summary table; the worst outcome: a failed
  * solve or differing golden (1) outranks invalid input (2) and unreadable
  * files (3), then success. */
-static int report_jobs(batch *b, int quiet)
+static int report_jobs(batch *b, const batch_opts *bo, const manifest *mf)
 {
+    int quiet = bo->quiet;
     int code = MECH_EXIT_OK;
     for (int i = 0; i < b->njobs; i++) {
         job *jb = &b->jobs[i];
@@ -385,10 +510,13 @@ static int report_jobs(batch *b, int quiet)
         free(jb->messages);
         free(jb->csv);
         free(jb->golden_path);
+        int unsolved = jb->code == MECH_EXIT_SOLVE && !strcmp(jb->golden ? jb->golden : "-", "-");
+        if (unsolved && bo->unsolvable_ok)
+            continue;  /* a result: FAILED in the table */
         if (jb->code == MECH_EXIT_SOLVE || (code == MECH_EXIT_OK && jb->code != MECH_EXIT_OK))
             code = jb->code;
     }
-    print_table(b, stdout);
+    print_table(b, mf, stdout);
     return code;
 }
 
@@ -398,21 +526,29 @@ int cmd_batch(int argc, char **argv)
     memset(&b, 0, sizeof b);
     compare_options_default(&b.cmp);
     b.cmp.table = 0;
-    batch_opts bo = {cmd_default_jobs(), 0, 0, 1};
+    batch_opts bo = {cmd_default_jobs(), 0, 0, 1, 0, 0, NULL};
     const char **files = calloc((size_t)argc + 1, sizeof *files);
+    char *list = NULL;
+    manifest *mf = NULL;
     int nfiles = 0;
     if (!files)
         return fprintf(stderr, "mech batch: out of memory\n"), MECH_EXIT_IO;
     int code = parse_batch_args(argc, argv, &b, &bo, files, &nfiles);
+    if (code < 0 && bo.files_from)
+        code = read_list(bo.files_from, &list, &files, &nfiles);
     if (code < 0)
         code = make_jobs(&b, &bo, files, nfiles);
+    if (code < 0 && bo.sharded && !(mf = make_manifest(&b, &bo, argc, argv, files, nfiles)))
+        code = (fprintf(stderr, "mech batch: out of memory\n"), MECH_EXIT_IO);
     if (code < 0) {
         cmd_progress_init(&b.progress, "batch", "files", bo.quiet);
         cmd_run_parallel(b.njobs, bo.nthreads, batch_job, &b);
         cmd_progress_done(&b.progress);
-        code = report_jobs(&b, bo.quiet);
+        code = report_jobs(&b, &bo, mf);
     }
+    free(mf);
     free(b.jobs);
     free(files);
+    free(list);
     return code;
 }

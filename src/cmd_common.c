@@ -1,10 +1,12 @@
 /* src/cmd_common.c: pieces several commands share: --help, loading a
  * checked file, usage errors, --set and --from/--to/--steps (solve, plot,
- * animate), --shard, the default number of workers, and running
- * independent jobs on worker threads (mech batch, mech sweep). */
+ * animate), --shard, the default number of workers (the CPU affinity mask),
+ * and running independent jobs on worker threads (mech batch, mech sweep). */
+#define _GNU_SOURCE  /* sched_getaffinity, CPU_COUNT */
 #include <errno.h>
 #include <math.h>
 #include <pthread.h>
+#include <sched.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -200,8 +202,14 @@ int cmd_parse_shard(const char *s, int *k, int *mod)
     return 0;
 }
 
+/* The CPUs this process may run on (its affinity mask: taskset, a Slurm
+ * allocation, a container's cpuset), not all those online: more workers
+ * than that only take turns. */
 int cmd_default_jobs(void)
 {
+    cpu_set_t set;
+    if (sched_getaffinity(0, sizeof set, &set) == 0 && CPU_COUNT(&set) > 0)
+        return CPU_COUNT(&set) < 1024 ? CPU_COUNT(&set) : 1024;
     long n = sysconf(_SC_NPROCESSORS_ONLN);
     return n > 0 && n < 1024 ? (int)n : 1;
 }

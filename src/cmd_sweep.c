@@ -5,12 +5,15 @@
  * result does not depend on the workers, and --shard K/M splits the grid
  * over machines (variant index i % M == K) with the index as first column
  * for a deterministic merge (sort -n). */
+#include <errno.h>
 #include <math.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "cmd_manifest.h"
+#include "cmd_rows.h"
 #include "commands.h"
 #include "internal.h"
 #include "output.h"
@@ -18,6 +21,7 @@
 const char cmd_sweep_help[] =
     "usage: mech sweep FILE --vary NAME=FROM:TO:COUNT [--vary ...] [--list NAME=A,B,...]\n"
     "                  [--metric M ...] [-o OUT.csv] [-j N] [--shard K/M] [--forces]\n"
+    "                  [--index-offset N] [--resume] [--unsolvable-ok]\n"
     "\n"
     "Solve a grid of variants of one mechanism, changing its named parameters\n"
     "(the file's 'parameters:'), and write one summary row per variant: the\n"
@@ -41,8 +45,16 @@ const char cmd_sweep_help[] =
     "                    transmission angle of a four-bar: coupler,rocker)\n"
     "                    (default: the number of rows solved)\n"
     "  -o FILE           write the summary CSV to FILE (default: standard output)\n"
-    "  -j, --jobs N      worker threads (default: the number of processors)\n"
-    "  --shard K/M       only the variants with index % M == K\n"
+    "  -j, --jobs N      worker threads (default: the processors this process may\n"
+    "                    run on: its CPU affinity, as set by taskset or Slurm)\n"
+    "  --shard K/M       only the variants with index % M == K; the CSV then starts\n"
+    "                    with a '# mech-manifest' line, for mech merge\n"
+    "  --index-offset N  number the variants from N (a grid that continues another\n"
+    "                    in one index space for mech merge; also writes the manifest)\n"
+    "  --resume          continue OUT.partial, the rows of a run that was stopped\n"
+    "                    (rows are written there as they finish; needs -o)\n"
+    "  --unsolvable-ok   exit 0 also when no variant could be solved (they are rows\n"
+    "                    with their status); bad input and I/O still fail\n"
     "  --forces          also the force analysis (needed for driver.torque metrics)\n"
     "  -q, --quiet       no progress report (a bar on a terminal, else a line every\n"
     "                    5 s)\n"
@@ -72,7 +84,7 @@ typedef struct metric {
 } metric;
 
 typedef struct variant {
-    int index;
+    long index;              /* offset included */
     const char *status;      /* ok, no-assembly, singular, invalid, error */
     int rows;
     double value[MAX_METRICS];
@@ -82,16 +94,18 @@ typedef struct variant {
 
 typedef struct sweep_run {
     const char *file;
+    long offset;          /* --index-offset: variant i of the grid is row offset + i */
+    int shard_k, shard_m; /* --shard K/M */
     axis axes[MAX_VARY];
     int naxes;
     metric metrics[MAX_METRICS];
     int nmetrics;
     int forces;
-    variant *vars;
-    int nvars;            /* variants in this shard */
+    long nvars;           /* variants in this shard */
     int quiet;            /* -q: no progress report */
-    atomic_int done;      /* variants finished */
+    atomic_long done;     /* variants finished */
     cmd_progress progress;
+    rowfile rows;         /* the rows as they finish (src/cmd_rows.h) */
 } sweep_run;
 
 
@@ -353,9 +367,11 @@ static int check_metrics(sweep_run *r, const mech_model *m)
 
 /* ---- one variant ------------------------------------------------------ */
 
-/* The parameter texts of variant v: axis k's index is a mixed-radix digit. */
-static void variant_overrides(const sweep_run *r, int v, mech_override *ov)
+/* The parameter texts of variant v (offset included): axis k's index is a
+ * mixed-radix digit. */
+static void variant_overrides(const sweep_run *r, long v, mech_override *ov)
 {
+    v -= r->offset;
     for (int k = r->naxes - 1; k >= 0; k--) {
         const axis *a = &r->axes[k];
         ov[k].name = a->name;
@@ -423,7 +439,7 @@ static void run_variant(const sweep_run *r, variant *var)
         singular |= strstr(msgtext, "singular") != NULL;
         locking |= strstr(msgtext, "friction does not converge") != NULL;
     }
-    fprintf(out, "variant %d:", var->index);
+    fprintf(out, "variant %ld:", var->index);
     for (int k = 0; k < r->naxes; k++)
         fprintf(out, " %s=%s", ov[k].name, ov[k].text);
     fputc('\n', out);
@@ -442,13 +458,6 @@ static void run_variant(const sweep_run *r, variant *var)
     mech_model_free(&m);
     if (msg)
         fclose(msg);
-}
-
-static void sweep_job(void *ctx, int i)
-{
-    sweep_run *r = ctx;
-    run_variant(r, &r->vars[i]);
-    cmd_progress_update(&r->progress, atomic_fetch_add(&r->done, 1) + 1, r->nvars);
 }
 
 /* ---- output ------------------------------------------------------------ */
@@ -471,12 +480,13 @@ static void put_cell(FILE *f, const char *s)
     fputc('"', f);
 }
 
-/* The index into axis k of variant v (as variant_overrides). */
-static int axis_index(const sweep_run *r, int v, int k)
+/* The index into axis k of variant v (offset included, as variant_overrides). */
+static int axis_index(const sweep_run *r, long v, int k)
 {
+    v -= r->offset;
     for (int j = r->naxes - 1; j > k; j--)
         v /= r->axes[j].count;
-    return v % r->axes[k].count;
+    return (int)(v % r->axes[k].count);
 }
 
 /* The shortest "%.Ng" of x that reads back as x: 0.04, not
@@ -491,7 +501,7 @@ static const char *shortest(double x, char *buf, size_t size)
     return buf;
 }
 
-static void write_summary(const sweep_run *r, FILE *f)
+static void write_header(const sweep_run *r, FILE *f)
 {
     char cell[256];
     fprintf(f, "variant [-]");
@@ -506,33 +516,41 @@ static void write_summary(const sweep_run *r, FILE *f)
         put_cell(f, cell);
     }
     fputc('\n', f);
-    for (int i = 0; i < r->nvars; i++) {
-        const variant *v = &r->vars[i];
-        fprintf(f, "%d", v->index);
-        for (int k = 0; k < r->naxes; k++)
-            fprintf(f, ",%s", shortest(r->axes[k].si[axis_index(r, v->index, k)], cell, sizeof cell));
-        fprintf(f, ",%s,%d", v->status, v->rows);
-        for (int k = 0; k < r->nmetrics; k++)
-            fprintf(f, ",%.17g", v->value[k]);
-        fputc('\n', f);
-    }
 }
 
-static int emit_summary(FILE *f, const void *r)
+enum { ROW_SIZE = 32 * (MAX_VARY + MAX_METRICS + 4) };
+
+/* Variant v's row, with its newline, into row[ROW_SIZE]. */
+static void format_row(const sweep_run *r, const variant *v, char *row)
 {
-    write_summary(r, f);
-    return ferror(f) ? -1 : 0;
+    char cell[64];
+    size_t n = (size_t)snprintf(row, ROW_SIZE, "%ld", v->index);
+    for (int k = 0; k < r->naxes; k++)
+        n += (size_t)snprintf(row + n, ROW_SIZE - n, ",%s",
+                              shortest(r->axes[k].si[axis_index(r, v->index, k)], cell, sizeof cell));
+    n += (size_t)snprintf(row + n, ROW_SIZE - n, ",%s,%d", v->status, v->rows);
+    for (int k = 0; k < r->nmetrics; k++)
+        n += (size_t)snprintf(row + n, ROW_SIZE - n, ",%.17g", v->value[k]);
+    snprintf(row + n, ROW_SIZE - n, "\n");
 }
 
-/* Whole or not at all, as the solver's CSV (src/output.h). */
-static int write_file(const sweep_run *r, const char *path)
+/* Row i of this shard (variant offset + K + i*M) solved, its row appended
+ * to the rows file and, when it was not solved, its messages printed:
+ * nothing of a variant is kept once its row is out. */
+static void sweep_job(void *ctx, int i)
 {
-    mech_diag d;
-    mech_diag_init(&d);
-    int rc = write_file_whole(path ? path : "-", emit_summary, r, &d);
-    mech_diag_print(&d, stderr);
-    mech_diag_free(&d);
-    return rc == MECH_OK ? MECH_EXIT_OK : MECH_EXIT_IO;
+    sweep_run *r = ctx;
+    if (rows_done(&r->rows, i))
+        return;  /* resumed: in the partial file already */
+    variant v;
+    memset(&v, 0, sizeof v);
+    v.index = r->offset + r->shard_k + (long)i * r->shard_m;
+    char row[ROW_SIZE];
+    run_variant(r, &v);
+    format_row(r, &v, row);
+    rows_put(&r->rows, i, row, strcmp(v.status, "ok") != 0 ? v.messages : NULL);
+    free(v.messages);
+    cmd_progress_update(&r->progress, (int)(atomic_fetch_add(&r->done, 1) + 1), (int)r->nvars);
 }
 
 static void free_run(sweep_run *r)
@@ -543,19 +561,41 @@ static void free_run(sweep_run *r)
         free(r->axes[k].texts);
         free(r->axes[k].si);
     }
-    if (r->vars)
-        for (int i = 0; i < r->nvars; i++)
-            free(r->vars[i].messages);
-    free(r->vars);
+    rows_close(&r->rows);
 }
 
-/* The command line of mech sweep into r (and *out, *sh). -1 when fine,
- * else the exit status (the problem printed). */
+/* The command line of mech sweep into r (and so). -1 when fine, else the
+ * exit status (the problem printed). */
 typedef struct sweep_opts {
     const char *out;
     long nthreads;
-    int shard_k, shard_m;
+    int sharded;          /* --shard or --index-offset: a part of a larger run */
+    int resume, unsolvable_ok;
+    int argc;
+    char **argv;
 } sweep_opts;
+
+/* The options that take a value, and those of them that do not change the
+ * rows (left out of the manifest's arguments). */
+static int takes_value(const char *a)
+{
+    static const char *const opts[] = {"--vary", "--list", "--metric", "-o", "-j", "--jobs",
+                                       "--shard", "--index-offset"};
+    for (size_t k = 0; k < sizeof opts / sizeof opts[0]; k++)
+        if (!strcmp(a, opts[k]))
+            return 1;
+    return 0;
+}
+
+static int leaves_rows_alone(const char *a)
+{
+    static const char *const opts[] = {"-o", "-j", "--jobs", "--shard", "--index-offset", "-q",
+                                       "--quiet", "--resume", "--unsolvable-ok"};
+    for (size_t k = 0; k < sizeof opts / sizeof opts[0]; k++)
+        if (!strcmp(a, opts[k]))
+            return 1;
+    return 0;
+}
 
 static int sweep_option(sweep_run *r, sweep_opts *so, const char *a, const char *v)
 {
@@ -571,9 +611,35 @@ static int sweep_option(sweep_run *r, sweep_opts *so, const char *a, const char 
         if (*end || so->nthreads < 1 || so->nthreads > 1024)
             return cmd_usage_error("sweep", "-j needs a number of workers from 1 to 1024, not '%s'", v);
     } else if (!strcmp(a, "--shard")) {
-        if (cmd_parse_shard(v, &so->shard_k, &so->shard_m) < 0)
+        so->sharded = 1;
+        if (cmd_parse_shard(v, &r->shard_k, &r->shard_m) < 0)
             return cmd_usage_error("sweep", "--shard needs K/M with 0 <= K < M, not '%s'", v);
+    } else if (!strcmp(a, "--index-offset")) {
+        so->sharded = 1;
+        r->offset = strtol(v, &end, 10);
+        if (end == v || *end || r->offset < 0 || r->offset > 1000000000000L)
+            return cmd_usage_error("sweep", "--index-offset needs a whole number from 0 to 10^12, "
+                                   "not '%s'", v);
     }
+    return -1;
+}
+
+static int sweep_flag(sweep_run *r, sweep_opts *so, const char *a)
+{
+    if (!strcmp(a, "--forces"))
+        r->forces = 1;
+    else if (!strcmp(a, "-q") || !strcmp(a, "--quiet"))
+        r->quiet = 1;
+    else if (!strcmp(a, "--resume"))
+        so->resume = 1;
+    else if (!strcmp(a, "--unsolvable-ok"))
+        so->unsolvable_ok = 1;
+    else if (a[0] == '-' && a[1])
+        return cmd_usage_error("sweep", "unknown option '%s'", a);
+    else if (r->file)
+        return cmd_usage_error("sweep", "one file at a time ('%s' is a second file)", a);
+    else
+        r->file = a;
     return -1;
 }
 
@@ -582,25 +648,12 @@ static int parse_sweep_args(int argc, char **argv, sweep_run *r, sweep_opts *so)
     int code = -1;
     for (int i = 1; i < argc && code < 0; i++) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
-        int takes = !strcmp(a, "--vary") || !strcmp(a, "--list") || !strcmp(a, "--metric") ||
-                    !strcmp(a, "-o") || !strcmp(a, "-j") || !strcmp(a, "--jobs") ||
-                    !strcmp(a, "--shard");
+        int takes = takes_value(a);
         if (cmd_wants_help(a))
             return fputs(cmd_sweep_help, stdout), MECH_EXIT_OK;
         if (takes && !v)
             return cmd_usage_error("sweep", "option '%s' needs a value", a);
-        if (takes)
-            code = sweep_option(r, so, a, v);
-        else if (!strcmp(a, "--forces"))
-            r->forces = 1;
-        else if (!strcmp(a, "-q") || !strcmp(a, "--quiet"))
-            r->quiet = 1;
-        else if (a[0] == '-' && a[1])
-            code = cmd_usage_error("sweep", "unknown option '%s'", a);
-        else if (r->file)
-            code = cmd_usage_error("sweep", "one file at a time ('%s' is a second file)", a);
-        else
-            r->file = a;
+        code = takes ? sweep_option(r, so, a, v) : sweep_flag(r, so, a);
         if (takes)
             i++;
     }
@@ -608,6 +661,8 @@ static int parse_sweep_args(int argc, char **argv, sweep_run *r, sweep_opts *so)
         code = cmd_usage_error("sweep", "%s", "no file given (usage: mech sweep FILE --vary NAME=FROM:TO:COUNT)");
     if (code < 0 && r->naxes == 0)
         code = cmd_usage_error("sweep", "%s", "nothing to vary: give --vary NAME=FROM:TO:COUNT or --list");
+    if (code < 0 && so->resume && (!so->out || !strcmp(so->out, "-")))
+        code = cmd_usage_error("sweep", "%s", "--resume needs -o FILE (it continues FILE.partial)");
     if (code < 0)
         code = cmd_refuse_input("sweep", so->out, &r->file, 1);
     return code;
@@ -618,7 +673,7 @@ static int parse_sweep_args(int argc, char **argv, sweep_run *r, sweep_opts *so)
 static int check_base(sweep_run *r)
 {
     mech_override ov[MAX_VARY];
-    variant_overrides(r, 0, ov);
+    variant_overrides(r, r->offset, ov);
     mech_diag d;
     mech_diag_init(&d);
     mech_model *m = NULL;
@@ -630,30 +685,68 @@ static int check_base(sweep_run *r)
     return code;
 }
 
-/* This shard's variants of the grid, solved on worker threads; the rows
- * written; exit 1 when none was solved. */
+/* The manifest line of this run (src/cmd_manifest.h) and the CSV header
+ * into *head (malloc'ed); -1, or the exit status. */
+static int make_head(const sweep_run *r, const sweep_opts *so, long total, char **head)
+{
+    manifest *mf = calloc(1, sizeof *mf);
+    size_t size = 0;
+    FILE *f = mf ? open_memstream(head, &size) : NULL;
+    if (!f)
+        return free(mf), fprintf(stderr, "mech sweep: out of memory\n"), MECH_EXIT_IO;
+    snprintf(mf->version, sizeof mf->version, "%s", MECH_VERSION);
+    snprintf(mf->command, sizeof mf->command, "sweep");
+    mf->shard_k = r->shard_k;
+    mf->shard_m = r->shard_m;
+    mf->rows = r->nvars;
+    mf->total = total;
+    mf->offset = r->offset;
+    mf->input = mf->grid = MANIFEST_HASH0;
+    int code = -1;
+    if (manifest_hash_file(&mf->input, r->file) != 0)
+        code = (fprintf(stderr, "mech sweep: cannot read %s: %s\n", r->file, strerror(errno)), MECH_EXIT_IO);
+    for (int k = 0; k < r->naxes; k++) {  /* the grid: names, units and every value */
+        const axis *a = &r->axes[k];
+        mf->grid = manifest_hash(mf->grid, a->name, strlen(a->name) + 1);
+        for (int i = 0; i < a->count; i++)
+            mf->grid = manifest_hash(mf->grid, a->texts[i], strlen(a->texts[i]) + 1);
+    }
+    for (int i = 1; i < so->argc; i++)  /* the file by its contents, not its path */
+        if (leaves_rows_alone(so->argv[i]))
+            i += takes_value(so->argv[i]);
+        else if (so->argv[i] != r->file)
+            manifest_add_arg(mf, so->argv[i]);
+    manifest_write(mf, f);
+    write_header(r, f);
+    free(mf);
+    if (fclose(f) != 0 && code < 0)
+        code = (fprintf(stderr, "mech sweep: out of memory\n"), MECH_EXIT_IO);
+    return code;
+}
+
+/* This shard's variants of the grid, solved on worker threads, each row
+ * out as soon as it is known; then OUT written in index order; exit 1 when
+ * none was solved (unless --unsolvable-ok). */
 static int run_variants(sweep_run *r, const sweep_opts *so, long total)
 {
-    r->vars = calloc((size_t)total, sizeof *r->vars);
-    if (!r->vars)
-        return fprintf(stderr, "mech sweep: out of memory\n"), MECH_EXIT_IO;
-    for (long i = 0; i < total; i++)
-        if (i % so->shard_m == so->shard_k)
-            r->vars[r->nvars++].index = (int)i;
+    char *head = NULL;
+    r->nvars = manifest_shard_rows(total, r->shard_k, r->shard_m);
+    int code = make_head(r, so, total, &head);
+    if (code < 0)
+        code = rows_open(&r->rows, "sweep", so->out, so->resume, head,
+                         r->offset + r->shard_k, r->shard_m, r->nvars);
+    free(head);
+    if (code >= 0)
+        return code;
+    atomic_store(&r->done, r->rows.ndone);
     cmd_progress_init(&r->progress, "sweep", "variants", r->quiet);
-    cmd_run_parallel(r->nvars, (int)so->nthreads, sweep_job, r);
+    cmd_run_parallel((int)r->nvars, (int)so->nthreads, sweep_job, r);
     cmd_progress_done(&r->progress);
-    int nok = 0;
-    for (int i = 0; i < r->nvars; i++) {
-        if (strcmp(r->vars[i].status, "ok") == 0)
-            nok++;
-        else if (r->vars[i].messages)
-            fputs(r->vars[i].messages, stderr);
-    }
-    int code = write_file(r, so->out);
+    long nok = 0;
+    code = rows_finish(&r->rows, so->out, so->sharded, 1 + r->naxes, &nok);
     if (code == MECH_EXIT_OK && r->nvars > 0 && nok == 0) {
-        fprintf(stderr, "mech sweep: none of the %d variants could be solved\n", r->nvars);
-        code = MECH_EXIT_SOLVE;
+        fprintf(stderr, "mech sweep: none of the %ld variants could be solved\n", r->nvars);
+        code = so->unsolvable_ok ? MECH_EXIT_OK : MECH_EXIT_SOLVE;
     }
     return code;
 }
@@ -662,7 +755,8 @@ int cmd_sweep(int argc, char **argv)
 {
     sweep_run r;
     memset(&r, 0, sizeof r);
-    sweep_opts so = {NULL, cmd_default_jobs(), 0, 1};
+    r.shard_m = 1;
+    sweep_opts so = {NULL, cmd_default_jobs(), 0, 0, 0, argc, argv};
     int code = parse_sweep_args(argc, argv, &r, &so);
     long total = 1;
     for (int k = 0; code < 0 && k < r.naxes; k++)

@@ -44,7 +44,7 @@ int cmd_refuse_input(const char *command, const char *out, const char *const *in
 int cmd_make_dir(const char *dir);
 /* "K/M" with 0 <= K < M: 0, or -1 when malformed. */
 int cmd_parse_shard(const char *s, int *k, int *mod);
-int cmd_default_jobs(void);  /* processors online */
+int cmd_default_jobs(void);  /* the CPUs of the affinity mask (else those online) */
 /* job(ctx, i) for i = 0 .. njobs-1 on up to nthreads threads (each i once). */
 void cmd_run_parallel(int njobs, int nthreads, void (*job)(void *ctx, int i), void *ctx);
 
@@ -91,6 +91,9 @@ extern const char cmd_report_help[];
 int cmd_report(int argc, char **argv);
 extern const char cmd_codegen_help[];
 int cmd_codegen(int argc, char **argv);
+/* `mech merge -o OUT SHARD...` (cmd_merge.c): shards of a sweep or batch. */
+extern const char cmd_merge_help[];
+int cmd_merge(int argc, char **argv);
 
 /* `mech compare [options] OUT.csv GOLDEN.csv` (cmd_compare.c): argv[0] is
  * "compare"; returns the exit code. */

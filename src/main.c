@@ -28,6 +28,8 @@ static const command commands[] = {
      cmd_batch_help},
     {"sweep", cmd_sweep, "solve a grid of variants of one mechanism, one summary row each",
      cmd_sweep_help},
+    {"merge", cmd_merge, "join the shards of a sweep or batch, checking their manifests",
+     cmd_merge_help},
     {"plot", cmd_plot, "draw SVG figures of the sweep (docs/plots.md)", cmd_plot_help},
     {"animate", cmd_animate, "write an animated SVG of the mechanism", cmd_animate_help},
     {"report", cmd_report, "write one self-contained HTML page of the mechanism (docs/report.md)",

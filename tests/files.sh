@@ -96,6 +96,7 @@ if run "animate -o $null" 0 "$MECH" animate $fb --frames 10 -o "$null"; then
 fi
 if run "sweep -o $null" 0 "$MECH" sweep $sc --list l=140mm -o "$null"; then
     [ -c "$null" ] && pass || fail "sweep -o $null: no longer a character device"
+    [ ! -e "$null.partial" ] && pass || fail "sweep -o $null: made $null.partial"
 fi
 
 # a directory is refused, exit 3, with a message
@@ -106,7 +107,16 @@ if run "solve -o DIRECTORY" 3 "$MECH" solve $fb -o "$tmp/adir"; then
 fi
 if run "sweep -o DIRECTORY" 3 "$MECH" sweep $sc --list l=140mm -o "$tmp/adir"; then
     has_line "$tmp/err" 'a directory' "sweep -o DIRECTORY: message"
+    [ ! -e "$tmp/adir.partial" ] && pass || fail "sweep -o DIRECTORY: left adir.partial"
 fi
+run "sweep --resume -o DIRECTORY" 2 "$MECH" sweep $sc --list l=140mm --resume -o "$tmp/adir" && pass
+
+# sweep -o OUT: OUT.partial is never a link followed (planted, it is refused)
+ln -s victim "$d/p.csv.partial"
+echo victim >"$d/victim"
+run "sweep, OUT.partial a planted link" 2 "$MECH" sweep $sc --list l=140mm -o "$d/p.csv" && pass
+run "sweep --resume, OUT.partial a planted link" 3 "$MECH" sweep $sc --list l=140mm --resume -o "$d/p.csv" && pass
+[ "$(cat "$d/victim")" = victim ] && pass || fail "sweep: the target of a planted OUT.partial link was written"
 
 # a socket, when python3 can make one
 if command -v python3 >/dev/null 2>&1 &&

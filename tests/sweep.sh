@@ -51,24 +51,155 @@ for v in 0 $((total / 3)) $((total * 2 / 3 + 7)) $((total - 1)); do
     fi
 done
 
-# the distributed recipe with local workers: M shards as separate processes
+# the distributed recipe with local workers: M shards as separate
+# processes, joined by mech merge (which checks their manifests)
 m=3
 sub="--vary l1=50mm:64mm:6 --vary l2=420mm:440mm:5"
 "$MECH" sweep $file $sub $metrics -j 1 -o "$tmp/ref.csv" 2>/dev/null
+head -n 1 "$tmp/ref.csv" | grep -q '^variant ' && pass || fail "an unsharded sweep starts with a manifest"
 seq 0 $((m - 1)) | xargs -P $m -I K "$MECH" sweep $file $sub $metrics -j 1 --shard K/$m \
     -o "$tmp/shard.K.csv" 2>/dev/null
-{ head -n 1 "$tmp/shard.0.csv"; tail -q -n +2 "$tmp"/shard.*.csv | sort -t, -k1,1n; } >"$tmp/merged.csv"
-cmp -s "$tmp/merged.csv" "$tmp/ref.csv" && pass || fail "xargs -P $m shards merged differ from the single run"
+has_line "$tmp/shard.1.csv" '^# mech-manifest version=[0-9.]* command=sweep shard=1/3 rows=10 total=30 offset=0 ' "the manifest of shard 1/3"
+if run "mech merge" 0 "$MECH" merge -o "$tmp/merged.csv" "$tmp"/shard.*.csv; then
+    cmp -s "$tmp/merged.csv" "$tmp/ref.csv" && pass || fail "xargs -P $m shards merged differ from the single run"
+fi
 if command -v parallel >/dev/null 2>&1; then
     seq 0 $((m - 1)) | parallel -j $m "$MECH sweep $file $sub $metrics -j 1 --shard {}/$m -o $tmp/par.{}.csv" 2>/dev/null
-    { head -n 1 "$tmp/par.0.csv"; tail -q -n +2 "$tmp"/par.*.csv | sort -t, -k1,1n; } >"$tmp/pmerged.csv"
+    "$MECH" merge -o "$tmp/pmerged.csv" "$tmp"/par.*.csv
     cmp -s "$tmp/pmerged.csv" "$tmp/ref.csv" && pass || fail "GNU Parallel shards merged differ from the single run"
 fi
+
+# merge refuses what is not one whole run, names the shard, writes nothing
+merge_refused() {  # LABEL PATTERN SHARD...
+    label=$1 pattern=$2
+    shift 2
+    if run "$label" 2 "$MECH" merge -o "$tmp/bad.csv" "$@"; then
+        has_line "$tmp/err" "$pattern" "merge, $label"
+        [ ! -e "$tmp/bad.csv" ] && pass || fail "merge, $label: a file was written"
+    fi
+}
+merge_refused "a shard missing" '^mech merge: shard 1/3 missing$' "$tmp/shard.0.csv" "$tmp/shard.2.csv"
+merge_refused "a shard twice" '^mech merge: shard 2/3 given twice' "$tmp"/shard.*.csv "$tmp/shard.2.csv"
+head -n 5 "$tmp/shard.1.csv" >"$tmp/cut.csv"
+merge_refused "a shard cut off" 'shard 1/3 (.*cut.csv): 3 rows, its manifest says 10' "$tmp/shard.0.csv" "$tmp/cut.csv" "$tmp/shard.2.csv"
+"$MECH" sweep $file --vary l1=50mm:64mm:6 --vary l2=420mm:440mm:6 $metrics -j 1 --shard 1/3 -o "$tmp/grid.csv" 2>/dev/null
+merge_refused "another grid" 'shard 1/3 (.*grid.csv) is not from the same run as shard 0/3 (.*): its grid differs' "$tmp/shard.0.csv" "$tmp/grid.csv" "$tmp/shard.2.csv"
+"$MECH" sweep $file $sub $metrics -j 1 --shard 1/4 -o "$tmp/m4.csv" 2>/dev/null
+merge_refused "another M" 'splits the run in 4 shards' "$tmp/shard.0.csv" "$tmp/m4.csv" "$tmp/shard.2.csv"
+sed 's/^4,/7,/' "$tmp/shard.1.csv" >"$tmp/dup.csv"
+merge_refused "an index twice" 'row 3 (index 7) is also in another shard' "$tmp/shard.0.csv" "$tmp/dup.csv" "$tmp/shard.2.csv"
+sed '2s/E.x/E.y/' "$tmp/shard.1.csv" >"$tmp/head.csv"
+merge_refused "another header" 'its header differs' "$tmp/shard.0.csv" "$tmp/head.csv" "$tmp/shard.2.csv"
+merge_refused "no manifest" "ref.csv: no '# mech-manifest' line" "$tmp/ref.csv"
+cp $file "$tmp/conv.yaml"
+sed -i 's/^# .*//' "$tmp/conv.yaml"
+"$MECH" sweep "$tmp/conv.yaml" $sub $metrics -j 1 --shard 1/3 -o "$tmp/other-input.csv" 2>/dev/null
+merge_refused "another input file" 'its input file (its contents) differs' "$tmp/shard.0.csv" "$tmp/other-input.csv" "$tmp/shard.2.csv"
+
+# one index space over two grids: --index-offset, merged with the grid
+# that covers both (l2 split 420..430 and 435..440)
+"$MECH" sweep $file --vary l1=50mm:64mm:6 --list l2=420mm,425mm,430mm $metrics -j 1 --shard 0/1 -o "$tmp/g1.csv" 2>/dev/null
+"$MECH" sweep $file --vary l1=50mm:64mm:6 --list l2=435mm,440mm $metrics -j 1 --index-offset 18 -o "$tmp/g2.csv" 2>/dev/null
+if run "merge of two grids" 0 "$MECH" merge -o "$tmp/g.csv" "$tmp/g1.csv" "$tmp/g2.csv"; then
+    [ "$(wc -l <"$tmp/g.csv")" -eq 31 ] && pass || fail "merge of two grids: $(wc -l <"$tmp/g.csv") lines"
+    # the same variants as the one grid, under their new numbers
+    cut -d, -f2- "$tmp/g.csv" | sort >"$tmp/g.rows"
+    cut -d, -f2- "$tmp/ref.csv" | sort >"$tmp/ref.rows"
+    cmp -s "$tmp/g.rows" "$tmp/ref.rows" && pass || fail "merge of two grids: other rows than the one grid"
+fi
+"$MECH" sweep $file --vary l1=50mm:64mm:6 --list l2=435mm,440mm $metrics -j 1 --index-offset 20 -o "$tmp/g3.csv" 2>/dev/null
+merge_refused "a gap in the index space" 'indices 18..19 are in no shard' "$tmp/g1.csv" "$tmp/g3.csv"
+
+# rows as they finish: a killed sweep leaves OUT.partial, --resume ends it
+big="--vary l1=50mm:64mm:30 --vary l2=420mm:440mm:30"
+"$MECH" sweep $file $big $metrics -q -o "$tmp/whole.csv" 2>/dev/null
+# (a progress line per variant: each says a count of rows already on disk)
+MECH_PROGRESS_SECONDS=0 "$MECH" sweep $file $big $metrics -o "$tmp/res.csv" 2>"$tmp/progress" &
+pid=$!
+sleep 0.5
+kill -KILL $pid 2>/dev/null
+wait $pid 2>/dev/null
+if [ -f "$tmp/res.csv.partial" ]; then
+    done=$(($(wc -l <"$tmp/res.csv.partial") - 2))
+    said=$(sed -n 's/^mech sweep: \([0-9]*\) of .*/\1/p' "$tmp/progress" | sort -n | tail -n 1)
+    [ "$done" -gt 0 ] && [ "$done" -ge "${said:-1}" ] && pass ||
+        fail "a killed sweep kept $done rows, its progress said ${said:-nothing} were done"
+    run "sweep over a partial file without --resume" 2 "$MECH" sweep $file $big $metrics -q -o "$tmp/res.csv" &&
+        has_line "$tmp/err" 'res.csv.partial exists' "sweep over a partial file: message"
+    run "sweep --resume with another grid" 2 "$MECH" sweep $file --vary l1=50mm:64mm:31 --vary l2=420mm:440mm:30 $metrics -q \
+        --resume -o "$tmp/res.csv" && has_line "$tmp/err" 'is not a part of this run' "sweep --resume, another grid: message"
+    printf '5,0.05' >>"$tmp/res.csv.partial"  # a row cut by the kill
+    if run "sweep --resume" 0 "$MECH" sweep $file $big $metrics -q --resume -o "$tmp/res.csv"; then
+        cmp -s "$tmp/res.csv" "$tmp/whole.csv" && pass || fail "sweep --resume: differs from the run never stopped"
+        [ ! -e "$tmp/res.csv.partial" ] && pass || fail "sweep --resume: the partial file stays"
+    fi
+else
+    echo "sweep.sh: the sweep finished within 0.5 s, the kill test skipped"
+fi
+
+# --unsolvable-ok: no variant solvable is a result (exit 0), not an error
+sc=mechanisms/slider-crank.yaml
+run "sweep, nothing solvable" 1 "$MECH" sweep $sc --list r=150mm,160mm -q && pass
+if run "sweep --unsolvable-ok" 0 "$MECH" sweep $sc --list r=150mm,160mm -q --unsolvable-ok; then
+    [ "$(grep -c ',no-assembly,' "$tmp/out")" -eq 2 ] && pass || fail "sweep --unsolvable-ok: rows $(cat "$tmp/out")"
+fi
+run "sweep --unsolvable-ok, bad input" 2 "$MECH" sweep $sc --list nosuch=1mm -q --unsolvable-ok && pass
+
 # batch shards: every file in exactly one shard, same CSVs as one batch
 mkdir "$tmp/b1" "$tmp/b2"
 "$MECH" batch -q --out-dir "$tmp/b1" mechanisms/*.yaml >/dev/null 2>&1
 seq 0 $((m - 1)) | xargs -P $m -I K "$MECH" batch -q -j 1 --shard K/$m --out-dir "$tmp/b2" \
     mechanisms/*.yaml >/dev/null 2>&1
 diff -r "$tmp/b1" "$tmp/b2" >/dev/null && pass || fail "batch shards differ from one batch"
+
+# batch --files-from: a frozen list (a file or standard input), sharded,
+# each shard's table with its manifest, merged and checked against the CSVs
+ls mechanisms/*.yaml >"$tmp/list"
+"$MECH" batch -q -j 1 --files-from "$tmp/list" >"$tmp/sum.txt" 2>/dev/null
+"$MECH" batch -q -j 1 mechanisms/*.yaml >"$tmp/sum-args.txt" 2>/dev/null
+# the table less its timing column (us/step)
+untimed() { awk '{ $5 = ""; print }' "$1"; }
+[ "$(untimed "$tmp/sum.txt")" = "$(untimed "$tmp/sum-args.txt")" ] && pass || fail "batch --files-from: another table than the same files as arguments"
+for k in 0 1 2; do
+    "$MECH" batch -q -j 1 --shard $k/3 --out-dir "$tmp/b3" --files-from - <"$tmp/list" >"$tmp/bsum.$k.txt" 2>/dev/null
+done
+has_line "$tmp/bsum.1.txt" '^# mech-manifest version=[0-9.]* command=batch shard=1/3 rows=3 total=10 ' "batch shard: manifest"
+has_line "$tmp/bsum.1.txt" "^double-crank  *ok .* 1\$" "batch shard: rows with their index"
+if run "merge batch summaries" 0 "$MECH" merge -o "$tmp/bmerged.txt" "$tmp"/bsum.*.txt; then
+    [ "$(untimed "$tmp/bmerged.txt")" = "$(untimed "$tmp/sum.txt")" ] && pass || fail "merged batch summaries differ from one batch's table"
+fi
+merge_refused "a batch shard missing" '^mech merge: shard 1/3 missing$' "$tmp/bsum.0.txt" "$tmp/bsum.2.txt"
+mv "$tmp/b3/jansen.csv" "$tmp/jansen.csv"
+merge_refused "a batch CSV missing" 'index 3 (jansen) is ok in its summary, but .*b3/jansen.csv cannot be read' "$tmp"/bsum.*.txt
+head -n 5 "$tmp/jansen.csv" >"$tmp/b3/jansen.csv"
+merge_refused "a batch CSV cut off" 'index 3 (jansen): .*b3/jansen.csv has 4 rows, its summary says' "$tmp"/bsum.*.txt
+ls tests/solve/*.yaml | head -n 3 >"$tmp/list2"
+"$MECH" batch -q -j 1 --shard 1/3 --out-dir "$tmp/b3" --files-from "$tmp/list2" >"$tmp/sum2.txt" 2>/dev/null
+merge_refused "summaries of two lists" 'shard 1/3 (.*sum2.txt) is not from the same run as shard 0/3 .*: its input file (its contents) differs' "$tmp/bsum.0.txt" "$tmp/sum2.txt" "$tmp/bsum.2.txt"
+mkdir -p "$tmp/a" "$tmp/b"; cp mechanisms/fourbar.yaml "$tmp/a/m.yaml"
+cp mechanisms/slider-crank.yaml "$tmp/b/m.yaml"
+printf '%s\n%s\n' "$tmp/a/m.yaml" "$tmp/b/m.yaml" >"$tmp/dups"
+if run "batch --files-from, same names" 2 "$MECH" batch -q --shard 0/2 --out-dir "$tmp/bd" --files-from "$tmp/dups"; then
+    has_line "$tmp/err" 'a/m.yaml and .*b/m.yaml would both be written to' "batch --files-from, same names: message"
+    [ ! -e "$tmp/bd/m.csv" ] && pass || fail "batch --files-from, same names: a CSV was written"
+fi
+: >"$tmp/empty"
+run "batch --files-from an empty list" 2 "$MECH" batch -q --files-from "$tmp/empty" && pass
+run "batch --files-from a missing list" 3 "$MECH" batch -q --files-from "$tmp/nosuch" && has_line "$tmp/err" 'cannot read the list' "batch --files-from missing: message"
+
+# batch --skip-existing: a CSV already there is kept (not solved, not written)
+echo marker >"$tmp/b3/jansen.csv"
+if run "batch --skip-existing" 0 "$MECH" batch -j 1 --shard 0/3 --out-dir "$tmp/b3" --files-from "$tmp/list" --skip-existing; then
+    has_line "$tmp/out" "^jansen  *kept .* 3\$" "batch --skip-existing: status kept"
+    [ "$(cat "$tmp/b3/jansen.csv")" = marker ] && pass || fail "batch --skip-existing: the existing CSV was rewritten"
+fi
+run "batch --skip-existing without --out-dir" 2 "$MECH" batch --skip-existing mechanisms/fourbar.yaml && pass
+
+# batch --unsolvable-ok: a mechanism that cannot be solved is a result
+run "batch, an unsolvable file" 1 "$MECH" batch -q mechanisms/fourbar.yaml tests/solve/non-grashof.yaml && pass
+if run "batch --unsolvable-ok" 0 "$MECH" batch -q --unsolvable-ok mechanisms/fourbar.yaml tests/solve/non-grashof.yaml; then
+    has_line "$tmp/out" '^non-grashof  *FAILED' "batch --unsolvable-ok: the row"
+fi
+run "batch --unsolvable-ok, an invalid file" 2 "$MECH" batch -q --unsolvable-ok tests/solve/non-grashof.yaml tests/bad/01-bad-indentation.yaml && pass
 
 summary

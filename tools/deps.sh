@@ -2,7 +2,8 @@
 # tools/deps.sh: install the Debian packages libmech needs, only those missing.
 # Runs apt-get as root, or through sudo when not root.
 set -e
-PKGS="make gcc libc6-dev pkg-config libyaml-dev libsuitesparse-dev libcriterion-dev python3-dev python3-numpy python3-pytest"
+# Extra packages may be named as arguments (make test-slurm: slurm-wlm munge).
+PKGS="make gcc libc6-dev pkg-config libyaml-dev libsuitesparse-dev libcriterion-dev python3-dev python3-numpy python3-pytest parallel $*"
 missing=""
 for p in $PKGS; do
     if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then

@@ -1,0 +1,58 @@
+#!/bin/sh
+# tests/parallel/recipes.sh: the GNU Parallel recipes of docs/batch.md, run
+# as written (taken from the file) on the local host (-S :): the merged
+# sweep equals the unsharded run; a shard killed while it runs makes the
+# recipe fail and `mech merge` name it; the repair recipe (parallel
+# --resume-failed) reruns just that shard, which continues its partial file,
+# and the merge then equals the unsharded run; the batch recipe's merged
+# table equals one batch's. Skipped (exit 0, said) without `parallel`.
+# Run from the repository root:  MECH=build/mech sh tests/parallel/recipes.sh
+NAME=parallel . tests/lib.sh
+. tests/recipe.sh
+
+if ! command -v parallel >/dev/null 2>&1; then
+    echo "parallel: GNU Parallel is not installed (Debian package parallel); skipped"
+    exit 0
+fi
+scratch
+cd "$work" || exit 2
+build/mech sweep mechanisms/conveyor.yaml --vary l1=50mm:64mm:100 --vary l2=420mm:440mm:20 \
+    --metric range:E.x -q -o "$tmp/ref.csv" || fail "the unsharded sweep"
+
+# the sweep recipe with one shard killed while it runs
+recipe parallel-sweep >"$tmp/sweep.sh"
+[ -s "$tmp/sweep.sh" ] && pass || fail "no recipe parallel-sweep in docs/batch.md"
+sh "$tmp/sweep.sh" >"$tmp/out" 2>"$tmp/err" &
+pid=$!
+k=$(running_shard 8 60)
+victim=$(shard_pid "--shard $k/8 ") && kill -TERM "$victim"
+wait $pid
+status=$?
+if [ -n "$victim" ]; then
+    [ "$status" -ne 0 ] && pass || fail "the recipe with shard $k killed exits 0"
+    has_line "$tmp/err" "^mech merge: shard $k/8 missing" "merge after shard $k was killed"
+    [ ! -e out/sweep.csv ] && pass || fail "merge wrote out/sweep.csv with shard $k missing"
+    [ -f "out/sweep.$k.csv.partial" ] && pass || fail "the killed shard left no partial file"
+else
+    fail "no shard was seen running to kill it"
+fi
+
+recipe parallel-sweep-repair >"$tmp/repair.sh"
+if run "the repair recipe" 0 sh "$tmp/repair.sh"; then
+    cmp -s out/sweep.csv "$tmp/ref.csv" && pass || fail "the repaired merge differs from the unsharded run"
+    [ ! -e "out/sweep.$k.csv.partial" ] && pass || fail "the repaired shard's partial file stays"
+fi
+# the log shows the killed shard run twice, the others once
+runs=$(awk -F'\t' 'NR > 1 { n[$NF]++ } END { for (c in n) print n[c] }' out/sweep.joblog | sort | uniq -c | tr -s ' ' | sed 's/^ //')
+[ "$runs" = "$(printf '7 1\n1 2')" ] && pass || fail "parallel --resume-failed: runs per shard $runs"
+
+# the batch recipe
+recipe parallel-batch >"$tmp/batch.sh"
+if run "the batch recipe" 0 sh "$tmp/batch.sh"; then
+    build/mech batch -q --files-from out/files.txt >"$tmp/one.txt" 2>/dev/null
+    [ "$(untimed out/summary.txt)" = "$(untimed "$tmp/one.txt")" ] && pass ||
+        fail "the merged batch table differs from one batch's"
+    [ "$(ls out/csv | wc -l)" -eq "$(wc -l <out/files.txt)" ] && pass || fail "the batch recipe: CSVs missing"
+fi
+cd "$repo" || exit 2
+summary

@@ -1,0 +1,52 @@
+# tests/recipe.sh: what the recipe tests (tests/parallel, tests/slurm) share,
+# sourced after tests/lib.sh. recipe NAME prints the fenced block that
+# follows "<!-- recipe NAME -->" in docs/batch.md, so the tests run the
+# recipes exactly as the documentation writes them. scratch makes $work, a
+# directory holding build/ (the directory of $MECH) and mechanisms/, the
+# recipes' working directory. kill_shard K_PATTERN kills the mech process of
+# this test whose arguments match (found by its working directory: never
+# another user's process).
+repo=$(pwd)
+recipe() {
+    awk -v want="<!-- recipe $1 -->" '
+        $0 == want { found = 1; next }
+        found && /^```/ { if (inside) exit; inside = 1; next }
+        inside { print }' "$repo/docs/batch.md"
+}
+
+scratch() {
+    work=$tmp/work
+    mkdir -p "$work"
+    ln -s "$(cd "$(dirname "$MECH")" && pwd)" "$work/build"
+    ln -s "$repo/mechanisms" "$work/mechanisms"
+}
+
+# The pid of the mech process running in $work whose command line has $1.
+shard_pid() {
+    for p in $(pgrep -f -- "$1"); do
+        [ "$(cat /proc/$p/comm 2>/dev/null)" = mech ] || continue
+        [ "$(readlink /proc/$p/cwd 2>/dev/null)" = "$(cd "$work" && pwd -P)" ] && echo "$p" && return 0
+    done
+    return 1
+}
+
+# The first shard K of M whose out/sweep.K.csv.partial holds rows: waits up
+# to $2 seconds; prints K, or nothing.
+running_shard() {
+    m=$1 limit=$2 waited=0
+    while [ "$waited" -lt $((limit * 20)) ]; do
+        for k in $(seq 0 $((m - 1))); do
+            f=$work/out/sweep.$k.csv.partial
+            if [ -f "$f" ] && [ "$(wc -l <"$f")" -ge 4 ]; then
+                echo "$k"
+                return 0
+            fi
+        done
+        sleep 0.05
+        waited=$((waited + 1))
+    done
+    return 1
+}
+
+# the table less its timing column (us/step)
+untimed() { awk '{ $5 = ""; print }' "$1"; }

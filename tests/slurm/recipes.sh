@@ -1,0 +1,124 @@
+#!/bin/sh
+# tests/slurm/recipes.sh: the Slurm recipes of docs/batch.md, run as written
+# (taken from the file) against a real single-node Slurm on localhost:
+# munged with its own key and socket, slurmctld and slurmd with a generated
+# slurm.conf, all in a temporary directory, stopped (by their pids) and
+# removed at the end. The sweep array's task 3 is cancelled (scancel) while
+# it runs: the submission fails and `mech merge` says "shard 3/8 missing";
+# the repair recipe (sbatch --array=3) reruns just that task, which
+# continues its partial file, and the merge equals the unsharded run. The
+# batch array's merged table equals one batch's. Needs root and the Debian
+# packages slurm-wlm and munge.
+# Run from the repository root:  MECH=build/mech sh tests/slurm/recipes.sh
+NAME=slurm . tests/lib.sh
+. tests/recipe.sh
+
+for c in munged slurmctld slurmd sbatch scancel squeue sinfo scontrol; do
+    if ! command -v $c >/dev/null 2>&1; then
+        echo "slurm: $c not found (Debian packages slurm-wlm and munge)" >&2
+        exit 2
+    fi
+done
+
+# ---- a single-node Slurm in $sl -------------------------------------------
+sl=$tmp/slurm
+mkdir -p "$sl/state" "$sl/spool" "$sl/log"
+port=$((17000 + ($$ % 400) * 2))  # two ports of our own: other tests may run a Slurm
+stop_slurm() {
+    [ -n "$SLURM_CONF" ] && scontrol shutdown >/dev/null 2>&1
+    for f in slurmd slurmctld munged; do  # by pid, in case shutdown did not reach them
+        p=$(cat "$sl/$f.pid" 2>/dev/null)
+        [ -n "$p" ] && kill "$p" 2>/dev/null
+    done
+    sleep 1
+    rm -rf "$tmp"
+}
+trap stop_slurm EXIT
+head -c 1024 /dev/urandom >"$sl/munge.key"
+chmod 600 "$sl/munge.key"
+munged -f --socket="$sl/munge.sock" --key-file="$sl/munge.key" --log-file="$sl/log/munged.log" \
+    --pid-file="$sl/munged.pid" --seed-file="$sl/munged.seed" || { echo "slurm: munged did not start" >&2; exit 2; }
+cat >"$sl/slurm.conf" <<CONF
+ClusterName=mechtest
+SlurmctldHost=localhost(127.0.0.1)
+SlurmctldPort=$port
+SlurmdPort=$((port + 1))
+SlurmUser=root
+SlurmdUser=root
+AuthType=auth/munge
+AuthInfo=socket=$sl/munge.sock
+CredType=cred/munge
+StateSaveLocation=$sl/state
+SlurmdSpoolDir=$sl/spool
+SlurmctldPidFile=$sl/slurmctld.pid
+SlurmdPidFile=$sl/slurmd.pid
+SlurmctldLogFile=$sl/log/slurmctld.log
+SlurmdLogFile=$sl/log/slurmd.log
+ProctrackType=proctrack/linuxproc
+TaskPlugin=task/affinity
+JobAcctGatherType=jobacct_gather/none
+AccountingStorageType=accounting_storage/none
+JobCompType=jobcomp/none
+SelectType=select/cons_tres
+SelectTypeParameters=CR_CPU
+ReturnToService=2
+MpiDefault=none
+NodeName=mechnode NodeAddr=127.0.0.1 NodeHostname=localhost CPUs=$(nproc) State=UNKNOWN
+PartitionName=mech Nodes=mechnode Default=YES MaxTime=INFINITE State=UP
+CONF
+export SLURM_CONF=$sl/slurm.conf
+slurmctld -f "$SLURM_CONF" -i || { echo "slurm: slurmctld did not start" >&2; exit 2; }
+slurmd -f "$SLURM_CONF" -N mechnode || { echo "slurm: slurmd did not start" >&2; exit 2; }
+for i in $(seq 60); do
+    [ "$(sinfo -h -o %t 2>/dev/null)" = idle ] && break
+    sleep 0.5
+done
+[ "$(sinfo -h -o %t 2>/dev/null)" = idle ] && pass ||
+    { fail "the node is not idle: $(sinfo 2>&1; tail -n 5 "$sl/log/slurmctld.log")"; exit 1; }
+
+# ---- the sweep array, task 3 cancelled, repaired ----------------------------
+scratch
+cd "$work" || exit 2
+build/mech sweep mechanisms/conveyor.yaml --vary l1=50mm:64mm:100 --vary l2=420mm:440mm:20 \
+    --metric range:E.x -q -o "$tmp/ref.csv" || fail "the unsharded sweep"
+recipe slurm-sweep.sbatch >sweep.sbatch
+recipe slurm-sweep >"$tmp/sweep.sh"
+[ -s sweep.sbatch ] && [ -s "$tmp/sweep.sh" ] && pass || fail "no Slurm sweep recipe in docs/batch.md"
+sh "$tmp/sweep.sh" >"$tmp/out" 2>"$tmp/err" &
+pid=$!
+cancelled=
+for i in $(seq 1200); do  # until task 3 has written rows (up to 60 s)
+    if [ -f out/sweep.3.csv.partial ] && [ "$(wc -l <out/sweep.3.csv.partial)" -ge 4 ]; then
+        job=$(squeue -h -n mech-sweep -o %F | head -n 1)
+        scancel "${job}_3" && cancelled=1
+        break
+    fi
+    [ -f out/sweep.3.csv ] && break
+    sleep 0.05
+done
+wait $pid
+status=$?
+if [ -n "$cancelled" ]; then
+    [ "$status" -ne 0 ] && pass || fail "the submission with task 3 cancelled exits 0"
+    has_line "$tmp/err" '^mech merge: shard 3/8 missing' "merge after task 3 was cancelled"
+    [ ! -e out/sweep.csv ] && pass || fail "merge wrote out/sweep.csv with shard 3 missing"
+else
+    fail "task 3 was not seen running, so not cancelled (status $status: $(head -n 3 "$tmp/err"))"
+fi
+recipe slurm-sweep-repair >"$tmp/repair.sh"
+if run "the repair recipe (sbatch --array=3)" 0 sh "$tmp/repair.sh"; then
+    cmp -s out/sweep.csv "$tmp/ref.csv" && pass || fail "the repaired merge differs from the unsharded run"
+fi
+# each task used one worker: Slurm's allocation, through the affinity mask
+grep -q . out/sweep.0.log 2>/dev/null && fail "task 0 said: $(head -n 2 out/sweep.0.log)" || pass
+
+# ---- the batch array ----------------------------------------------------------
+recipe slurm-batch.sbatch >batch.sbatch
+recipe slurm-batch >"$tmp/batch.sh"
+if run "the Slurm batch recipe" 0 sh "$tmp/batch.sh"; then
+    build/mech batch -q --files-from out/files.txt >"$tmp/one.txt" 2>/dev/null
+    [ "$(untimed out/summary.txt)" = "$(untimed "$tmp/one.txt")" ] && pass ||
+        fail "the merged batch table differs from one batch's"
+fi
+cd "$repo" || exit 2
+summary
