@@ -141,9 +141,11 @@ done:
 /* ---- one dense block, k x k column major ----------------------------- */
 
 /* LU with partial pivoting in place: P a = L U, unit L below the diagonal.
- * Returns the local column of a zero pivot, or -1. */
+ * Returns the local column of a zero pivot, or -1. A zero multiplier's
+ * update (x - 0 t) is skipped: the same values, but for the sign of a zero. */
 static int block_factor_general(double *a, int k, int *piv, int *swaps)
 {
+    int rows[BLOCKLU_MAX_BLOCK];
     for (int j = 0; j < k; j++) {
         int p = j;
         for (int i = j + 1; i < k; i++)
@@ -161,13 +163,17 @@ static int block_factor_general(double *a, int k, int *piv, int *swaps)
             }
         }
         double inv = 1.0 / a[j + j * k];
+        int nl = 0;  /* the rows with a nonzero multiplier: force blocks are sparse */
         for (int i = j + 1; i < k; i++)
-            a[i + j * k] *= inv;
-        for (int c = j + 1; c < k; c++) {
+            if (a[i + j * k] != 0.0) {
+                a[i + j * k] *= inv;
+                rows[nl++] = i;
+            }
+        for (int c = j + 1; c < k && nl > 0; c++) {
             double t = a[j + c * k];
             if (t != 0.0)
-                for (int i = j + 1; i < k; i++)
-                    a[i + c * k] -= a[i + j * k] * t;
+                for (int q = 0; q < nl; q++)
+                    a[rows[q] + c * k] -= a[rows[q] + j * k] * t;
         }
     }
     return -1;
