@@ -134,6 +134,23 @@ static int fuse_sincos(tape *t)
     return 0;
 }
 
+/* Give back what compiling over-allocated: the instruction array grew by
+ * doubling and the image was sized for every node of the DAG (a chain of
+ * 10^5 loops: megabytes). A failed shrink keeps the larger block. */
+static void trim(tape *t)
+{
+    if (t->nins > 0) {
+        tape_ins *ins = xrealloc_array(t->ins, (size_t)t->nins, sizeof *ins);
+        if (ins)
+            t->ins = ins;
+    }
+    if (t->nreg > 0) {
+        double *reg0 = xrealloc_array(t->reg0, (size_t)t->nreg, sizeof *reg0);
+        if (reg0)
+            t->reg0 = reg0;
+    }
+}
+
 /* Registers an instruction reads: a; then b; then c. */
 static int operands(int op)
 {
@@ -223,6 +240,7 @@ int tape_fuse(tape *t, const ex *const *roots, const int *nroots)
     t->phase_start[t->nphases] = t->nins = out;
     free(uses);
     free(def);
+    trim(t);
     return 0;
 }
 
@@ -295,6 +313,7 @@ int tape_compile(tape *t, expr_ctx *c, int nvars, int nphases, const ex *const *
     free(stack.v);
     if (fuse_sincos(t) < 0)
         goto fail;
+    trim(t);
     return 0;
 fail:
     free(stack.v);
