@@ -117,12 +117,16 @@ int kin_state_init(kin_state *st, const mech_model *m)
     st->o = xcalloc(2 * nl, sizeof *st->o);
     st->vo = xcalloc(2 * nl, sizeof *st->vo);
     st->ao = xcalloc(2 * nl, sizeof *st->ao);
-    if (!st->th || !st->om || !st->al || !st->c || !st->s || !st->o || !st->vo || !st->ao) {
+    st->guide = xcalloc(3 * (size_t)m->njoints + 1, sizeof *st->guide);
+    if (!st->th || !st->om || !st->al || !st->c || !st->s || !st->o || !st->vo || !st->ao ||
+        !st->guide) {
         kin_state_free(st);
         return MECH_ENOMEM;
     }
     for (size_t l = 0; l < nl; l++)
         st->c[l] = 1.0;  /* angle 0 until updated; the ground stays so */
+    for (int j = 0; j < m->njoints; j++)
+        st->guide[3 * j] = NAN;  /* no direction yet */
     return MECH_OK;
 }
 
@@ -136,6 +140,7 @@ void kin_state_free(kin_state *st)
     free(st->o);
     free(st->vo);
     free(st->ao);
+    free(st->guide);
     memset(st, 0, sizeof *st);
 }
 
@@ -183,12 +188,18 @@ static const double *point_xy(const mech_model *m, int l, int i, double *buf)
 
 /* Offset of the mover point from the guide point, and its rates, for a
  * slider with guide g: d = s u, with u at angle th_g + angle. */
-static void slide_offset(const kin_state *st, const mech_joint *jt, double s, double sd,
+static void slide_offset(kin_state *st, int j, const mech_joint *jt, double s, double sd,
                          double sdd, double *d, double *dv, double *da)
 {
     int g = jt->link[1];
     double ang = st->th[g] + jt->angle, w = st->om[g], al = st->al[g];
-    double ux = cos(ang), uy = sin(ang);  /* u; u_perp = (-uy, ux) */
+    double *u = st->guide + 3 * j;  /* angle, cos, sin: the same values while it holds */
+    if (!(u[0] == ang)) {
+        u[0] = ang;
+        u[1] = cos(ang);
+        u[2] = sin(ang);
+    }
+    double ux = u[1], uy = u[2];  /* u; u_perp = (-uy, ux) */
     d[0] = s * ux;
     d[1] = s * uy;
     double tang = sd, norm = s * w;                          /* along u, along u_perp */
@@ -213,8 +224,8 @@ static void place_link(const kin_tree *t, kin_state *st, int l, const double *po
     }
     int sv = t->slide_var[j];
     double d[3][2];
-    slide_offset(st, jt, var_value(pos, sv), var_value(vel, sv), var_value(acc, sv), d[0], d[1],
-                 d[2]);
+    slide_offset(st, j, jt, var_value(pos, sv), var_value(vel, sv), var_value(acc, sv), d[0],
+                 d[1], d[2]);
     double sign = l == jt->link[0] ? 1.0 : -1.0;  /* mover = guide point + d */
     kin_on_link(st, pl, point_xy(m, pl, jt->point[l == jt->link[0] ? 1 : 0], rbuf), p, v, a);
     for (int k = 0; k < 2; k++) {

@@ -28,6 +28,8 @@ typedef struct kin_state {
     double *c, *s;          /* [nlinks] cos and sin of th (ground: 1, 0); kept while th
                                does not change */
     double *o, *vo, *ao;    /* [2 nlinks] frame origin and its rates */
+    double *guide;          /* [3 njoints] a slider's guide angle, its cos and sin, kept
+                               while the angle does not change (a ground guide: always) */
 } kin_state;
 
 int kin_tree_build(kin_tree *t, const mech_system *s);
