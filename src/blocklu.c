@@ -148,9 +148,12 @@ static int block_factor_general(double *a, int k, int *piv, int *swaps)
     int rows[BLOCKLU_MAX_BLOCK];
     for (int j = 0; j < k; j++) {
         int p = j;
+        double best = fabs(a[j + j * k]);
         for (int i = j + 1; i < k; i++)
-            if (fabs(a[i + j * k]) > fabs(a[p + j * k]))
+            if (fabs(a[i + j * k]) > best) {  /* the first of equal magnitudes, as before */
+                best = fabs(a[i + j * k]);
                 p = i;
+            }
         piv[j] = p;
         if (!(a[p + j * k] != 0.0))
             return j;
