@@ -20,6 +20,9 @@ typedef struct kin_tree {
     int *point_link;    /* [npoint_names] the carrier link of a point name nearest the ground */
     int *point_index;   /* [npoint_names] the point's index in that link */
     unsigned char *active; /* [nlinks] frames to compute (kin_mark_point/link) */
+    double *attach;     /* [4 nlinks] link l is placed from its parent through the joint's
+                           point: at attach[4l], [4l+1] in the parent's frame (revolute: the
+                           pin; slider: the guide's point), at [4l+2], [4l+3] in l's */
 } kin_tree;
 
 /* Positions, velocities and accelerations of every active link frame. */
