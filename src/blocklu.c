@@ -424,7 +424,9 @@ void blocklu_solve(blocklu *b, double *x)
     const double *above = b->v + pl->ndense;
     for (int k = 0; k < pl->n; k++)
         y[k] = x[pl->P[k]];
-    for (int k = pl->nblocks - 1; k >= 0; k--) {
+    if (pl->nblocks == 1)  /* one loop or one coupled group: nothing above it */
+        block_solve(b->v, pl->n, b->piv, y);
+    for (int k = pl->nblocks - 1; k >= 0 && pl->nblocks > 1; k--) {
         int k0 = pl->R[k], size = pl->R[k + 1] - k0;
         block_solve(b->v + pl->at[k], size, b->piv + k0, y + k0);
         for (int j = k0; j < k0 + size; j++)
