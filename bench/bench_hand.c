@@ -439,6 +439,102 @@ static void conveyor_out(const double *x, const double *xd, const double *xdd, d
         *o++ = x[k], *o++ = xd[k], *o++ = xdd[k];
 }
 
+/* ---- the conveyor's joint reactions by hand (friction off) ----------------- */
+
+/* Newton-Euler for the five moving links (x, y forces and the moment about
+ * the centre of mass), unknowns: the reactions at O, A, B, E, D, F, G (each
+ * on the later link of the file, its opposite on the earlier) and the
+ * driver torque; 15 x 15, dense LU with partial pivoting. The tray's
+ * distributed cargo (50 kg over E-D) acts at the tray's centre. */
+enum { CF_N = 15 };
+static const double C_rho = 7850, C_bw = 0.040, C_bt = 0.020, C_pw = 0.300, C_pt = 0.004,
+                    C_cargo = 50, C_g = 9.81;
+
+static const char *const CVF_COLS[] = {
+    "q", "A.x", "A.y", "A.vx", "A.vy", "A.ax", "A.ay", "B.x", "B.y", "B.vx", "B.vy", "B.ax",
+    "B.ay", "C.x", "C.y", "C.vx", "C.vy", "C.ax", "C.ay", "D.x", "D.y", "D.vx", "D.vy", "D.ax",
+    "D.ay", "E.x", "E.y", "E.vx", "E.vy", "E.ax", "E.ay", "crank.angle", "crank.omega",
+    "crank.alpha", "coupler.angle", "coupler.omega", "coupler.alpha", "tray.angle",
+    "tray.omega", "tray.alpha", "rocker4.angle", "rocker4.omega", "rocker4.alpha",
+    "rocker5.angle", "rocker5.omega", "rocker5.alpha", "driver.torque", NULL};
+
+/* One joint: reaction column c at point p, +R on link la (centre ga), -R on lb. */
+static void cf_joint(double *A, int c, const double *p, int la, const double *ga, int lb,
+                     const double *gb)
+{
+    const int ls[2] = {la, lb};
+    const double *gs[2] = {ga, gb}, sg[2] = {1, -1};
+    for (int k = 0; k < 2; k++) {
+        if (ls[k] == 0)
+            continue;
+        int r = 3 * (ls[k] - 1);
+        double rx = p[0] - gs[k][0], ry = p[1] - gs[k][1];
+        A[r * CF_N + c] += sg[k], A[(r + 1) * CF_N + c + 1] += sg[k];
+        A[(r + 2) * CF_N + c] += -sg[k] * ry, A[(r + 2) * CF_N + c + 1] += sg[k] * rx;
+    }
+}
+
+/* The driver torque at one position from the kinematics (x, xd, xdd). */
+static double conveyor_torque(const double *x, const double *xd, const double *xdd, double q,
+                              double qd, double qdd)
+{
+    double l3 = C_l3a + C_l3b, rG3 = hypot((C_l3b - C_l3a) / 2, C_lk),
+           aG3 = atan2(C_lk, (C_l3b - C_l3a) / 2);
+    double m1 = C_rho * C_bw * C_bt * C_l1, m2 = C_rho * C_bw * C_bt * C_l2,
+           m3 = C_rho * C_pw * C_pt * l3, m4 = C_rho * C_bw * C_bt * C_l4, m5 = m4;
+    double mass[6] = {0, m1, m2, m3, m4, m5};
+    double inertia[6] = {0, m1 * (C_l1 * C_l1 + C_bw * C_bw) / 12,
+                         m2 * (C_l2 * C_l2 + C_bw * C_bw) / 12, m3 * (l3 * l3 + C_pw * C_pw) / 12,
+                         m4 * (C_l4 * C_l4 + C_bw * C_bw) / 12, m5 * (C_l5 * C_l5 + C_bw * C_bw) / 12};
+    double al[6] = {0, qdd, xdd[0], xdd[1], xdd[2], xdd[3]};
+    /* points and centres with their accelerations: [x, y, vx, vy, ax, ay] */
+    double P_A[6] = {0}, P_B[6], P_E[6], P_D[6], P_F[6] = {C_xF, -C_a, 0, 0, 0, 0},
+           P_G[6] = {C_xG, -C_a, 0, 0, 0, 0}, G[6][6] = {{0}};
+    add_arm(P_A, C_l1, q, qd, qdd);
+    memcpy(P_B, P_A, sizeof P_B);
+    add_arm(P_B, C_l2, x[0], xd[0], xdd[0]);
+    memcpy(P_E, P_B, sizeof P_E), memcpy(P_D, P_B, sizeof P_D);
+    add_arm(P_E, C_rE, x[1] + C_aE, xd[1], xdd[1]);
+    add_arm(P_D, C_rD, x[1] + C_aD, xd[1], xdd[1]);
+    add_arm(G[1], C_l1 / 2, q, qd, qdd);
+    memcpy(G[2], P_A, sizeof G[2]);
+    add_arm(G[2], C_l2 / 2, x[0], xd[0], xdd[0]);
+    memcpy(G[3], P_B, sizeof G[3]);
+    add_arm(G[3], rG3, x[1] + aG3, xd[1], xdd[1]);
+    memcpy(G[4], P_F, sizeof G[4]);
+    add_arm(G[4], C_l4 / 2, x[2], xd[2], xdd[2]);
+    memcpy(G[5], P_G, sizeof G[5]);
+    add_arm(G[5], C_l5 / 2, x[3], xd[3], xdd[3]);
+    double A[CF_N * CF_N] = {0}, b[CF_N];
+    static const double origin[2] = {0, 0};
+    cf_joint(A, 0, origin, 1, G[1], 0, NULL);    /* O: ground-crank */
+    cf_joint(A, 2, P_A, 2, G[2], 1, G[1]);       /* A: crank-coupler */
+    cf_joint(A, 4, P_B, 3, G[3], 2, G[2]);       /* B: coupler-tray */
+    cf_joint(A, 6, P_E, 4, G[4], 3, G[3]);       /* E: tray-rocker4 */
+    cf_joint(A, 8, P_D, 5, G[5], 3, G[3]);       /* D: tray-rocker5 */
+    cf_joint(A, 10, P_F, 4, G[4], 0, NULL);      /* F: ground-rocker4 */
+    cf_joint(A, 12, P_G, 5, G[5], 0, NULL);      /* G: ground-rocker5 */
+    A[2 * CF_N + 14] = 1;                        /* the driver torque on the crank */
+    for (int l = 1; l <= 5; l++) {  /* A y = m a - m g - loads; I al - load moments */
+        double fy = -mass[l] * C_g - (l == 3 ? C_cargo * C_g : 0);  /* cargo at the centre */
+        b[3 * (l - 1)] = mass[l] * G[l][4];
+        b[3 * (l - 1) + 1] = mass[l] * G[l][5] - fy;
+        b[3 * (l - 1) + 2] = inertia[l] * al[l];
+    }
+    int piv[CF_N];
+    if (lu(CF_N, A, piv))
+        return NAN;
+    lu_solve(CF_N, A, piv, b);
+    return b[14];
+}
+
+static void conveyor_out_forces(const double *x, const double *xd, const double *xdd, double q,
+                                double qd, double qdd, double *o)
+{
+    conveyor_out(x, xd, xdd, q, qd, qdd, o);
+    o[46] = conveyor_torque(x, xd, xdd, q, qd, qdd);
+}
+
 /* ---- timing and comparison -------------------------------------------------- */
 
 static int ncols_of(const char *const *cols)
@@ -481,6 +577,10 @@ static double compare(const mech_table *t, const double *hand, const char *const
     return worst;
 }
 
+/* 1: the interpreter also solves the joint reactions, friction off (the
+ * conveyor's row with forces) */
+static int with_forces;
+
 static double time_interpreter(const mech_model *m, double tol, mech_table *keep,
                                mech_solve_stats *st, double *min)
 {
@@ -489,7 +589,8 @@ static double time_interpreter(const mech_model *m, double tol, mech_table *keep
         mech_solve_options o;
         mech_solve_options_default(&o);
         o.tol = tol;
-        o.forces = -1; /* kinematics only, like the hand-written solvers */
+        o.forces = with_forces ? 1 : -1; /* kinematics only, like the hand-written solvers */
+        o.friction = MECH_FRICTION_OFF;
         mech_table t = {0};
         mech_diag d;
         mech_diag_init(&d);
@@ -572,9 +673,12 @@ static hand_mech hand_of(const char *name)
     st.lref = hypot(S_L3 + S_L5, S_L4 + S_L2);
     hand_mech cv = {4, C_l3a + C_l3b, conveyor_eval, conveyor_acc, conveyor_out, CV_COLS,
                     {-155 * M_PI / 180, 0, -8 * M_PI / 180, -7 * M_PI / 180}};
+    hand_mech cf = cv;  /* with the driver torque (joint reactions, friction off) */
+    cf.out = conveyor_out_forces, cf.cols = CVF_COLS;
     return strcmp(name, "fourbar") == 0               ? fb
            : strcmp(name, "offset-slider-crank") == 0 ? sc
            : strcmp(name, "stirling") == 0            ? st
+           : strcmp(name, "conveyor-forces") == 0     ? cf
                                                       : cv;
 }
 
@@ -593,7 +697,7 @@ static int count_one(const char *dir, const char *name, const char *side, int st
     double from = m->driver.values[0], to = m->driver.values[m->driver.nvalues - 1];
     int rc = 0;
     if (strcmp(side, "hand") == 0) {
-        hand_mech h = hand_of(name);
+        hand_mech h = hand_of(forces ? "conveyor-forces" : name);
         int nc = ncols_of(h.cols);
         double *qs = calloc((size_t)steps + 1, sizeof *qs);
         double *out = calloc((size_t)(steps + 1) * (size_t)nc, sizeof *out);
@@ -662,6 +766,10 @@ int main(int argc, char **argv)
     h = hand_of("conveyor");
     row("conveyor", "Newton, 4x4 J, dense LU", m, &h, CV_COLS, 1e-12);
     row("conveyor", "Newton, 4x4 J, dense LU", m, &h, CV_COLS, 1e-15);
+    h = hand_of("conveyor-forces");
+    with_forces = 1;
+    row("conv+torq", "+ 15x15 forces, dense LU", m, &h, CVF_COLS, 1e-12);
+    with_forces = 0;
     mech_model_free(&m);
     return 0;
 }
