@@ -38,7 +38,7 @@ enum { REPS = 31, MAXN = 8, MAXCOLS = 64 };
 /* ---- rotating vectors ---------------------------------------------------- */
 
 /* p, v, a += r e(th) with th' = w, th'' = al. */
-static void add_arm(double *p, double r, double th, double w, double al)
+static inline void add_arm(double *p, double r, double th, double w, double al)
 {
     double c = r * cos(th), s = r * sin(th);
     p[0] += c, p[1] += s;
