@@ -201,6 +201,7 @@ bench:
 	  build/bench/bench-solve mechanisms/*.yaml && \
 	  build/bench/bench-hand mechanisms && \
 	  MECH=build/bench/mech BUILD=build/bench sh bench/bench_codegen.sh && \
+	  sh bench/bench_ratio.sh build/bench/bench-hand && \
 	  build/bench/bench-accuracy mechanisms build/bench && \
 	  build/bench/bench-scale build/bench && \
 	  MECH=build/bench/mech sh bench/bench_batch.sh && \
