@@ -67,6 +67,7 @@ typedef struct mech_point {
     int id;         /* index into mech_model.point_names (shared names = same pin) */
     double x, y;    /* in the link's own frame, m */
     mech_mark mark;
+    double dxy[2];  /* d(x, y)/dp for the parameter p a sensitivity load seeds, else 0 */
 } mech_point;
 
 typedef struct mech_link {
@@ -253,6 +254,11 @@ typedef struct mech_system mech_system;
 
 /* Build the system of a checked model (the model must outlive it). */
 int mech_system_new(const mech_model *m, mech_system **out, mech_diag *d);
+/* The same equations for printing (mech equations): lengths and angles
+ * that depend on the file's parameters appear as the parameters (`r`) or
+ * as named lengths |AB| and angles <AB; the file is read again once per
+ * parameter to see what depends on what. Not for solving. */
+int mech_system_new_named(const mech_model *m, mech_system **out, mech_diag *d);
 void mech_system_free(mech_system **s);
 int mech_system_size(const mech_system *s);   /* number of unknowns */
 

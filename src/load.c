@@ -101,12 +101,13 @@ static void load_document(loader *ld, const ynode *root)
 }
 
 static int load_string_with(const char *text, size_t len, const char *name,
-                            const mech_override *ov, int nov, mech_model **out, mech_diag *d);
+                            const mech_override *ov, int nov, const char *seed,
+                            mech_model **out, mech_diag *d);
 
 int mech_load_string(const char *text, size_t len, const char *name, mech_model **out,
                      mech_diag *d)
 {
-    return load_string_with(text, len, name, NULL, 0, out, d);
+    return load_string_with(text, len, name, NULL, 0, NULL, out, d);
 }
 
 /* Overrides naming no parameter of the file. */
@@ -120,7 +121,8 @@ static void unused_overrides(loader *ld)
 }
 
 static int load_string_with(const char *text, size_t len, const char *name,
-                            const mech_override *ov, int nov, mech_model **out, mech_diag *d)
+                            const mech_override *ov, int nov, const char *seed,
+                            mech_model **out, mech_diag *d)
 {
     *out = NULL;
     size_t errors_before = d->nerrors;
@@ -132,6 +134,8 @@ static int load_string_with(const char *text, size_t len, const char *name,
     ld.d = d;
     ld.ov = ov;
     ld.nov = nov;
+    ld.seed = seed;
+    ld.env.dvalue = &ld.dlast;
     unsigned char used[64] = {0};
     ld.ov_used = used;
     if (nov > 64) {
@@ -281,7 +285,21 @@ int mech_load_file_with(const char *path, const mech_override *ov, int nov, mech
     char *buf = read_file(path, yaml_default_limits.max_bytes, &len, d, &rc);
     if (!buf)
         return rc;
-    rc = load_string_with(buf, len, path, ov, nov, out, d);
+    rc = load_string_with(buf, len, path, ov, nov, NULL, out, d);
+    free(buf);
+    return rc;
+}
+
+int load_file_seeded(const char *path, const mech_override *ov, int nov, const char *seed,
+                     mech_model **out, mech_diag *d)
+{
+    *out = NULL;
+    size_t len = 0;
+    int rc;
+    char *buf = read_file(path, yaml_default_limits.max_bytes, &len, d, &rc);
+    if (!buf)
+        return rc;
+    rc = load_string_with(buf, len, path, ov, nov, seed, out, d);
     free(buf);
     return rc;
 }
