@@ -165,6 +165,7 @@ typedef struct mech_param {
     char *name;
     double value;      /* SI, or a pure number */
     mech_mark mark;
+    char unit[32];     /* SI unit of the value ("m", "rad", "kg/m^3"), "" for a bare number */
 } mech_param;
 
 typedef struct mech_outputs {
@@ -407,6 +408,20 @@ typedef struct mech_solve_stats {
  * MECH_EINPUT for an invalid system. `stats` may be NULL. */
 int mech_solve(const mech_model *m, const mech_solve_options *o, mech_table *out,
                mech_solve_stats *stats, mech_diag *d);
+
+/* Sensitivities (src/sensitivity.c, docs/sensitivity.md): to `table`, the
+ * result of mech_solve(m, o, ...), add for each parameter names[k] and each
+ * kinematic column COL (points' x, y, vx, vy, ax, ay; links' angle, omega,
+ * alpha; sliders' s, v, a) a column "d(COL)/d(NAME)" in COL's unit over
+ * NAME's SI unit (per 1 of a bare number), from the implicit-function
+ * theorem: J dx/dp = -df/dp at each row, and the derivatives of the
+ * velocity and acceleration equations for the rates; exact to rounding.
+ * m must come from a file (read again once per parameter, with the same
+ * overrides ov[0..nov-1]); force columns get none. MECH_OK, or an error in
+ * d (an unknown parameter, redundant constraints, a singular row). */
+int mech_sensitivity(const mech_model *m, const mech_override *ov, int nov,
+                     const mech_solve_options *o, const char *const *names, int nnames,
+                     mech_table *table, mech_diag *d);
 
 /* ---- The analysed system ----------------------------------------------
  * mech_solve is three steps that callers may also take themselves:

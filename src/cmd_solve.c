@@ -38,6 +38,11 @@ const char cmd_solve_help[] =
     "                      klu: SuiteSparse KLU always (docs/solver.md)\n"
     "  --set NAME=VALUE    replace the file's parameter NAME by VALUE (repeatable),\n"
     "                      e.g. --set 'l=150 mm'\n"
+    "  --sensitivity LIST  for each parameter NAME in the comma-separated LIST, add\n"
+    "                      a column d(COL)/d(NAME) [COL's unit/NAME's unit] after\n"
+    "                      the others for every position, velocity and\n"
+    "                      acceleration column COL: exact derivatives by the\n"
+    "                      implicit-function theorem, not finite differences\n"
     "  --outputs LIST      comma-separated point, link and slider names to output\n"
     "                      instead of the file's outputs\n"
     "  --level L           positions, velocities or accelerations (default): the\n"
@@ -80,6 +85,7 @@ enum { MAX_SET = 64 };
 
 typedef struct solve_args {
     const char *file, *out, *from, *to, *outputs;
+    const char *sens;            /* --sensitivity NAME,... */
     mech_override set[MAX_SET];  /* --set NAME=VALUE: parameters replaced */
     char *set_text[MAX_SET];
     int nset;
@@ -100,7 +106,7 @@ static int parse_number(const char *text, double *v)
 static const char *const value_options[] = {"-o", "--output", "--from", "--to", "--outputs",
                                            "--steps", "--tol", "--max-iter", "--min-rcond",
                                            "--level", "--friction", "--set", "--linear-solver",
-                                           "--range"};
+                                           "--range", "--sensitivity"};
 
 static int takes_value(const char *arg)
 {
@@ -122,6 +128,8 @@ static int parse_valued(solve_args *a, const char *arg, const char *val)
         a->to = val;
     else if (strcmp(arg, "--outputs") == 0)
         a->outputs = val;
+    else if (strcmp(arg, "--sensitivity") == 0)
+        a->sens = val;
     else if (strcmp(arg, "--steps") == 0) {
         if (!cmd_parse_int(val, 1, 1000000, &a->steps))
             return cmd_usage_error("solve", "--steps needs a whole number from 1 to 1000000 (as in a file), "
@@ -386,27 +394,39 @@ static int write_rows(const solve_args *a, const mech_table *t)
     return code;
 }
 
-int cmd_solve(int argc, char **argv)
+/* --sensitivity: the derivative columns added to t (mech_sensitivity). */
+static int add_sensitivity(const solve_args *a, const mech_model *m, mech_table *t)
 {
-    solve_args a = {0};
-    int code = parse_args(argc, argv, &a);
-    if (code >= 0) {
-        for (int i = 0; i < a.nset; i++)
-            free(a.set_text[i]);
-        return code;
+    enum { MAX_NAMES = 64 };
+    char *list = strdup(a->sens), *save = NULL;
+    const char *names[MAX_NAMES];
+    int n = 0;
+    if (!list)
+        return fprintf(stderr, "mech solve: out of memory\n"), MECH_EXIT_IO;
+    for (char *tok = strtok_r(list, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
+        if (n == MAX_NAMES) {
+            free(list);
+            return cmd_usage_error("solve", "--sensitivity takes at most 64 names, not %s", a->sens);
+        }
+        names[n++] = tok;
     }
-    mech_model *m = NULL;
-    code = cmd_refuse_input("solve", a.out, &a.file, 1);
-    if (code < 0)
-        code = cmd_load_checked_with(a.file, a.set, a.nset, &m);
-    for (int i = 0; i < a.nset; i++)
-        free(a.set_text[i]);
-    if (code != MECH_EXIT_OK)
-        return code;
-    if ((code = apply_overrides(&a, m)) >= 0) {
-        mech_model_free(&m);
-        return code;
+    if (n == 0) {
+        free(list);
+        return cmd_usage_error("solve", "--sensitivity needs parameter names, not '%s'", a->sens);
     }
+    mech_diag d;
+    mech_diag_init(&d);
+    int rc = mech_sensitivity(m, a->set, a->nset, &a->opt, names, n, t, &d);
+    mech_diag_print(&d, stderr);
+    mech_diag_free(&d);
+    free(list);
+    return rc == MECH_OK ? -1 : cmd_exit_status(rc);
+}
+
+static int solve_loaded(solve_args *pa, mech_model *m)
+{
+    solve_args a = *pa;
+    int code;
     if (a.verbose)
         a.opt.log = stderr;
     mech_diag d;
@@ -432,11 +452,39 @@ int cmd_solve(int argc, char **argv)
     code = cmd_exit_status(rc);
     if (rc == MECH_ESOLVE && a.within && only_assembly_gaps(&t))
         code = MECH_EXIT_OK;
+    if (a.sens && t.nrows > 0 && (rc == MECH_OK || rc == MECH_ESOLVE)) {
+        a.opt.progress = NULL;
+        int sc = add_sensitivity(&a, m, &t);
+        if (sc >= 0) {
+            mech_table_free(&t);
+            return sc;
+        }
+    }
     if (rc == MECH_OK || (rc == MECH_ESOLVE && t.nrows > 0)) {
         int wc = write_rows(&a, &t);
         code = wc != MECH_EXIT_OK ? wc : code;
     }
     mech_table_free(&t);
+    return code;
+}
+
+int cmd_solve(int argc, char **argv)
+{
+    solve_args a = {0};
+    int code = parse_args(argc, argv, &a);
+    if (code >= 0) {
+        for (int i = 0; i < a.nset; i++)
+            free(a.set_text[i]);
+        return code;
+    }
+    mech_model *m = NULL;
+    code = cmd_refuse_input("solve", a.out, &a.file, 1);
+    if (code < 0)
+        code = cmd_load_checked_with(a.file, a.set, a.nset, &m);
+    if (code == MECH_EXIT_OK && (code = apply_overrides(&a, m)) < 0)
+        code = solve_loaded(&a, m);
+    for (int i = 0; i < a.nset; i++)
+        free(a.set_text[i]);
     mech_outputs_free(&a.selected);
     mech_model_free(&m);
     return code;

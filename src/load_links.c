@@ -152,6 +152,8 @@ void load_parameters(loader *ld, const ynode *map)
         }
         mp->value = p.value;
         mp->mark = k->mark;
+        if (!p.bare)
+            dim_format(p.d, mp->unit, sizeof mp->unit);
         p.name = mp->name;
         ld->params[m->nparams++] = p;
         ld->env.nparams = m->nparams;
