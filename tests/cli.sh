@@ -457,4 +457,19 @@ if run "mech batch, progress" 0 env MECH_PROGRESS_SECONDS=0 "$MECH" batch -j 1 m
     has_line "$tmp/err" '^mech batch: 1 of 2 files (50%), [0-9]* s$' "batch: progress lines"
 fi
 
+# issue 20: parameters kept symbolic (mech equations) and sensitivities
+if run "mech equations, parameter names" 0 "$MECH" equations mechanisms/offset-slider-crank.yaml; then
+    has_line "$tmp/out" "^  f1 = l\*cos(th_rod) - x_B + r\*cos(th_crank) " "equations: r and l by name"
+    has_line "$tmp/out" "^  f2 = l\*sin(th_rod) - e + r\*sin(th_crank) " "equations: e by name"
+fi
+if run "mech solve --sensitivity" 0 "$MECH" solve mechanisms/offset-slider-crank.yaml --steps 4 -q --sensitivity r,l; then
+    has_line "$tmp/out" '^q \[rad\],.*,d(A\.x)/d(r) \[m/m\],.*,d(x_B\.a)/d(l) \[m/s^2/m\]$' "sensitivity: header"
+    # A = r (cos q, sin q): d(A.x)/d(r) = cos q, 1 at q = 0; d(A.vy)/d(r) = w cos q = 314.159...
+    ax=$(awk -F, 'NR == 2 { print $20 }' "$tmp/out")
+    [ "$ax" = "1" ] && pass || fail "sensitivity: d(A.x)/d(r) at q = 0 is '$ax', not 1"
+fi
+if run "mech solve --sensitivity, unknown name" 2 "$MECH" solve mechanisms/offset-slider-crank.yaml --steps 4 -q --sensitivity rr; then
+    has_line "$tmp/err" "no parameter 'rr' in the file (its parameters: r, l, e)" "sensitivity: unknown name"
+fi
+
 summary
