@@ -130,6 +130,15 @@ int quantity_eval_param(const char *text, const expr_env *env, expr_param *out,
 int load_file_seeded(const char *path, const mech_override *ov, int nov, const char *seed,
                      mech_model **out, mech_diag *d);
 
+/* load.c: a file read and parsed once (load_doc_read), then turned into
+ * models with different parameter replacements (load_doc_model, as
+ * mech_load_file_with; threads may share the document). */
+typedef struct load_doc load_doc;
+int load_doc_read(const char *path, load_doc **out, mech_diag *d);
+int load_doc_model(const load_doc *doc, const mech_override *ov, int nov, mech_model **out,
+                   mech_diag *d);
+void load_doc_free(load_doc **doc);
+
 /* ---- yamltree.c: a bounded YAML document tree with marks. */
 typedef enum { YNODE_SCALAR, YNODE_SEQ, YNODE_MAP } ynode_kind;
 typedef struct ynode ynode;
