@@ -166,6 +166,7 @@ typedef struct mech_param {
     double value;      /* SI, or a pure number */
     mech_mark mark;
     char unit[32];     /* SI unit of the value ("m", "rad", "kg/m^3"), "" for a bare number */
+    double tol;        /* tolerance: the value is value +- tol (same unit); 0 when none */
 } mech_param;
 
 typedef struct mech_outputs {
@@ -422,6 +423,15 @@ int mech_solve(const mech_model *m, const mech_solve_options *o, mech_table *out
 int mech_sensitivity(const mech_model *m, const mech_override *ov, int nov,
                      const mech_solve_options *o, const char *const *names, int nnames,
                      mech_table *table, mech_diag *d);
+
+/* Tolerance stack-up (docs/sensitivity.md): to `table`, the result of
+ * mech_solve(m, o, ...), add for every kinematic column COL the columns
+ * "worst(COL)" = sum over the parameters p with a tolerance of
+ * |d(COL)/dp| tol_p, and "rss(COL)" = sqrt(sum (d(COL)/dp tol_p)^2), in
+ * COL's unit (first order: from mech_sensitivity's derivatives). An error
+ * when no parameter has a tolerance. */
+int mech_tolerances(const mech_model *m, const mech_override *ov, int nov,
+                    const mech_solve_options *o, mech_table *table, mech_diag *d);
 
 /* ---- The analysed system ----------------------------------------------
  * mech_solve is three steps that callers may also take themselves:

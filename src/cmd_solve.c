@@ -11,6 +11,7 @@
 const char cmd_solve_help[] =
     "usage: mech solve FILE [-o OUT.csv] [--from A --to B --steps N] [--tol T]\n"
     "                  [--outputs NAME,...] [--level positions|velocities|accelerations]\n"
+    "                  [--sensitivity NAME,...] [--tolerances]\n"
     "                  [--forces] [--friction on|off|both]\n"
     "                  [--diagnostics] [--stats] [--verbose] [--all]\n"
     "                  [--within-assembly] [--range assembly]\n"
@@ -43,6 +44,11 @@ const char cmd_solve_help[] =
     "                      the others for every position, velocity and\n"
     "                      acceleration column COL: exact derivatives by the\n"
     "                      implicit-function theorem, not finite differences\n"
+    "  --tolerances        for every position, velocity and acceleration column COL\n"
+    "                      add worst(COL) = sum |d(COL)/dp| tol_p over the parameters\n"
+    "                      with a tolerance ({value: 40 mm, tolerance: 0.05 mm}) and\n"
+    "                      rss(COL) = sqrt(sum (d(COL)/dp tol_p)^2); print the\n"
+    "                      largest of each over the sweep to standard error\n"
     "  --outputs LIST      comma-separated point, link and slider names to output\n"
     "                      instead of the file's outputs\n"
     "  --level L           positions, velocities or accelerations (default): the\n"
@@ -86,6 +92,7 @@ enum { MAX_SET = 64 };
 typedef struct solve_args {
     const char *file, *out, *from, *to, *outputs;
     const char *sens;            /* --sensitivity NAME,... */
+    int tolerances;              /* --tolerances */
     mech_override set[MAX_SET];  /* --set NAME=VALUE: parameters replaced */
     char *set_text[MAX_SET];
     int nset;
@@ -216,6 +223,8 @@ static int parse_args(int argc, char **argv, solve_args *a)
             a->opt.diagnostics = 1;
         else if (strcmp(arg, "--all") == 0)
             a->opt.all_blocks = 1;
+        else if (strcmp(arg, "--tolerances") == 0)
+            a->tolerances = 1;
         else if (strcmp(arg, "--within-assembly") == 0)
             a->within = 1;
         else if (strcmp(arg, "--forces") == 0)
@@ -423,6 +432,48 @@ static int add_sensitivity(const solve_args *a, const mech_model *m, mech_table 
     return rc == MECH_OK ? -1 : cmd_exit_status(rc);
 }
 
+/* --tolerances: the summary of the worst(COL) and rss(COL) columns. */
+static void print_stackup(const mech_model *m, const mech_table *t, FILE *out)
+{
+    fprintf(out, "mech solve: tolerance stack-up, first order, from");
+    for (int i = 0; i < m->nparams; i++)
+        if (m->params[i].tol > 0)
+            fprintf(out, " %s +-%.6g %s", m->params[i].name, m->params[i].tol,
+                    m->params[i].unit[0] ? m->params[i].unit : "(bare)");
+    fprintf(out, "; largest over the %d rows:\n", t->nrows);
+    for (int c = 0; c + 1 < t->ncolumns; c++) {
+        const char *name = t->columns[c].name;
+        if (strncmp(name, "worst(", 6) != 0)
+            continue;
+        int at = 0;
+        double worst = 0, rss = 0;
+        for (int r = 0; r < t->nrows; r++) {
+            if (mech_table_get(t, r, c) > worst) {
+                worst = mech_table_get(t, r, c);
+                at = r;
+            }
+            rss = fmax(rss, mech_table_get(t, r, c + 1));
+        }
+        fprintf(out, "  %-24.*s worst case %-12.6g RSS %-12.6g [%s] (worst at q = %.6g)\n",
+                (int)strlen(name) - 7, name + 6, worst, rss, t->columns[c].unit,
+                t->nrows ? mech_table_get(t, at, 0) : 0.0);
+    }
+}
+
+/* --tolerances: the columns (mech_tolerances) and the summary. */
+static int add_tolerances(const solve_args *a, const mech_model *m, mech_table *t)
+{
+    mech_diag d;
+    mech_diag_init(&d);
+    int rc = mech_tolerances(m, a->set, a->nset, &a->opt, t, &d);
+    mech_diag_print(&d, stderr);
+    mech_diag_free(&d);
+    if (rc != MECH_OK)
+        return cmd_exit_status(rc);
+    print_stackup(m, t, stderr);
+    return -1;
+}
+
 static int solve_loaded(solve_args *pa, mech_model *m)
 {
     solve_args a = *pa;
@@ -452,9 +503,11 @@ static int solve_loaded(solve_args *pa, mech_model *m)
     code = cmd_exit_status(rc);
     if (rc == MECH_ESOLVE && a.within && only_assembly_gaps(&t))
         code = MECH_EXIT_OK;
-    if (a.sens && t.nrows > 0 && (rc == MECH_OK || rc == MECH_ESOLVE)) {
+    if ((a.sens || a.tolerances) && t.nrows > 0 && (rc == MECH_OK || rc == MECH_ESOLVE)) {
         a.opt.progress = NULL;
-        int sc = add_sensitivity(&a, m, &t);
+        int sc = a.sens ? add_sensitivity(&a, m, &t) : -1;
+        if (sc < 0 && a.tolerances)
+            sc = add_tolerances(&a, m, &t);
         if (sc >= 0) {
             mech_table_free(&t);
             return sc;

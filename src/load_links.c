@@ -105,6 +105,55 @@ static int eval_parameter(loader *ld, const ynode *k, const ynode *v, const char
     return 0;
 }
 
+/* A parameter's definition: the scalar `40 mm`, or the `value` of
+ * {value: 40 mm, tolerance: 0.05 mm} (*tol: the tolerance's node). NULL
+ * when reported. */
+static const ynode *parameter_value(loader *ld, const ynode *v, const char *name,
+                                    const ynode **tol)
+{
+    if (v->kind != YNODE_MAP)
+        return load_want_kind(ld, v, YNODE_SCALAR, "a parameter value") ? v : NULL;
+    static const char *const keys[] = {"value", "tolerance"};
+    char where[128];
+    snprintf(where, sizeof where, "parameter '%s'", name);
+    load_check_keys(ld, v, keys, COUNT(keys), where);
+    const ynode *val = ymap_get(v, "value");
+    if (!val && load_misspelt(v, "value", keys, COUNT(keys)))
+        return NULL;  /* reported as a typo */
+    if (!val) {
+        load_err(ld, v, "parameter '%s' needs a 'value' (as {value: 40 mm, tolerance: "
+                        "0.05 mm})", name);
+        return NULL;
+    }
+    *tol = ymap_get(v, "tolerance");
+    return load_want_kind(ld, val, YNODE_SCALAR, "a parameter value") ? val : NULL;
+}
+
+/* The tolerance of parameter p (+-, SI): a quantity of p's dimension (a bare
+ * number only for a bare p), not negative. 0, or -1 with the problem reported. */
+static int eval_tolerance(loader *ld, const ynode *t, const char *name, const expr_param *p,
+                          double *out)
+{
+    char msg[256];
+    size_t pos = 0;
+    expr_param tp = {0};
+    if (!load_want_kind(ld, t, YNODE_SCALAR, "a tolerance"))
+        return -1;
+    if (quantity_eval_param(t->text, &ld->env, &tp, msg, sizeof msg, &pos) < 0)
+        return load_err(ld, t, "tolerance of parameter '%s': %s", name, msg), -1;
+    char du[32], dt[32];
+    dim_format(p->d, du, sizeof du);
+    dim_format(tp.d, dt, sizeof dt);
+    if (tp.bare != p->bare || (!p->bare && !dim_equal(tp.d, p->d)))
+        return load_err(ld, t, "tolerance of parameter '%s' must be in the value's unit (%s), "
+                               "not '%s'", name, p->bare ? "a bare number" : du, t->text), -1;
+    if (tp.value < 0)
+        return load_err(ld, t, "tolerance of parameter '%s' is negative (write the +- "
+                               "half-width: 0.05 mm)", name), -1;
+    *out = tp.value;
+    return 0;
+}
+
 void load_parameters(loader *ld, const ynode *map)
 {
     if (!load_check_map(ld, map, NULL, 0, "'parameters'", "parameter"))
@@ -135,11 +184,17 @@ void load_parameters(loader *ld, const ynode *map)
         }
         if (k->dup_of)
             continue; /* duplicate key, already reported */
-        if (!load_want_kind(ld, v, YNODE_SCALAR, "a parameter value"))
-            continue;
+        const ynode *tol = NULL;
+        const ynode *def = parameter_value(ld, v, name, &tol);
         expr_param p = {0};
-        if (eval_parameter(ld, k, v, name, &p) != 0)
+        double tolerance = 0.0;
+        if (def && eval_parameter(ld, k, def, name, &p) != 0)
+            continue;  /* reported, and its uses are not reported again */
+        if (!def || (tol && eval_tolerance(ld, tol, name, &p, &tolerance) != 0)) {
+            if (name_map_put(&ld->bad_params, k->text, 1) < 0)  /* no echo from its uses */
+                load_err(ld, k, "out of memory");
             continue;
+        }
         if (ld->seed && strcmp(ld->seed, name) == 0)
             p.dvalue = 1.0;  /* the parameter the derivatives are taken by */
         mech_param *mp = &m->params[m->nparams];
@@ -151,6 +206,7 @@ void load_parameters(loader *ld, const ynode *map)
             continue;
         }
         mp->value = p.value;
+        mp->tol = tolerance;
         mp->mark = k->mark;
         if (!p.bare)
             dim_format(p.d, mp->unit, sizeof mp->unit);

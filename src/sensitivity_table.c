@@ -258,13 +258,112 @@ static int find_params(const mech_model *m, const char *const *names, int nnames
     return MECH_OK;
 }
 
+/* The sensitivities of t's kinematic columns by the parameters which[]:
+ * *vals[(row * nnames + k) * nc + c] for column cols[c]. */
+static int sensitivities(const mech_model *m, const mech_override *ov, int nov,
+                         const mech_solve_options *o, const int *which, int nnames,
+                         const mech_table *table, sens_col *cols, int *nc, double **vals,
+                         mech_diag *d)
+{
+    sens_plan sp;
+    mech_table x = {0};
+    *vals = NULL;
+    int rc = m->file ? MECH_OK
+                     : diag_error(d, "<model>", (mech_mark){0, 0}, "sensitivities need the "
+                                  "model's file (it is read again per parameter)");
+    if (rc != MECH_OK || (rc = sens_plan_new(&sp, m, ov, nov, which, nnames, d)) != MECH_OK)
+        return rc;
+    if (plan_columns(&sp, table, cols, nc) < 0)
+        rc = diag_error(d, m->file, (mech_mark){0, 0}, "out of memory");
+    if (rc == MECH_OK)
+        rc = sens_plan_compile(&sp, d);
+    if (rc == MECH_OK)
+        rc = solve_states(m, o, &x, d);
+    if (rc == MECH_OK &&
+        !(*vals = xcalloc((size_t)table->nrows * nnames * *nc + 1, sizeof **vals)))
+        rc = diag_error(d, m->file, (mech_mark){0, 0}, "out of memory");
+    if (rc == MECH_OK)
+        rc = fill_rows(&sp, table, &x, nnames, cols, *nc, *vals, d);
+    sens_plan_free(&sp);
+    mech_table_free(&x);
+    if (rc != MECH_OK) {
+        free(*vals);
+        *vals = NULL;
+    }
+    return rc;
+}
+
 int mech_sensitivity(const mech_model *m, const mech_override *ov, int nov,
                      const mech_solve_options *o, const char *const *names, int nnames,
                      mech_table *table, mech_diag *d)
 {
-    sens_plan sp;
-    mech_table x = {0};
     int nc = 0, *which = xcalloc((size_t)nnames + 1, sizeof *which);
+    sens_col *cols = xcalloc((size_t)table->ncolumns + 1, sizeof *cols);
+    double *vals = NULL;
+    int rc = which && cols ? find_params(m, names, nnames, which, d)
+                           : diag_error(d, m->file, (mech_mark){0, 0}, "out of memory");
+    if (rc == MECH_OK)
+        rc = sensitivities(m, ov, nov, o, which, nnames, table, cols, &nc, &vals, d);
+    if (rc == MECH_OK && widen(table, m, which, nnames, cols, nc, vals) < 0)
+        rc = diag_error(d, m->file, (mech_mark){0, 0}, "out of memory");
+    free(vals);
+    free(which);
+    free(cols);
+    return rc;
+}
+
+/* The worst-case and RSS columns of the kinematic columns cols[0..nc-1]. */
+static int add_stackup(mech_table *t, const mech_model *m, const int *which, int np,
+                       const sens_col *cols, int nc, const double *vals)
+{
+    int old = t->ncolumns, wide = old + 2 * nc;
+    mech_column *cn = xcalloc((size_t)wide, sizeof *cn);
+    double *v = xcalloc((size_t)t->nrows * (size_t)wide + 1, sizeof *v);
+    if (!cn || !v) {
+        free(cn);
+        free(v);
+        return -1;
+    }
+    memcpy(cn, t->columns, (size_t)old * sizeof *cn);
+    int failed = 0;
+    for (int c = 0; c < nc; c++)
+        for (int k = 0; k < 2; k++) {
+            const mech_column *col = &t->columns[cols[c].col];
+            size_t ln = strlen(col->name) + 8;
+            mech_column *out = &cn[old + 2 * c + k];
+            out->name = malloc(ln);
+            out->unit = xstrdup(col->unit);
+            if (!out->name || !out->unit)
+                failed = 1;
+            else
+                snprintf(out->name, ln, "%s(%s)", k ? "rss" : "worst", col->name);
+        }
+    for (int r = 0; r < t->nrows; r++) {
+        double *row = v + (size_t)r * wide;
+        memcpy(row, t->values + (size_t)r * old, (size_t)old * sizeof *v);
+        for (int c = 0; c < nc; c++) {
+            double worst = 0, sq = 0;
+            for (int k = 0; k < np; k++) {
+                double dev = vals[((size_t)r * np + k) * nc + c] * m->params[which[k]].tol;
+                worst += fabs(dev);  /* sum |dCOL/dp| tol_p */
+                sq += dev * dev;
+            }
+            row[old + 2 * c] = worst;
+            row[old + 2 * c + 1] = sqrt(sq);  /* root-sum-square */
+        }
+    }
+    free(t->columns);
+    free(t->values);
+    t->columns = cn;
+    t->values = v;
+    t->ncolumns = wide;
+    return failed ? -1 : 0;
+}
+
+int mech_tolerances(const mech_model *m, const mech_override *ov, int nov,
+                    const mech_solve_options *o, mech_table *table, mech_diag *d)
+{
+    int np = 0, nc = 0, *which = xcalloc((size_t)m->nparams + 1, sizeof *which);
     sens_col *cols = xcalloc((size_t)table->ncolumns + 1, sizeof *cols);
     double *vals = NULL;
     if (!which || !cols) {
@@ -272,27 +371,16 @@ int mech_sensitivity(const mech_model *m, const mech_override *ov, int nov,
         free(cols);
         return diag_error(d, m->file, (mech_mark){0, 0}, "out of memory"), MECH_ENOMEM;
     }
-    int rc = find_params(m, names, nnames, which, d);
-    if (rc == MECH_OK && !m->file)
-        rc = diag_error(d, "<model>", (mech_mark){0, 0}, "sensitivities need the model's file");
-    if (rc != MECH_OK || (rc = sens_plan_new(&sp, m, ov, nov, which, nnames, d)) != MECH_OK)
-        goto out;
-    if (plan_columns(&sp, table, cols, &nc) < 0)
-        rc = diag_error(d, m->file, (mech_mark){0, 0}, "out of memory");
+    for (int i = 0; i < m->nparams; i++)
+        if (m->params[i].tol > 0)
+            which[np++] = i;
+    int rc = np ? MECH_OK
+                : diag_error(d, m->file, (mech_mark){0, 0}, "--tolerances: no parameter has a "
+                             "tolerance (write one as r: {value: 40 mm, tolerance: 0.05 mm})");
     if (rc == MECH_OK)
-        rc = sens_plan_compile(&sp, d);
-    if (rc == MECH_OK)
-        rc = solve_states(m, o, &x, d);
-    vals = rc == MECH_OK ? xcalloc((size_t)table->nrows * nnames * nc + 1, sizeof *vals) : NULL;
-    if (rc == MECH_OK && !vals)
+        rc = sensitivities(m, ov, nov, o, which, np, table, cols, &nc, &vals, d);
+    if (rc == MECH_OK && add_stackup(table, m, which, np, cols, nc, vals) < 0)
         rc = diag_error(d, m->file, (mech_mark){0, 0}, "out of memory");
-    if (rc == MECH_OK)
-        rc = fill_rows(&sp, table, &x, nnames, cols, nc, vals, d);
-    if (rc == MECH_OK && widen(table, m, which, nnames, cols, nc, vals) < 0)
-        rc = diag_error(d, m->file, (mech_mark){0, 0}, "out of memory");
-    sens_plan_free(&sp);
-out:
-    mech_table_free(&x);
     free(vals);
     free(which);
     free(cols);

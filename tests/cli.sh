@@ -472,4 +472,22 @@ if run "mech solve --sensitivity, unknown name" 2 "$MECH" solve mechanisms/offse
     has_line "$tmp/err" "no parameter 'rr' in the file (its parameters: r, l, e)" "sensitivity: unknown name"
 fi
 
+# issue 20 item 4: tolerances
+sed 's/^  r: 40 mm .*/  r: {value: 40 mm, tolerance: 0.05 mm}/; s/^  l: 120 mm .*/  l: {value: 120 mm, tolerance: 0.1 mm}/' \
+    mechanisms/offset-slider-crank.yaml >"$tmp/tol.yaml"
+if run "mech solve --tolerances" 0 "$MECH" solve "$tmp/tol.yaml" -q --tolerances --outputs B -o "$tmp/tol.csv"; then
+    has_line "$tmp/err" '^mech solve: tolerance stack-up, first order, from r +-5e-05 m l +-0.0001 m; largest over the 361 rows:$' "tolerances: summary head"
+    # by hand at q = 240 deg: |dx/dr| tol_r + |dx/dl| tol_l = 1.05371 * 5e-5 + 1.18692 * 1e-4 (docs/sensitivity.md)
+    has_line "$tmp/err" '^  B.x  *worst case 0.000171378  *RSS 0.000130621  *\[m\] (worst at q = 4.18879)$' "tolerances: B.x stack-up"
+    has_line "$tmp/tol.csv" '^q \[rad\],B.x \[m\],.*,worst(B.x) \[m\],rss(B.x) \[m\],' "tolerances: columns"
+fi
+sed 's/tolerance: 0.05 mm/tolerance: 0.05/' "$tmp/tol.yaml" >"$tmp/tol-bad.yaml"
+if run "tolerance without a unit" 2 "$MECH" check "$tmp/tol-bad.yaml"; then
+    has_line "$tmp/err" "tol-bad.yaml:53:32: error: tolerance of parameter 'r' must be in the value's unit (m), not '0.05'" "tolerance: unit"
+    [ "$(wc -l <"$tmp/err")" -eq 1 ] && pass || fail "tolerance without a unit: echoed errors: $(cat "$tmp/err")"
+fi
+if run "mech solve --tolerances without tolerances" 2 "$MECH" solve mechanisms/offset-slider-crank.yaml -q --tolerances; then
+    has_line "$tmp/err" "no parameter has a tolerance" "tolerances: none"
+fi
+
 summary

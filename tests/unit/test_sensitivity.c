@@ -15,11 +15,13 @@
 #include <complex.h>
 #include <criterion/criterion.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "helpers.h"
+#include "internal.h"
 
 static const char fourbar_yaml[] =
     "name: four-bar with parameters\n"
@@ -250,6 +252,95 @@ Test(sensitivity, an_unknown_parameter_is_an_error_naming_the_known_ones)
     cr_expect(strstr(d.entries[d.count - 1].message, "no parameter 'rr' in the file (its "
                                                      "parameters: r, l, e)"),
               "%s", d.entries[d.count - 1].message);
+    mech_table_free(&t);
+    mech_diag_free(&d);
+    mech_model_free(&m);
+}
+
+/* ---- tolerance stack-up against a Monte Carlo sweep -------------------- */
+
+/* The offset slider-crank with r = 40 +- 0.05 mm and l = 120 +- 0.1 mm. */
+static const char *toleranced_path(void)
+{
+    static const char path[] = "build/test_sensitivity_tol.yaml";
+    FILE *in = fopen("mechanisms/offset-slider-crank.yaml", "r"), *out = fopen(path, "w");
+    cr_assert(in && out);
+    char line[512];
+    while (fgets(line, sizeof line, in)) {
+        if (strncmp(line, "  r: 40 mm", 10) == 0)
+            fputs("  r: {value: 40 mm, tolerance: 0.05 mm}\n", out);
+        else if (strncmp(line, "  l: 120 mm", 11) == 0)
+            fputs("  l: {value: 120 mm, tolerance: 0.1 mm}\n", out);
+        else
+            fputs(line, out);
+    }
+    fclose(in);
+    fclose(out);
+    return path;
+}
+
+static uint64_t lcg = 20261125;
+static double uniform(void)  /* in [-1, 1), seeded: the test is reproducible */
+{
+    lcg = lcg * 6364136223846793005u + 1442695040888963407u;
+    return (double)(lcg >> 11) / 4503599627370496.0 - 1.0;
+}
+
+/* worst(x_B.s) bounds every sample's deviation and is nearly reached at the
+ * corners; the samples' standard deviation is RSS/sqrt(3) (uniform errors
+ * of half-width tol have standard deviation tol/sqrt(3)): 10^4 samples give
+ * it to about 1 % (the 5 % bound has margin). First order: the second-order
+ * terms, about tol^2/l = 1e-7 of the deviations, are inside the margins. */
+Test(sensitivity, stackup_bounds_a_monte_carlo_sweep_of_10000_samples, .timeout = 120)
+{
+    enum { N = 10000, STEPS = 24 };
+    const char *path = toleranced_path();
+    mech_model *m = load_path(path);
+    mech_solve_options o;
+    mech_solve_options_default(&o);
+    o.has_range = 1;
+    o.from = 0;
+    o.to = 2 * 3.14159265358979323846;
+    o.steps = STEPS;
+    mech_diag d;
+    mech_diag_init(&d);
+    mech_table t = {0};
+    cr_assert_eq(mech_solve(m, &o, &t, NULL, &d), MECH_OK);
+    cr_assert_eq(mech_tolerances(m, NULL, 0, &o, &t, &d), MECH_OK);
+    int xs = mech_table_column(&t, "x_B.s"), wc = mech_table_column(&t, "worst(x_B.s)");
+    int rc = mech_table_column(&t, "rss(x_B.s)");
+    cr_assert(xs >= 0 && wc >= 0 && rc >= 0);
+    load_doc *doc = NULL;
+    cr_assert_eq(load_doc_read(path, &doc, &d), MECH_OK);
+    static double maxdev[STEPS + 1], sum2[STEPS + 1];
+    for (int i = 0; i < N; i++) {
+        char rt[64], lt[64];
+        snprintf(rt, sizeof rt, "%.17g mm", 40 + 0.05 * uniform());
+        snprintf(lt, sizeof lt, "%.17g mm", 120 + 0.1 * uniform());
+        mech_override ov[2] = {{"r", rt}, {"l", lt}};
+        mech_model *v = NULL;
+        mech_table s = {0};
+        cr_assert_eq(load_doc_model(doc, ov, 2, &v, &d), MECH_OK);
+        cr_assert_eq(mech_solve(v, &o, &s, NULL, &d), MECH_OK);
+        for (int r = 0; r <= STEPS; r++) {
+            double dev = mech_table_get(&s, r, xs) - mech_table_get(&t, r, xs);
+            maxdev[r] = fmax(maxdev[r], fabs(dev));
+            sum2[r] += dev * dev;
+        }
+        mech_table_free(&s);
+        mech_model_free(&v);
+    }
+    for (int r = 0; r <= STEPS; r++) {
+        double worst = mech_table_get(&t, r, wc), rss = mech_table_get(&t, r, rc);
+        double sigma = sqrt(sum2[r] / N);
+        cr_expect_leq(maxdev[r], worst * 1.001 + 1e-12, "row %d: a sample deviates %.6g, worst "
+                      "case %.6g", r, maxdev[r], worst);
+        cr_expect_geq(maxdev[r], 0.9 * worst, "row %d: largest sample %.6g, worst case %.6g",
+                      r, maxdev[r], worst);
+        cr_expect(fabs(sigma - rss / sqrt(3.0)) <= 0.05 * rss / sqrt(3.0),
+                  "row %d: sample sigma %.6g, RSS/sqrt(3) %.6g", r, sigma, rss / sqrt(3.0));
+    }
+    load_doc_free(&doc);
     mech_table_free(&t);
     mech_diag_free(&d);
     mech_model_free(&m);
