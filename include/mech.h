@@ -259,7 +259,8 @@ int mech_system_new(const mech_model *m, mech_system **out, mech_diag *d);
 /* The same equations for printing (mech equations): lengths and angles
  * that depend on the file's parameters appear as the parameters (`r`) or
  * as named lengths |AB| and angles <AB; the file is read again once per
- * parameter to see what depends on what. Not for solving. */
+ * parameter to see what depends on what (numbers are printed when it
+ * cannot be, or with more than 200 parameters). Not for solving. */
 int mech_system_new_named(const mech_model *m, mech_system **out, mech_diag *d);
 void mech_system_free(mech_system **s);
 int mech_system_size(const mech_system *s);   /* number of unknowns */

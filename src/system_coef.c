@@ -267,7 +267,8 @@ void sys_named_body(mech_system *s, const loop_term *t, ex *x, ex *y)
     *y = expr_mul(c, len, expr_sin(c, ang));
 }
 
-/* Parameters beyond this many are not named (one load of the file each). */
+/* Parameters beyond this many are not named (one load of the file each);
+ * nor are they when the file cannot be read again (a model from a string). */
 enum { MAX_NAMED_PARAMS = 200 };
 
 int mech_system_new_named(const mech_model *m, mech_system **out, mech_diag *d)
@@ -278,9 +279,15 @@ int mech_system_new_named(const mech_model *m, mech_system **out, mech_diag *d)
     param_grad *g = xcalloc(1, sizeof *g);
     if (!g)
         return diag_error(d, m->file, (mech_mark){0, 0}, "out of memory"), MECH_ENOMEM;
-    int rc = pgrad_build(m, NULL, 0, NULL, 0, g, d);
-    if (rc == MECH_OK)
-        rc = sys_new_with(m, SYS_NAMED, &g->view, out, d);
+    mech_diag quiet;  /* a model from a string has no file to read again: numbers */
+    mech_diag_init(&quiet);
+    int rc = pgrad_build(m, NULL, 0, NULL, 0, g, &quiet);
+    mech_diag_free(&quiet);
+    if (rc != MECH_OK) {
+        free(g);
+        return mech_system_new(m, out, d);
+    }
+    rc = sys_new_with(m, SYS_NAMED, &g->view, out, d);
     if (rc != MECH_OK) {
         pgrad_free(g);
         free(g);
