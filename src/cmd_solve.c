@@ -123,6 +123,26 @@ static int takes_value(const char *arg)
     return 0;
 }
 
+enum { MAX_SENS_NAMES = 64 };
+
+/* Split --sensitivity's list in place into names[], at most 64, different,
+ * none empty; 0 when it is not such a list. */
+static int split_names(char *list, const char **names, int *n)
+{
+    char *save = NULL;
+    size_t len = strlen(list);
+    int bad = len == 0 || list[0] == ',' || list[len - 1] == ',' || strstr(list, ",,");
+    for (char *tok = strtok_r(list, ",", &save); tok && !bad; tok = strtok_r(NULL, ",", &save)) {
+        for (int k = 0; k < *n; k++)
+            bad |= strcmp(names[k], tok) == 0;  /* a name twice: the same columns twice */
+        if (*n == MAX_SENS_NAMES)
+            bad = 1;
+        else
+            names[(*n)++] = tok;
+    }
+    return !bad;
+}
+
 /* One option with its value; returns -1 to go on, else the exit status. */
 static int parse_valued(solve_args *a, const char *arg, const char *val)
 {
@@ -135,8 +155,16 @@ static int parse_valued(solve_args *a, const char *arg, const char *val)
         a->to = val;
     else if (strcmp(arg, "--outputs") == 0)
         a->outputs = val;
-    else if (strcmp(arg, "--sensitivity") == 0)
+    else if (strcmp(arg, "--sensitivity") == 0) {
+        char *copy = strdup(val);
+        const char *names[MAX_SENS_NAMES];
+        int n = 0, ok = copy && split_names(copy, names, &n);
+        free(copy);
+        if (!ok)
+            return cmd_usage_error("solve", "--sensitivity needs at most 64 different parameter "
+                                   "names separated by commas, not '%s'", val);
         a->sens = val;
+    }
     else if (strcmp(arg, "--steps") == 0) {
         if (!cmd_parse_int(val, 1, 1000000, &a->steps))
             return cmd_usage_error("solve", "--steps needs a whole number from 1 to 1000000 (as in a file), "
@@ -406,23 +434,12 @@ static int write_rows(const solve_args *a, const mech_table *t)
 /* --sensitivity: the derivative columns added to t (mech_sensitivity). */
 static int add_sensitivity(const solve_args *a, const mech_model *m, mech_table *t)
 {
-    enum { MAX_NAMES = 64 };
-    char *list = strdup(a->sens), *save = NULL;
-    const char *names[MAX_NAMES];
+    char *list = strdup(a->sens);
+    const char *names[MAX_SENS_NAMES];
     int n = 0;
     if (!list)
         return fprintf(stderr, "mech solve: out of memory\n"), MECH_EXIT_IO;
-    for (char *tok = strtok_r(list, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
-        if (n == MAX_NAMES) {
-            free(list);
-            return cmd_usage_error("solve", "--sensitivity takes at most 64 names, not %s", a->sens);
-        }
-        names[n++] = tok;
-    }
-    if (n == 0) {
-        free(list);
-        return cmd_usage_error("solve", "--sensitivity needs parameter names, not '%s'", a->sens);
-    }
+    split_names(list, names, &n);  /* checked by parse_valued */
     mech_diag d;
     mech_diag_init(&d);
     int rc = mech_sensitivity(m, a->set, a->nset, &a->opt, names, n, t, &d);

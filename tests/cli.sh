@@ -489,5 +489,10 @@ fi
 if run "mech solve --tolerances without tolerances" 2 "$MECH" solve mechanisms/offset-slider-crank.yaml -q --tolerances; then
     has_line "$tmp/err" "no parameter has a tolerance" "tolerances: none"
 fi
+for bad in "r,,l" "r," "r,r" ""; do
+    if run "mech solve --sensitivity '$bad'" 2 "$MECH" solve mechanisms/offset-slider-crank.yaml -q --sensitivity "$bad"; then
+        has_line "$tmp/err" "sensitivity needs at most 64 different parameter names separated by commas" "sensitivity: '$bad'"
+    fi
+done
 
 summary
