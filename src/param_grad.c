@@ -65,8 +65,45 @@ static int seeded(const mech_model *m, const mech_override *ov, int nov, const c
     return MECH_OK;
 }
 
+/* The seeded load carries derivatives into the points only. A parameter
+ * that also sets a slider's angle would be differentiated without that
+ * term: found by loading the file with the parameter nudged, and refused. */
+static int check_slider_angles(const mech_model *m, const mech_override *ov, int nov,
+                               const mech_param *p, mech_diag *d)
+{
+    enum { MAX_OV = 64 };
+    mech_override all[MAX_OV + 1];
+    char text[96];
+    double nudged = p->value != 0 ? p->value * (1 + 1e-7) : 1e-7;
+    snprintf(text, sizeof text, "%.17g %s", nudged, p->unit);
+    int n = 0;
+    for (int i = 0; i < nov && n < MAX_OV; i++)
+        if (strcmp(ov[i].name, p->name) != 0)
+            all[n++] = ov[i];
+    all[n++] = (mech_override){p->name, text};
+    mech_diag quiet;
+    mech_diag_init(&quiet);
+    mech_model *nm = NULL;
+    int rc = mech_load_file_with(m->file, all, n, &nm, &quiet);
+    mech_diag_free(&quiet);
+    if (rc != MECH_OK || nm->njoints != m->njoints) {
+        mech_model_free(&nm);
+        return MECH_OK;  /* nothing to compare; the seeded load said what it could */
+    }
+    for (int j = 0; j < m->njoints; j++)
+        if (m->joints[j].kind == MECH_JOINT_SLIDER && nm->joints[j].angle != m->joints[j].angle) {
+            rc = diag_error(d, m->file, m->joints[j].mark, "parameter '%s' sets the angle of "
+                            "slider '%s': sensitivities through a slider's angle are not "
+                            "computed", p->name, m->joints[j].name);
+            mech_model_free(&nm);
+            return rc;
+        }
+    mech_model_free(&nm);
+    return MECH_OK;
+}
+
 int pgrad_build(const mech_model *m, const mech_override *ov, int nov, const int *which,
-                int nwhich, param_grad *g, mech_diag *d)
+                int nwhich, int check_angles, param_grad *g, mech_diag *d)
 {
     memset(g, 0, sizeof *g);
     int np = which ? nwhich : m->nparams;
@@ -85,6 +122,8 @@ int pgrad_build(const mech_model *m, const mech_override *ov, int nov, const int
         if (!g->names[k] || !g->dxy[k])
             goto oom;
         int rc = seeded(m, ov, nov, p->name, g->dxy[k], d);
+        if (rc == MECH_OK && check_angles)
+            rc = check_slider_angles(m, ov, nov, p, d);
         if (rc != MECH_OK) {
             pgrad_free(g);
             return rc;

@@ -14,9 +14,11 @@ typedef struct param_grad {
 
 /* The parameters which[0..nwhich-1] (indices into m->params), or all of
  * them (which NULL), each by one load of m->file with the same overrides
- * seeded with it. MECH_OK, or the loader's status with the problem in d. */
+ * seeded with it; check_angles: refuse a parameter that sets a slider's
+ * angle (not carried into the derivatives; one more load each). MECH_OK,
+ * or the loader's status with the problem in d. */
 int pgrad_build(const mech_model *m, const mech_override *ov, int nov, const int *which,
-                int nwhich, param_grad *g, mech_diag *d);
+                int nwhich, int check_angles, param_grad *g, mech_diag *d);
 void pgrad_free(param_grad *g);
 
 #endif

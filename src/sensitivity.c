@@ -228,7 +228,7 @@ int sens_plan_new(sens_plan *sp, const mech_model *m, const mech_override *ov, i
                   const int *which, int nwhich, mech_diag *d)
 {
     memset(sp, 0, sizeof *sp);
-    int rc = pgrad_build(m, ov, nov, which, nwhich, &sp->grad, d);
+    int rc = pgrad_build(m, ov, nov, which, nwhich, 1, &sp->grad, d);
     if (rc != MECH_OK)
         return rc;
     if ((rc = sys_new_with(m, SYS_CARTESIAN, NULL, &sp->sys, d)) != MECH_OK) {

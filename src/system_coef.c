@@ -281,7 +281,7 @@ int mech_system_new_named(const mech_model *m, mech_system **out, mech_diag *d)
         return diag_error(d, m->file, (mech_mark){0, 0}, "out of memory"), MECH_ENOMEM;
     mech_diag quiet;  /* a model from a string has no file to read again: numbers */
     mech_diag_init(&quiet);
-    int rc = pgrad_build(m, NULL, 0, NULL, 0, g, &quiet);
+    int rc = pgrad_build(m, NULL, 0, NULL, 0, 0, g, &quiet);
     mech_diag_free(&quiet);
     if (rc != MECH_OK) {
         free(g);

@@ -494,5 +494,11 @@ for bad in "r,,l" "r," "r,r" ""; do
         has_line "$tmp/err" "sensitivity needs at most 64 different parameter names separated by commas" "sensitivity: '$bad'"
     fi
 done
+sed 's/^  e: 30 mm .*/  e: 30 mm\n  alpha: 0 deg/; s/^    angle: 0 deg .*/    angle: alpha/' \
+    mechanisms/offset-slider-crank.yaml >"$tmp/angle.yaml"
+if run "mech solve --sensitivity, a slider's angle" 2 "$MECH" solve "$tmp/angle.yaml" -q --steps 4 --sensitivity alpha; then
+    has_line "$tmp/err" "error: parameter 'alpha' sets the angle of slider 'x_B': sensitivities through a slider's angle are not computed" "sensitivity: slider angle refused"
+fi
+run "mech solve --sensitivity r, a slider's angle elsewhere" 0 "$MECH" solve "$tmp/angle.yaml" -q --steps 4 --sensitivity r && pass
 
 summary

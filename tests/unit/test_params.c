@@ -168,7 +168,7 @@ Test(params, point_derivatives_match_hand_derivatives)
     param_grad g;
     mech_diag d;
     mech_diag_init(&d);
-    cr_assert_eq(pgrad_build(m, NULL, 0, NULL, 0, &g, &d), MECH_OK);
+    cr_assert_eq(pgrad_build(m, NULL, 0, NULL, 0, 0, &g, &d), MECH_OK);
     const double r = 0.04, phi = M_PI_ / 6, l = 3 * r + 0.01, h = sqrt(l * l + r * r);
     double dx, dy;
     /* A = r (cos phi, sin phi) */
