@@ -196,7 +196,7 @@ test-browser: $(BUILD)/mech
 bench:
 	@$(MAKE) --no-print-directory BUILD=build/bench OPT="-O2 -DNDEBUG" build/bench/bench-eval \
 	    build/bench/bench-solve build/bench/bench-hand build/bench/bench-accuracy build/bench/bench-scale \
-	    build/bench/mech build/bench/bench-alloc
+	    build/bench/mech build/bench/bench-alloc build/bench/bench-sweep
 	{ build/bench/bench-eval mechanisms/*.yaml && \
 	  build/bench/bench-solve mechanisms/*.yaml && \
 	  build/bench/bench-hand mechanisms && \
@@ -205,6 +205,7 @@ bench:
 	  build/bench/bench-accuracy mechanisms build/bench && \
 	  build/bench/bench-scale build/bench && \
 	  MECH=build/bench/mech sh bench/bench_batch.sh && \
+	  build/bench/bench-sweep mechanisms/conveyor.yaml l1 55 65 && \
 	  build/bench/bench-alloc mechanisms/*.yaml; } 2>&1 | tee build/bench/report.txt
 	sh bench/report.sh build/bench/report.txt
 
@@ -212,6 +213,9 @@ $(BUILD)/bench-eval: bench/bench_eval.c $(BUILD)/libmech.a $(HEADERS)
 	$(CC) $(CFLAGS) -Isrc -o $@ $< $(BUILD)/libmech.a $(LDLIBS)
 
 $(BUILD)/bench-solve: bench/bench_solve.c bench/bench_util.h $(BUILD)/libmech.a $(HEADERS)
+	$(CC) $(CFLAGS) -Isrc -o $@ $< $(BUILD)/libmech.a $(LDLIBS)
+
+$(BUILD)/bench-sweep: bench/bench_sweep.c $(BUILD)/libmech.a $(HEADERS)
 	$(CC) $(CFLAGS) -Isrc -o $@ $< $(BUILD)/libmech.a $(LDLIBS)
 
 $(BUILD)/bench-alloc: bench/bench_alloc.c $(BUILD)/libmech.a $(HEADERS)

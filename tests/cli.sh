@@ -510,4 +510,48 @@ if run "mech batch, progress" 0 env MECH_PROGRESS_SECONDS=0 "$MECH" batch -j 1 m
     has_line "$tmp/err" '^mech batch: 1 of 2 files (50%), [0-9]* s$' "batch: progress lines"
 fi
 
+# issue 20: parameters kept symbolic (mech equations) and sensitivities
+if run "mech equations, parameter names" 0 "$MECH" equations mechanisms/offset-slider-crank.yaml; then
+    has_line "$tmp/out" "^  f1 = l\*cos(th_rod) - x_B + r\*cos(th_crank) " "equations: r and l by name"
+    has_line "$tmp/out" "^  f2 = l\*sin(th_rod) - e + r\*sin(th_crank) " "equations: e by name"
+fi
+if run "mech solve --sensitivity" 0 "$MECH" solve mechanisms/offset-slider-crank.yaml --steps 4 -q --sensitivity r,l; then
+    has_line "$tmp/out" '^q \[rad\],.*,d(A\.x)/d(r) \[m/m\],.*,d(x_B\.a)/d(l) \[m/s^2/m\]$' "sensitivity: header"
+    # A = r (cos q, sin q): d(A.x)/d(r) = cos q, 1 at q = 0; d(A.vy)/d(r) = w cos q = 314.159...
+    ax=$(awk -F, 'NR == 2 { print $20 }' "$tmp/out")
+    [ "$ax" = "1" ] && pass || fail "sensitivity: d(A.x)/d(r) at q = 0 is '$ax', not 1"
+fi
+if run "mech solve --sensitivity, unknown name" 2 "$MECH" solve mechanisms/offset-slider-crank.yaml --steps 4 -q --sensitivity rr; then
+    has_line "$tmp/err" "no parameter 'rr' in the file (its parameters: r, l, e)" "sensitivity: unknown name"
+fi
+
+# issue 20 item 4: tolerances
+sed 's/^  r: 40 mm .*/  r: {value: 40 mm, tolerance: 0.05 mm}/; s/^  l: 120 mm .*/  l: {value: 120 mm, tolerance: 0.1 mm}/' \
+    mechanisms/offset-slider-crank.yaml >"$tmp/tol.yaml"
+if run "mech solve --tolerances" 0 "$MECH" solve "$tmp/tol.yaml" -q --tolerances --outputs B -o "$tmp/tol.csv"; then
+    has_line "$tmp/err" '^mech solve: tolerance stack-up, first order, from r +-5e-05 m l +-0.0001 m; largest over the 361 rows:$' "tolerances: summary head"
+    # by hand at q = 240 deg: |dx/dr| tol_r + |dx/dl| tol_l = 1.05371 * 5e-5 + 1.18692 * 1e-4 (docs/sensitivity.md)
+    has_line "$tmp/err" '^  B.x  *worst case 0.000171378  *RSS 0.000130621  *\[m\] (worst at q = 4.18879)$' "tolerances: B.x stack-up"
+    has_line "$tmp/tol.csv" '^q \[rad\],B.x \[m\],.*,worst(B.x) \[m\],rss(B.x) \[m\],' "tolerances: columns"
+fi
+sed 's/tolerance: 0.05 mm/tolerance: 0.05/' "$tmp/tol.yaml" >"$tmp/tol-bad.yaml"
+if run "tolerance without a unit" 2 "$MECH" check "$tmp/tol-bad.yaml"; then
+    has_line "$tmp/err" "tol-bad.yaml:53:32: error: tolerance of parameter 'r' must be in the value's unit (m), not '0.05'" "tolerance: unit"
+    [ "$(wc -l <"$tmp/err")" -eq 1 ] && pass || fail "tolerance without a unit: echoed errors: $(cat "$tmp/err")"
+fi
+if run "mech solve --tolerances without tolerances" 2 "$MECH" solve mechanisms/offset-slider-crank.yaml -q --tolerances; then
+    has_line "$tmp/err" "no parameter has a tolerance" "tolerances: none"
+fi
+for bad in "r,,l" "r," "r,r" ""; do
+    if run "mech solve --sensitivity '$bad'" 2 "$MECH" solve mechanisms/offset-slider-crank.yaml -q --sensitivity "$bad"; then
+        has_line "$tmp/err" "sensitivity needs at most 64 different parameter names separated by commas" "sensitivity: '$bad'"
+    fi
+done
+sed 's/^  e: 30 mm .*/  e: 30 mm\n  alpha: 0 deg/; s/^    angle: 0 deg .*/    angle: alpha/' \
+    mechanisms/offset-slider-crank.yaml >"$tmp/angle.yaml"
+if run "mech solve --sensitivity, a slider's angle" 2 "$MECH" solve "$tmp/angle.yaml" -q --steps 4 --sensitivity alpha; then
+    has_line "$tmp/err" "error: parameter 'alpha' sets the angle of slider 'x_B': sensitivities through a slider's angle are not computed" "sensitivity: slider angle refused"
+fi
+run "mech solve --sensitivity r, a slider's angle elsewhere" 0 "$MECH" solve "$tmp/angle.yaml" -q --steps 4 --sensitivity r && pass
+
 summary
