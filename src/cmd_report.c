@@ -302,11 +302,11 @@ static int solve_both(report_run *r)
     return cmd_exit_status(rc);
 }
 
-/* mech_system_print's text into r->equations. */
+/* mech_system_print's text into r->equations: the named system, as mech equations prints it. */
 static int equations(report_run *r)
 {
     mech_system *s = NULL;
-    if (mech_system_new(r->m, &s, &r->d) != MECH_OK)
+    if (mech_system_new_named(r->m, &s, &r->d) != MECH_OK)
         return MECH_EXIT_INPUT;
     FILE *f = open_memstream(&r->equations, &r->equations_len);
     if (f) {

@@ -188,8 +188,8 @@ grep -q "warning" "$tmp/warnings/solve.err" && pass || fail "redundant-parallelo
 WANT=1 page_of partial tests/hard/non-grashof-crank.yaml
 has_line "$tmp/err" "220 of the sweep's 361 positions were solved; the page shows them" "partial"
 WANT=1 page_of two-intervals tests/hard/non-grashof-two-intervals.yaml
-# the animation traces paths (dashed polylines) only when no gap would be bridged
-traces() { grep -c '<polyline fill="none"[^>]*stroke-dasharray' "$1"; }
+# the animation traces paths (dashed, data-trace) only when no gap would be bridged
+traces() { grep -c 'stroke-dasharray="[^"]*" data-trace=' "$1"; }
 [ "$(traces "$tmp/fourbar/page.html")" -gt 0 ] && pass || fail "the four-bar's page traces no path"
 [ "$(traces "$tmp/partial/page.html")" = 0 ] && pass || fail "a partial page traces paths across its gap"
 # --set: the page is that of the file with the parameter replaced
