@@ -127,6 +127,10 @@ else
     fail "codegen without --header: $(cat "$tmp/err" "$tmp/cc" | head -n 2)"
 fi
 
+# a mechanism's name that would end a C comment early
+sed 's|^name: .*|name: "ends a comment */ early"|' mechanisms/fourbar.yaml >"$tmp/comment.yaml"
+build "$tmp/comment" "$tmp/comment.yaml"
+
 # ---- bad input ----
 run "unknown file" 3 "$MECH" codegen "$tmp/no-such.yaml" -o "$tmp/x.c" && pass
 run "invalid file" 2 "$MECH" codegen tests/bad/25-loop-unknown-point.yaml -o "$tmp/x.c" &&
@@ -139,6 +143,8 @@ run "output is the input" 2 "$MECH" codegen "$tmp/input.yaml" -o "$tmp/input.yam
 run "header is the input" 2 "$MECH" codegen "$tmp/input.yaml" -o "$tmp/y.c" --header "$tmp/input.yaml"
 cmp -s mechanisms/fourbar.yaml "$tmp/input.yaml" && pass || fail "the input was changed"
 [ ! -e "$tmp/y.c" ] && pass || fail "a refused run wrote its source"
+run "header name with a quote" 2 "$MECH" codegen mechanisms/fourbar.yaml -o "$tmp/q.c" \
+    --header "$tmp/a\"b.h" && has_line "$tmp/err" "cannot be #included" "header name with a quote"
 run "header is the source" 2 "$MECH" codegen mechanisms/fourbar.yaml -o "$tmp/z.c" --header "$tmp/z.c" && pass
 run "no output" 2 "$MECH" codegen mechanisms/fourbar.yaml && pass
 run "no file" 2 "$MECH" codegen -o "$tmp/x.c" && pass
