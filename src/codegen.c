@@ -507,9 +507,12 @@ int codegen_emit_source(FILE *f, const void *ctx)
         fprintf(f, "#include \"%s\"\n\n", g->opt.header);
     else
         emit_declarations(g, f);
+    /* macros and a typedef, not new enumerators: --prefix cg must not redeclare
+       CG_OK (the fixed text's static names avoid P_solve, P_init, P_predict too) */
     fprintf(f, "typedef %s_state cg_state;\n"
-               "enum { CG_OK = %s_OK, CG_NO_ASSEMBLY = %s_NO_ASSEMBLY, CG_SINGULAR = %s_SINGULAR,"
-               " CG_BRANCH = %s_BRANCH };\n\n", g->lower, g->upper, g->upper, g->upper, g->upper);
+               "#define CG_OK %s_OK\n#define CG_NO_ASSEMBLY %s_NO_ASSEMBLY\n"
+               "#define CG_SINGULAR %s_SINGULAR\n#define CG_BRANCH %s_BRANCH\n\n",
+            g->lower, g->upper, g->upper, g->upper, g->upper);
     if (emit_pattern(g, f) < 0 || codegen_expr_emit(g, f) < 0)
         return -1;
     for (int i = 0; codegen_runtime[i]; i++)

@@ -127,6 +127,14 @@ else
     fail "codegen without --header: $(cat "$tmp/err" "$tmp/cc" | head -n 2)"
 fi
 
+# prefixes that meet the source's own names (CG_OK, the static block_solve
+# of an earlier version) compile
+for p in cg block linear newton; do
+    "$MECH" codegen mechanisms/stirling.yaml -o "$tmp/$p.c" --prefix $p 2>"$tmp/err" &&
+        $CC $CFLAGS_GEN -c -o "$tmp/$p.o" "$tmp/$p.c" 2>"$tmp/cc" && pass ||
+        fail "--prefix $p: $(cat "$tmp/err" "$tmp/cc" | head -n 2)"
+done
+
 # a mechanism's name that would end a C comment early
 sed 's|^name: .*|name: "ends a comment */ early"|' mechanisms/fourbar.yaml >"$tmp/comment.yaml"
 build "$tmp/comment" "$tmp/comment.yaml"
