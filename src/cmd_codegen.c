@@ -81,6 +81,9 @@ static int parse(int argc, char **argv, codegen_args *a)
     if (a->header && (strcmp(a->header, "-") == 0 || strcmp(a->header, a->out) == 0))
         return cmd_usage_error("codegen", "the header must be a file other than the source "
                                "('%s')", a->header);
+    if (a->header && strpbrk(a->header, "\"\\\n"))
+        return cmd_usage_error("codegen", "the header's name cannot be #included: it has a "
+                               "quote, a backslash or a line break ('%s')", a->header);
     const char *inputs[] = {a->file};
     int refused = cmd_refuse_input("codegen", a->out, inputs, 1);
     if (refused < 0 && a->header)

@@ -127,6 +127,18 @@ else
     fail "codegen without --header: $(cat "$tmp/err" "$tmp/cc" | head -n 2)"
 fi
 
+# prefixes that meet the source's own names (CG_OK, the static block_solve
+# of an earlier version) compile
+for p in cg block linear newton; do
+    "$MECH" codegen mechanisms/stirling.yaml -o "$tmp/$p.c" --prefix $p 2>"$tmp/err" &&
+        $CC $CFLAGS_GEN -c -o "$tmp/$p.o" "$tmp/$p.c" 2>"$tmp/cc" && pass ||
+        fail "--prefix $p: $(cat "$tmp/err" "$tmp/cc" | head -n 2)"
+done
+
+# a mechanism's name that would end a C comment early
+sed 's|^name: .*|name: "ends a comment */ early"|' mechanisms/fourbar.yaml >"$tmp/comment.yaml"
+build "$tmp/comment" "$tmp/comment.yaml"
+
 # ---- bad input ----
 run "unknown file" 3 "$MECH" codegen "$tmp/no-such.yaml" -o "$tmp/x.c" && pass
 run "invalid file" 2 "$MECH" codegen tests/bad/25-loop-unknown-point.yaml -o "$tmp/x.c" &&
@@ -139,6 +151,8 @@ run "output is the input" 2 "$MECH" codegen "$tmp/input.yaml" -o "$tmp/input.yam
 run "header is the input" 2 "$MECH" codegen "$tmp/input.yaml" -o "$tmp/y.c" --header "$tmp/input.yaml"
 cmp -s mechanisms/fourbar.yaml "$tmp/input.yaml" && pass || fail "the input was changed"
 [ ! -e "$tmp/y.c" ] && pass || fail "a refused run wrote its source"
+run "header name with a quote" 2 "$MECH" codegen mechanisms/fourbar.yaml -o "$tmp/q.c" \
+    --header "$tmp/a\"b.h" && has_line "$tmp/err" "cannot be #included" "header name with a quote"
 run "header is the source" 2 "$MECH" codegen mechanisms/fourbar.yaml -o "$tmp/z.c" --header "$tmp/z.c" && pass
 run "no output" 2 "$MECH" codegen mechanisms/fourbar.yaml && pass
 run "no file" 2 "$MECH" codegen -o "$tmp/x.c" && pass
