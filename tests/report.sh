@@ -197,6 +197,16 @@ sed 's/^  l: 140 mm /  l: 150 mm /' mechanisms/slider-crank.yaml >"$tmp/slider-c
 grep -q "l: 150 mm" "$tmp/slider-crank-150.yaml" && pass || fail "slider-crank.yaml has no 'l: 140 mm'"
 REPORT_ONLY="--set l=150mm" OTHER=$tmp/slider-crank-150.yaml PLOT_ALL=0 page_of set mechanisms/slider-crank.yaml
 
+# markup in the file's name stays text: the page is well-formed and has
+# only its own two </script>
+sed 's/^name: .*/name: "Crank <b>rocker<\/b> \& \\"co\\" <\/script><!--"/' $four >"$tmp/markup.yaml"
+rrun "markup in the name" 0 "$MECH" report "$tmp/markup.yaml" -o "$tmp/markup.html"
+grep -q '<h1>Crank &lt;b&gt;rocker&lt;/b&gt; &amp; &quot;co&quot; &lt;/script&gt;&lt;!--</h1>' \
+    "$tmp/markup.html" && pass || fail "the name's markup is not escaped in the heading"
+[ "$(grep -c '</script>' "$tmp/markup.html")" = 2 ] && pass || fail "a </script> from the file's name"
+python3 -c 'import sys, xml.dom.minidom; xml.dom.minidom.parse(sys.argv[1])' "$tmp/markup.html" &&
+    pass || fail "markup in the name: not well-formed"
+
 # --frames: the slider's positions are rows spread evenly
 rrun "frames" 0 "$MECH" report $four --frames 5 -o "$tmp/f.html"
 rows=$(sed -n 's/^\[\([0-9]*\),.*/\1/p' "$tmp/f.html" | paste -sd, -)

@@ -17,8 +17,8 @@
 #      centroid is within 1 px of row K's position; between K1 and K2 the
 #      discs moved;
 #   3. Play (REPORT.html#play&test: the button clicked through the DOM): 1 s
-#      into the 4 s pass the slider is at a quarter of the rows (+-5 %) and
-#      the values shown are that row's;
+#      later the animation has run and the slider has followed it (at the
+#      row of the animation's time) with the values of that row;
 #   4. a screenshot of the whole page (device scale 0.5): the animation and
 #      every figure (as many as `mech plot` draws) are drawn, not blank.
 #
@@ -106,7 +106,7 @@ for name in ${REPORT_MECHS:-stirling offset-slider-crank}; do
     $CHECK moved "$dir/slider0.txt" "$dir/slider$((rows / 3)).txt" 10 ||
         fail "$name: the drawing did not follow the slider"
 
-    # Play: 1 s of the 4 s pass later the slider has followed the animation
+    # Play: 1 s later the slider has followed the animation
     browse "file://$page#play&test" 1400,1000 1 --virtual-time-budget=4000 --dump-dom \
         >"$dir/dom-play.html" 2>"$dir/chromium.log" || fail "$name: chromium --dump-dom (play)"
     $CHECK play "$dir/dom-play.html" "$dir/solve.csv" "$rows" || fail "$name: Play"
