@@ -351,72 +351,18 @@ static int animation(report_run *r)
 /* ---- A partial sweep: the gaps said as mech solve says them
  * (src/cmd_solve.c, print_gaps), and figures whose curves break there. */
 
-/* Requested driver position i (as mech_analysis_new lists them). */
-static double requested_q(const report_run *r, int i)
-{
-    if (!r->o.has_range)
-        return r->m->driver.values[i];
-    int steps = r->o.steps > 0 ? r->o.steps : 1;
-    return i == steps ? r->o.to : r->o.from + (r->o.to - r->o.from) * i / steps;
-}
-
-/* A driver position in deg or mm with `decimals` decimals. */
-static void q_text(const mech_model *m, double q, int decimals, char *buf, size_t size)
-{
-    int angle = m->driver.kind == MECH_DRIVE_ANGLE;
-    snprintf(buf, size, "%.*f %s", decimals, angle ? q * 57.295779513082321 : q * 1e3,
-             angle ? "deg" : "mm");
-}
-
-/* Decimals a limit found to 1e-12 of the row spacing h deserves, bounded by
- * the position's own rounding (as mech solve). */
-static int limit_decimals(const mech_model *m, double q, double h)
-{
-    double unit = m->driver.kind == MECH_DRIVE_ANGLE ? 57.295779513082321 : 1e3;
-    double acc = fmax(1e-12 * fabs(h), 1e-11 * fmax(fabs(q), fabs(h))) * unit;
-    int d = (int)floor(-log10(acc));
-    return d < 0 ? 0 : d > 12 ? 12 : d;
-}
-
-static const char *gap_words(mech_gap_kind k)
-{
-    switch (k) {
-    case MECH_GAP_NO_ASSEMBLY: return "the mechanism does not assemble";
-    case MECH_GAP_DEAD_POINT: return "a dead point or limit position the driver cannot pass";
-    case MECH_GAP_CHANGE_POINT: return "a change point, where two assembly branches cross";
-    case MECH_GAP_BRANCH: return "the mechanism leaves the declared branch";
-    default: return "the solution jumps to another assembly";
-    }
-}
-
 /* One line per gap into r->gap_lines, printed on stderr as mech solve
  * prints them ("mech report: gap: ..."). */
 static int gap_lines(report_run *r)
 {
     const mech_table *t = &r->t;
-    int n = t->nrequested;
     if (t->ngaps == 0)
         return MECH_EXIT_OK;
     if (!(r->gap_lines = calloc((size_t)t->ngaps, sizeof *r->gap_lines)))
         return fprintf(stderr, "mech report: out of memory\n"), MECH_EXIT_IO;
-    double h = n > 1 ? fabs(requested_q(r, n - 1) - requested_q(r, 0)) / (n - 1) : 1.0;
     for (int i = 0; i < t->ngaps; i++) {
-        const mech_gap *g = &t->gaps[i];
-        char q1[64], q2[64], l1[64] = "", l2[64] = "", rows[200], line[600];
-        q_text(r->m, requested_q(r, g->first_row), 6, q1, sizeof q1);
-        q_text(r->m, requested_q(r, g->last_row), 6, q2, sizeof q2);
-        if (g->from_limit)
-            q_text(r->m, g->from, limit_decimals(r->m, g->from, h), l1, sizeof l1);
-        if (g->to_limit)
-            q_text(r->m, g->to, limit_decimals(r->m, g->to, h), l2, sizeof l2);
-        if (g->first_row == g->last_row)
-            snprintf(rows, sizeof rows, "row %d of %d (driver at %s)", g->first_row + 1, n, q1);
-        else
-            snprintf(rows, sizeof rows, "rows %d to %d of %d (driver at %s to %s)",
-                     g->first_row + 1, g->last_row + 1, n, q1, q2);
-        snprintf(line, sizeof line, "%s not solved: %s%s%s%s%s%s", rows, gap_words(g->kind),
-                 l1[0] || l2[0] ? "; limits found: " : "", l1[0] ? "from " : "", l1,
-                 l1[0] && l2[0] ? " to " : l2[0] ? "to " : "", l2);
+        char line[600];
+        cmd_gap_line(r->m, &r->o, t, i, line, sizeof line);
         fprintf(stderr, "mech report: gap: %s\n", line);
         if (!(r->gap_lines[i] = strdup(line)))
             return fprintf(stderr, "mech report: out of memory\n"), MECH_EXIT_IO;

@@ -292,68 +292,13 @@ static void print_stats(const mech_model *m, const mech_solve_stats *st, FILE *o
             per * 1e6, st->seconds, st->setup_seconds);
 }
 
-/* Requested driver position i (as mech_analysis_new lists them). */
-static double requested_q(const solve_args *a, const mech_model *m, int i)
-{
-    if (!a->opt.has_range)
-        return m->driver.values[i];
-    int steps = a->opt.steps > 0 ? a->opt.steps : 1;
-    return i == steps ? a->opt.to : a->opt.from + (a->opt.to - a->opt.from) * i / steps;
-}
-
-/* A driver position as users read it: degrees or millimetres, with
- * `decimals` decimals. */
-static void q_text(const mech_model *m, double q, int decimals, char *buf, size_t size)
-{
-    int angle = m->driver.kind == MECH_DRIVE_ANGLE;
-    snprintf(buf, size, "%.*f %s", decimals, angle ? q * 57.295779513082321 : q * 1e3,
-             angle ? "deg" : "mm");
-}
-
-/* Decimals that a limit found to 1e-12 of the row spacing h deserves,
- * bounded by the position's own rounding floor (about 1e-11 of it, rad or m). */
-static int limit_decimals(const mech_model *m, double q, double h)
-{
-    double unit = m->driver.kind == MECH_DRIVE_ANGLE ? 57.295779513082321 : 1e3;
-    double acc = fmax(1e-12 * fabs(h), 1e-11 * fmax(fabs(q), fabs(h))) * unit;
-    int d = (int)floor(-log10(acc));
-    return d < 0 ? 0 : d > 12 ? 12 : d;
-}
-
-static const char *gap_words(mech_gap_kind k)
-{
-    switch (k) {
-    case MECH_GAP_NO_ASSEMBLY: return "the mechanism does not assemble";
-    case MECH_GAP_DEAD_POINT: return "a dead point or limit position the driver cannot pass";
-    case MECH_GAP_CHANGE_POINT: return "a change point, where two assembly branches cross";
-    case MECH_GAP_BRANCH: return "the mechanism leaves the declared branch";
-    default: return "the solution jumps to another assembly";
-    }
-}
-
 /* One line per gap: the rows missing, why, and the limits found. */
 static void print_gaps(const solve_args *a, const mech_model *m, const mech_table *t)
 {
+    char line[600];
     for (int i = 0; i < t->ngaps; i++) {
-        const mech_gap *g = &t->gaps[i];
-        int n = t->nrequested;
-        double h = n > 1 ? fabs(requested_q(a, m, n - 1) - requested_q(a, m, 0)) / (n - 1) : 1.0;
-        char q1[64], q2[64], l1[64] = "", l2[64] = "";
-        q_text(m, requested_q(a, m, g->first_row), 6, q1, sizeof q1);
-        q_text(m, requested_q(a, m, g->last_row), 6, q2, sizeof q2);
-        if (g->from_limit)
-            q_text(m, g->from, limit_decimals(m, g->from, h), l1, sizeof l1);
-        if (g->to_limit)
-            q_text(m, g->to, limit_decimals(m, g->to, h), l2, sizeof l2);
-        char rows[200];
-        if (g->first_row == g->last_row)
-            snprintf(rows, sizeof rows, "row %d of %d (driver at %s)", g->first_row + 1, n, q1);
-        else
-            snprintf(rows, sizeof rows, "rows %d to %d of %d (driver at %s to %s)",
-                     g->first_row + 1, g->last_row + 1, n, q1, q2);
-        fprintf(stderr, "mech solve: gap: %s not solved: %s%s%s%s%s%s\n", rows, gap_words(g->kind),
-                l1[0] || l2[0] ? "; limits found: " : "", l1[0] ? "from " : "", l1,
-                l1[0] && l2[0] ? " to " : l2[0] ? "to " : "", l2);
+        cmd_gap_line(m, &a->opt, t, i, line, sizeof line);
+        fprintf(stderr, "mech solve: gap: %s\n", line);
     }
 }
 

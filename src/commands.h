@@ -95,6 +95,12 @@ int cmd_codegen(int argc, char **argv);
 extern const char cmd_merge_help[];
 int cmd_merge(int argc, char **argv);
 
+/* Gap i of a partial sweep t, as `mech solve` and `mech report` print it
+ * ("rows 3 to 9 of 361 (driver at ...) not solved: why; limits found: ...");
+ * o are the options the sweep was solved with (cmd_gaps.c). */
+void cmd_gap_line(const mech_model *m, const mech_solve_options *o, const mech_table *t, int i,
+                  char *line, size_t size);
+
 /* `mech compare [options] OUT.csv GOLDEN.csv` (cmd_compare.c): argv[0] is
  * "compare"; returns the exit code. */
 extern const char cmd_compare_help[];
