@@ -135,6 +135,16 @@ static int split_names(char *list, const char **names, int *n)
     return !bad;
 }
 
+/* Is --sensitivity's list well formed (split_names on a copy)? */
+static int valid_names(const char *val)
+{
+    char *copy = strdup(val);
+    const char *names[MAX_SENS_NAMES];
+    int n = 0, ok = copy && split_names(copy, names, &n);
+    free(copy);
+    return ok;
+}
+
 /* One option with its value; returns -1 to go on, else the exit status. */
 static int parse_valued(solve_args *a, const char *arg, const char *val)
 {
@@ -148,11 +158,7 @@ static int parse_valued(solve_args *a, const char *arg, const char *val)
     else if (strcmp(arg, "--outputs") == 0)
         a->outputs = val;
     else if (strcmp(arg, "--sensitivity") == 0) {
-        char *copy = strdup(val);
-        const char *names[MAX_SENS_NAMES];
-        int n = 0, ok = copy && split_names(copy, names, &n);
-        free(copy);
-        if (!ok)
+        if (!valid_names(val))
             return cmd_usage_error("solve", "--sensitivity needs at most 64 different parameter "
                                    "names separated by commas, not '%s'", val);
         a->sens = val;

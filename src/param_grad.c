@@ -18,6 +18,7 @@ void pgrad_free(param_grad *g)
     }
     free(g->names);
     free(g->values);
+    free(g->units);
     free(g->dxy);
     memset(g, 0, sizeof *g);
 }
@@ -110,13 +111,15 @@ int pgrad_build(const mech_model *m, const mech_override *ov, int nov, const int
     size_t npts = 2 * (size_t)total_points(m) + 1;
     g->names = xcalloc((size_t)np + 1, sizeof *g->names);
     g->values = xcalloc((size_t)np + 1, sizeof *g->values);
+    g->units = xcalloc((size_t)np + 1, sizeof *g->units);
     g->dxy = xcalloc((size_t)np + 1, sizeof *g->dxy);
-    if (!g->names || !g->values || !g->dxy)
+    if (!g->names || !g->values || !g->units || !g->dxy)
         goto oom;
     for (int k = 0; k < np; k++) {
         const mech_param *p = &m->params[which ? which[k] : k];
         g->names[k] = xstrdup(p->name);
         g->values[k] = p->value;
+        g->units[k] = p->unit;
         g->dxy[k] = xcalloc(npts, sizeof *g->dxy[k]);
         g->view.nparams = k + 1;
         if (!g->names[k] || !g->dxy[k])
@@ -131,6 +134,7 @@ int pgrad_build(const mech_model *m, const mech_override *ov, int nov, const int
     }
     g->view.names = (const char *const *)g->names;
     g->view.values = g->values;
+    g->view.units = g->units;
     g->view.dxy = g->dxy;
     return MECH_OK;
 oom:

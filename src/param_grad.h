@@ -9,6 +9,7 @@ typedef struct param_grad {
     sys_params view;   /* what sys_new_with(SYS_NAMED) and sensitivity.c read */
     char **names;      /* [view.nparams] owned */
     double *values;    /* [view.nparams] SI */
+    const char **units; /* [view.nparams] borrowed from the model's mech_param.unit */
     double **dxy;      /* [view.nparams] -> [2 * points of all links, link by link] */
 } param_grad;
 

@@ -48,7 +48,8 @@ static void print_coefficients(const mech_system *s, FILE *out)
         if (s->coef_desc[k])
             fprintf(out, "  %s\n", s->coef_desc[k]);
         else
-            fprintf(out, "  %s = %.10g\n", s->names[first + k], s->params->values[k]);
+            fprintf(out, "  %s = %.10g%s%s\n", s->names[first + k], s->params->values[k],
+                    s->params->units[k][0] ? " " : "", s->params->units[k]);
     }
     fputc('\n', out);
 }
@@ -157,7 +158,9 @@ static void latex_coefficients(const mech_system *s, FILE *out)
     fputs("\\subsection*{Parameters (SI units)}\n\\begin{itemize}\n", out);
     for (int k = 0; k < ncoef; k++) {
         if (!s->coef_desc[k]) {
-            fprintf(out, "\\item $%s = %.10g$\n", s->latex[first + k], s->params->values[k]);
+            fprintf(out, "\\item $%s = %.10g$ ", s->latex[first + k], s->params->values[k]);
+            latex_text(s->params->units[k], out);  /* kg/m^3: ^ escaped */
+            fputc('\n', out);
             continue;
         }
         fprintf(out, "\\item $%s$", s->latex[first + k]);

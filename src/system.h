@@ -42,6 +42,7 @@ typedef struct sys_params {
     int nparams;
     const char *const *names;   /* [nparams] */
     const double *values;       /* [nparams] SI */
+    const char *const *units;   /* [nparams] their SI units ("" for a bare number) */
     double **dxy;               /* [nparams] -> [2 * points of all links, link by link] */
 } sys_params;
 

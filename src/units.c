@@ -579,7 +579,7 @@ static qval parse_term(qparser *p)
                 qfail(p, at, "division by zero");
                 return a;
             }
-            a.dv = (a.dv * b.v - a.v * b.dv) / (b.v * b.v);
+            a.dv = a.dv / b.v - (a.v / b.v) * (b.dv / b.v);  /* (a/b)' without b^2 underflowing */
             a.v /= b.v;
         }
         a.d = dim_add(a.d, b.d, *at == '*' ? 1 : -1);
