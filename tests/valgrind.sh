@@ -39,5 +39,7 @@ check "mech solve --tolerances" solve "$tmp/tol.yaml" --tolerances --sensitivity
 check "mech solve --sensitivity, unknown name" solve mechanisms/conveyor.yaml --sensitivity zz -q
 check "mech plot" plot mechanisms/fourbar.yaml --out "$tmp/plots"
 check "mech animate" animate mechanisms/fourbar.yaml -o "$tmp/a.svg"
+check "mech report --forces" report mechanisms/fourbar.yaml --forces -o "$tmp/r.html"
+check "mech report, a partial sweep" report tests/hard/non-grashof-crank.yaml -o "$tmp/p.html"
 echo "valgrind: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]
