@@ -88,6 +88,8 @@ static int place_entries(blocklu_plan *b, const int *Ap, const int *Ai, const in
 
 int blocklu_analyze(blocklu_plan *b, int n, const int *Ap, const int *Ai, int max_block)
 {
+    if (max_block > BLOCKLU_MAX_BLOCK)  /* block_factor_general's row list holds that many */
+        max_block = BLOCKLU_MAX_BLOCK;
     memset(b, 0, sizeof *b);
     b->n = n;
     b->P = xcalloc((size_t)n + 1, sizeof *b->P);

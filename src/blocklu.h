@@ -43,7 +43,7 @@ typedef struct blocklu {
 
 /* Block triangular form of the pattern (Ap, Ai: CSC, n columns). Returns 0,
  * 1 when the pattern is structurally singular, 2 when some diagonal block is
- * larger than max_block, -1 when out of memory. */
+ * larger than max_block (at most BLOCKLU_MAX_BLOCK), -1 when out of memory. */
 int blocklu_analyze(blocklu_plan *b, int n, const int *Ap, const int *Ai, int max_block);
 void blocklu_plan_free(blocklu_plan *b);
 /* Workspace and factors for values of the plan's pattern; -1 when out of memory. */
