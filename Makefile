@@ -4,7 +4,7 @@
 #   make run        deps + build + the main job: solve the Stirling engine
 #   make test       deps + build + the full test suite
 #   make test-san   the test suite built with -fsanitize=address,undefined
-#   make test-browser  figures and animation rendered by headless chromium
+#   make test-browser  figures, animation and report rendered by headless chromium
 #   make test-slurm    docs/batch.md's Slurm recipes on a single-node Slurm (root)
 #   make bench      optimised benchmarks, printed as tables
 #   make golden     regenerate tests/golden/*.csv (review the diff by hand)
@@ -142,6 +142,8 @@ test: deps
 	MECH=$(BUILD)/mech sh tests/files.sh
 	MECH=$(BUILD)/mech sh tests/golden.sh
 	MECH=$(BUILD)/mech MECH_SANITIZE=$(if $(SAN),1,) sh tests/sweep.sh
+	MECH=$(BUILD)/mech MECH_SANITIZE=$(if $(SAN),1,) sh tests/codegen.sh
+	MECH=$(BUILD)/mech sh tests/report.sh
 	MECH=$(BUILD)/mech sh tests/parallel/recipes.sh
 	@$(MAKE) --no-print-directory test-install test-python
 
@@ -183,22 +185,27 @@ fuzz-replay:
 test-valgrind: $(BUILD)/mech
 	MECH=$(BUILD)/mech sh tests/valgrind.sh
 
-# Figures and animation seen by headless chromium (docs/plots.md).
+# Figures, animation and the HTML report seen by headless chromium
+# (docs/plots.md, docs/report.md).
 test-browser: $(BUILD)/mech
 	MECH=$(BUILD)/mech OUT=$(BUILD)/browser sh tests/browser/run.sh
+	MECH=$(BUILD)/mech OUT=$(BUILD)/browser-report sh tests/browser/report.sh
 
 # Benchmarks: optimised, no sanitizers; prints tables and writes them, with
 # the plots, into docs/performance.md (bench/report.sh).
 bench:
 	@$(MAKE) --no-print-directory BUILD=build/bench OPT="-O2 -DNDEBUG" build/bench/bench-eval \
 	    build/bench/bench-solve build/bench/bench-hand build/bench/bench-accuracy build/bench/bench-scale \
-	    build/bench/mech build/bench/bench-alloc
+	    build/bench/mech build/bench/bench-alloc build/bench/bench-sweep
 	{ build/bench/bench-eval mechanisms/*.yaml && \
 	  build/bench/bench-solve mechanisms/*.yaml && \
 	  build/bench/bench-hand mechanisms && \
+	  MECH=build/bench/mech BUILD=build/bench sh bench/bench_codegen.sh && \
+	  sh bench/bench_ratio.sh build/bench/bench-hand && \
 	  build/bench/bench-accuracy mechanisms build/bench && \
 	  build/bench/bench-scale build/bench && \
 	  MECH=build/bench/mech sh bench/bench_batch.sh && \
+	  build/bench/bench-sweep mechanisms/conveyor.yaml l1 55 65 && \
 	  build/bench/bench-alloc mechanisms/*.yaml; } 2>&1 | tee build/bench/report.txt
 	sh bench/report.sh build/bench/report.txt
 
@@ -206,6 +213,9 @@ $(BUILD)/bench-eval: bench/bench_eval.c $(BUILD)/libmech.a $(HEADERS)
 	$(CC) $(CFLAGS) -Isrc -o $@ $< $(BUILD)/libmech.a $(LDLIBS)
 
 $(BUILD)/bench-solve: bench/bench_solve.c bench/bench_util.h $(BUILD)/libmech.a $(HEADERS)
+	$(CC) $(CFLAGS) -Isrc -o $@ $< $(BUILD)/libmech.a $(LDLIBS)
+
+$(BUILD)/bench-sweep: bench/bench_sweep.c $(BUILD)/libmech.a $(HEADERS)
 	$(CC) $(CFLAGS) -Isrc -o $@ $< $(BUILD)/libmech.a $(LDLIBS)
 
 $(BUILD)/bench-alloc: bench/bench_alloc.c $(BUILD)/libmech.a $(HEADERS)

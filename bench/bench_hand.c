@@ -2,7 +2,9 @@
  * for one mechanism each, with the interpreter's outputs (positions,
  * velocities and accelerations of the same points, links and sliders):
  *
- *   fourbar.yaml   closed form (circle intersection, 2x2 Cramer for rates)
+ *   fourbar.yaml   closed form (circle intersection, 2x2 Cramer for rates),
+ *                  and Newton with a hand-written 2x2 Jacobian
+ *   offset-slider-crank.yaml  Newton with a hand-written 2x2 Jacobian
  *   stirling.yaml  Newton with a hand-written 8x8 Jacobian (docs/stirling.md
  *                  section 7, in the file's mirrored frame), inline dense LU
  *   conveyor.yaml  Newton with a hand-written 4x4 Jacobian, inline dense LU
@@ -16,7 +18,13 @@
  * `mech_solve` at MECH_WANT_ALL without forces, at the default tolerance
  * 1e-12 and at 1e-15 ("full accuracy"); both are timed as the
  * median of repeated sweeps and their tables compared (they must agree to
- * ~1e-9, or the comparison is void). Prints a table; not a test. */
+ * ~1e-9, or the comparison is void). Prints a table; not a test.
+ *
+ * bench-hand --count NAME interp|hand STEPS [forces] runs one sweep of
+ * STEPS intervals over the file's driver range, interpreter or hand-written
+ * (the forces variant: interpreter with joint reactions, friction off), for
+ * bench/bench_ratio.sh to count instructions per step under callgrind (the
+ * difference of two step counts, inside mech_solve or hand_sweep). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -30,7 +38,7 @@ enum { REPS = 31, MAXN = 8, MAXCOLS = 64 };
 /* ---- rotating vectors ---------------------------------------------------- */
 
 /* p, v, a += r e(th) with th' = w, th'' = al. */
-static void add_arm(double *p, double r, double th, double w, double al)
+static inline void add_arm(double *p, double r, double th, double w, double al)
 {
     double c = r * cos(th), s = r * sin(th);
     p[0] += c, p[1] += s;
@@ -285,6 +293,85 @@ static void stirling_out(const double *x, const double *xd, const double *xdd, d
         *o++ = x[sliders[k]], *o++ = xd[sliders[k]], *o++ = xdd[sliders[k]];
 }
 
+/* ---- four-bar by Newton (mechanisms/fourbar.yaml) --------------------------- */
+
+/* x = [theta3 (coupler), theta4 (rocker)]: O A + A B = O C + C B */
+static void fourbar_eval(const double *x, double q, double *F, double *J, double *fq)
+{
+    double cq = cos(q), sq = sin(q), c3 = cos(x[0]), s3 = sin(x[0]), c4 = cos(x[1]),
+           s4 = sin(x[1]);
+    F[0] = FB_A * cq + FB_B * c3 - FB_D - FB_C * c4;
+    F[1] = FB_A * sq + FB_B * s3 - FB_C * s4;
+    J[0] = -FB_B * s3, J[1] = FB_C * s4;
+    J[2] = FB_B * c3, J[3] = -FB_C * c4;
+    fq[0] = -FB_A * sq, fq[1] = FB_A * cq;
+}
+
+static void fourbar_acc(const double *x, const double *xq, double q, double *r)
+{
+    double w3 = xq[0] * xq[0], w4 = xq[1] * xq[1];
+    r[0] = FB_A * cos(q) + FB_B * cos(x[0]) * w3 - FB_C * cos(x[1]) * w4;
+    r[1] = FB_A * sin(q) + FB_B * sin(x[0]) * w3 - FB_C * sin(x[1]) * w4;
+}
+
+static void fourbar_out(const double *x, const double *xd, const double *xdd, double q,
+                        double qd, double qdd, double *o)
+{
+    double A[6] = {0}, B[6], P[6];
+    add_arm(A, FB_A, q, qd, qdd);
+    memcpy(B, A, sizeof B), memcpy(P, A, sizeof P);
+    add_arm(B, FB_B, x[0], xd[0], xdd[0]);
+    add_arm(P, FB_PL, x[0] + FB_PA, xd[0], xdd[0]);
+    *o++ = q;
+    memcpy(o, A, sizeof A), o += 6;
+    memcpy(o, B, sizeof B), o += 6;
+    memcpy(o, P, sizeof P), o += 6;
+    *o++ = q, *o++ = qd, *o++ = qdd;
+    for (int k = 0; k < 2; k++)
+        *o++ = x[k], *o++ = xd[k], *o++ = xdd[k];
+}
+
+/* ---- offset slider-crank (mechanisms/offset-slider-crank.yaml) ------------- */
+
+#define SC_R 0.040
+#define SC_L 0.120
+#define SC_E 0.030
+
+static const char *const SC_COLS[] = {
+    "q", "A.x", "A.y", "A.vx", "A.vy", "A.ax", "A.ay", "B.x", "B.y", "B.vx", "B.vy", "B.ax",
+    "B.ay", "rod.angle", "rod.omega", "rod.alpha", "x_B.s", "x_B.v", "x_B.a", NULL};
+
+/* x = [theta (rod), s (slide of B from G = (0, e))]: O A + A B = O G + s e_x */
+static void slider_eval(const double *x, double q, double *F, double *J, double *fq)
+{
+    double cq = cos(q), sq = sin(q), c = cos(x[0]), s = sin(x[0]);
+    F[0] = SC_R * cq + SC_L * c - x[1];
+    F[1] = SC_R * sq + SC_L * s - SC_E;
+    J[0] = -SC_L * s, J[1] = -1;
+    J[2] = SC_L * c, J[3] = 0;
+    fq[0] = -SC_R * sq, fq[1] = SC_R * cq;
+}
+
+static void slider_acc(const double *x, const double *xq, double q, double *r)
+{
+    double w = xq[0] * xq[0];
+    r[0] = SC_R * cos(q) + SC_L * cos(x[0]) * w;
+    r[1] = SC_R * sin(q) + SC_L * sin(x[0]) * w;
+}
+
+static void slider_out(const double *x, const double *xd, const double *xdd, double q,
+                       double qd, double qdd, double *o)
+{
+    double A[6] = {0}, B[6] = {0, SC_E, 0, 0, 0, 0};
+    add_arm(A, SC_R, q, qd, qdd);
+    B[0] = x[1], B[2] = xd[1], B[4] = xdd[1];
+    *o++ = q;
+    memcpy(o, A, sizeof A), o += 6;
+    memcpy(o, B, sizeof B), o += 6;
+    *o++ = x[0], *o++ = xd[0], *o++ = xdd[0];
+    *o++ = x[1], *o++ = xd[1], *o++ = xdd[1];
+}
+
 /* ---- six-bar conveyor (mechanisms/conveyor.yaml) --------------------------- */
 
 #define MM 0.001
@@ -352,6 +439,102 @@ static void conveyor_out(const double *x, const double *xd, const double *xdd, d
         *o++ = x[k], *o++ = xd[k], *o++ = xdd[k];
 }
 
+/* ---- the conveyor's joint reactions by hand (friction off) ----------------- */
+
+/* Newton-Euler for the five moving links (x, y forces and the moment about
+ * the centre of mass), unknowns: the reactions at O, A, B, E, D, F, G (each
+ * on the later link of the file, its opposite on the earlier) and the
+ * driver torque; 15 x 15, dense LU with partial pivoting. The tray's
+ * distributed cargo (50 kg over E-D) acts at the tray's centre. */
+enum { CF_N = 15 };
+static const double C_rho = 7850, C_bw = 0.040, C_bt = 0.020, C_pw = 0.300, C_pt = 0.004,
+                    C_cargo = 50, C_g = 9.81;
+
+static const char *const CVF_COLS[] = {
+    "q", "A.x", "A.y", "A.vx", "A.vy", "A.ax", "A.ay", "B.x", "B.y", "B.vx", "B.vy", "B.ax",
+    "B.ay", "C.x", "C.y", "C.vx", "C.vy", "C.ax", "C.ay", "D.x", "D.y", "D.vx", "D.vy", "D.ax",
+    "D.ay", "E.x", "E.y", "E.vx", "E.vy", "E.ax", "E.ay", "crank.angle", "crank.omega",
+    "crank.alpha", "coupler.angle", "coupler.omega", "coupler.alpha", "tray.angle",
+    "tray.omega", "tray.alpha", "rocker4.angle", "rocker4.omega", "rocker4.alpha",
+    "rocker5.angle", "rocker5.omega", "rocker5.alpha", "driver.torque", NULL};
+
+/* One joint: reaction column c at point p, +R on link la (centre ga), -R on lb. */
+static void cf_joint(double *A, int c, const double *p, int la, const double *ga, int lb,
+                     const double *gb)
+{
+    const int ls[2] = {la, lb};
+    const double *gs[2] = {ga, gb}, sg[2] = {1, -1};
+    for (int k = 0; k < 2; k++) {
+        if (ls[k] == 0)
+            continue;
+        int r = 3 * (ls[k] - 1);
+        double rx = p[0] - gs[k][0], ry = p[1] - gs[k][1];
+        A[r * CF_N + c] += sg[k], A[(r + 1) * CF_N + c + 1] += sg[k];
+        A[(r + 2) * CF_N + c] += -sg[k] * ry, A[(r + 2) * CF_N + c + 1] += sg[k] * rx;
+    }
+}
+
+/* The driver torque at one position from the kinematics (x, xd, xdd). */
+static double conveyor_torque(const double *x, const double *xd, const double *xdd, double q,
+                              double qd, double qdd)
+{
+    double l3 = C_l3a + C_l3b, rG3 = hypot((C_l3b - C_l3a) / 2, C_lk),
+           aG3 = atan2(C_lk, (C_l3b - C_l3a) / 2);
+    double m1 = C_rho * C_bw * C_bt * C_l1, m2 = C_rho * C_bw * C_bt * C_l2,
+           m3 = C_rho * C_pw * C_pt * l3, m4 = C_rho * C_bw * C_bt * C_l4, m5 = m4;
+    double mass[6] = {0, m1, m2, m3, m4, m5};
+    double inertia[6] = {0, m1 * (C_l1 * C_l1 + C_bw * C_bw) / 12,
+                         m2 * (C_l2 * C_l2 + C_bw * C_bw) / 12, m3 * (l3 * l3 + C_pw * C_pw) / 12,
+                         m4 * (C_l4 * C_l4 + C_bw * C_bw) / 12, m5 * (C_l5 * C_l5 + C_bw * C_bw) / 12};
+    double al[6] = {0, qdd, xdd[0], xdd[1], xdd[2], xdd[3]};
+    /* points and centres with their accelerations: [x, y, vx, vy, ax, ay] */
+    double P_A[6] = {0}, P_B[6], P_E[6], P_D[6], P_F[6] = {C_xF, -C_a, 0, 0, 0, 0},
+           P_G[6] = {C_xG, -C_a, 0, 0, 0, 0}, G[6][6] = {{0}};
+    add_arm(P_A, C_l1, q, qd, qdd);
+    memcpy(P_B, P_A, sizeof P_B);
+    add_arm(P_B, C_l2, x[0], xd[0], xdd[0]);
+    memcpy(P_E, P_B, sizeof P_E), memcpy(P_D, P_B, sizeof P_D);
+    add_arm(P_E, C_rE, x[1] + C_aE, xd[1], xdd[1]);
+    add_arm(P_D, C_rD, x[1] + C_aD, xd[1], xdd[1]);
+    add_arm(G[1], C_l1 / 2, q, qd, qdd);
+    memcpy(G[2], P_A, sizeof G[2]);
+    add_arm(G[2], C_l2 / 2, x[0], xd[0], xdd[0]);
+    memcpy(G[3], P_B, sizeof G[3]);
+    add_arm(G[3], rG3, x[1] + aG3, xd[1], xdd[1]);
+    memcpy(G[4], P_F, sizeof G[4]);
+    add_arm(G[4], C_l4 / 2, x[2], xd[2], xdd[2]);
+    memcpy(G[5], P_G, sizeof G[5]);
+    add_arm(G[5], C_l5 / 2, x[3], xd[3], xdd[3]);
+    double A[CF_N * CF_N] = {0}, b[CF_N];
+    static const double origin[2] = {0, 0};
+    cf_joint(A, 0, origin, 1, G[1], 0, NULL);    /* O: ground-crank */
+    cf_joint(A, 2, P_A, 2, G[2], 1, G[1]);       /* A: crank-coupler */
+    cf_joint(A, 4, P_B, 3, G[3], 2, G[2]);       /* B: coupler-tray */
+    cf_joint(A, 6, P_E, 4, G[4], 3, G[3]);       /* E: tray-rocker4 */
+    cf_joint(A, 8, P_D, 5, G[5], 3, G[3]);       /* D: tray-rocker5 */
+    cf_joint(A, 10, P_F, 4, G[4], 0, NULL);      /* F: ground-rocker4 */
+    cf_joint(A, 12, P_G, 5, G[5], 0, NULL);      /* G: ground-rocker5 */
+    A[2 * CF_N + 14] = 1;                        /* the driver torque on the crank */
+    for (int l = 1; l <= 5; l++) {  /* A y = m a - m g - loads; I al - load moments */
+        double fy = -mass[l] * C_g - (l == 3 ? C_cargo * C_g : 0);  /* cargo at the centre */
+        b[3 * (l - 1)] = mass[l] * G[l][4];
+        b[3 * (l - 1) + 1] = mass[l] * G[l][5] - fy;
+        b[3 * (l - 1) + 2] = inertia[l] * al[l];
+    }
+    int piv[CF_N];
+    if (lu(CF_N, A, piv))
+        return NAN;
+    lu_solve(CF_N, A, piv, b);
+    return b[14];
+}
+
+static void conveyor_out_forces(const double *x, const double *xd, const double *xdd, double q,
+                                double qd, double qdd, double *o)
+{
+    conveyor_out(x, xd, xdd, q, qd, qdd, o);
+    o[46] = conveyor_torque(x, xd, xdd, q, qd, qdd);
+}
+
 /* ---- timing and comparison -------------------------------------------------- */
 
 static int ncols_of(const char *const *cols)
@@ -394,6 +577,10 @@ static double compare(const mech_table *t, const double *hand, const char *const
     return worst;
 }
 
+/* 1: the interpreter also solves the joint reactions, friction off (the
+ * conveyor's row with forces) */
+static int with_forces;
+
 static double time_interpreter(const mech_model *m, double tol, mech_table *keep,
                                mech_solve_stats *st, double *min)
 {
@@ -402,7 +589,8 @@ static double time_interpreter(const mech_model *m, double tol, mech_table *keep
         mech_solve_options o;
         mech_solve_options_default(&o);
         o.tol = tol;
-        o.forces = -1; /* kinematics only, like the hand-written solvers */
+        o.forces = with_forces ? 1 : -1; /* kinematics only, like the hand-written solvers */
+        o.friction = MECH_FRICTION_OFF;
         mech_table t = {0};
         mech_diag d;
         mech_diag_init(&d);
@@ -472,11 +660,80 @@ static mech_model *load(const char *dir, const char *file)
     return m;
 }
 
+/* The hand-written solvers, by the short name of bench/bench_ratio.sh. */
+static hand_mech hand_of(const char *name)
+{
+    hand_mech fb = {2, FB_D, fourbar_eval, fourbar_acc, fourbar_out, FB_COLS,
+                    {40 * M_PI / 180, 100 * M_PI / 180}};
+    hand_mech sc = {2, SC_L, slider_eval, slider_acc, slider_out, SC_COLS,
+                    {14.5 * M_PI / 180, 0.156}};
+    hand_mech st = {8, 0, stirling_eval, stirling_acc, stirling_out, ST_COLS,
+                    {1.2745, 0.070, 0.3818, 0.2101, 0.2003, 0.024, 1.0973, 0.017}};
+    /* lref: the largest distance between two ground points (H and M) */
+    st.lref = hypot(S_L3 + S_L5, S_L4 + S_L2);
+    hand_mech cv = {4, C_l3a + C_l3b, conveyor_eval, conveyor_acc, conveyor_out, CV_COLS,
+                    {-155 * M_PI / 180, 0, -8 * M_PI / 180, -7 * M_PI / 180}};
+    hand_mech cf = cv;  /* with the driver torque (joint reactions, friction off) */
+    cf.out = conveyor_out_forces, cf.cols = CVF_COLS;
+    return strcmp(name, "fourbar") == 0               ? fb
+           : strcmp(name, "offset-slider-crank") == 0 ? sc
+           : strcmp(name, "stirling") == 0            ? st
+           : strcmp(name, "conveyor-forces") == 0     ? cf
+                                                      : cv;
+}
+
+/* Through a volatile pointer: never inlined, so that callgrind can count
+ * inside it (--toggle-collect=hand_sweep). */
+static long (*volatile hand_sweep_call)(const hand_mech *, const double *, int, double, double,
+                                        double, double *, int) = hand_sweep;
+
+/* One sweep of `steps` intervals over the file's driver range, by the
+ * interpreter (kinematics, or forces with friction off) or by hand. */
+static int count_one(const char *dir, const char *name, const char *side, int steps, int forces)
+{
+    char file[256];
+    snprintf(file, sizeof file, "%s.yaml", name);
+    mech_model *m = load(dir, file);
+    double from = m->driver.values[0], to = m->driver.values[m->driver.nvalues - 1];
+    int rc = 0;
+    if (strcmp(side, "hand") == 0) {
+        hand_mech h = hand_of(forces ? "conveyor-forces" : name);
+        int nc = ncols_of(h.cols);
+        double *qs = calloc((size_t)steps + 1, sizeof *qs);
+        double *out = calloc((size_t)(steps + 1) * (size_t)nc, sizeof *out);
+        for (int i = 0; i <= steps; i++)
+            qs[i] = from + (to - from) * i / steps;
+        rc = hand_sweep_call(&h, qs, steps + 1, m->driver.speed, m->driver.accel, 1e-12, out, nc) < 0;
+        free(qs);
+        free(out);
+    } else {
+        mech_solve_options o;
+        mech_solve_options_default(&o);
+        o.has_range = 1, o.from = from, o.to = to, o.steps = steps;
+        o.forces = forces ? 1 : -1;
+        o.friction = MECH_FRICTION_OFF;
+        mech_table t = {0};
+        mech_solve_stats st;
+        mech_diag d;
+        mech_diag_init(&d);
+        rc = mech_solve(m, &o, &t, &st, &d) != MECH_OK;
+        if (rc)
+            mech_diag_print(&d, stderr);
+        mech_diag_free(&d);
+        mech_table_free(&t);
+    }
+    mech_model_free(&m);
+    return rc;
+}
+
 int main(int argc, char **argv)
 {
-    const char *dir = argc > 1 ? argv[1] : "mechanisms";
     C_rE = hypot(C_l3a, C_lk), C_aE = atan2(C_lk, -C_l3a);
     C_rD = hypot(C_l3b, C_lk), C_aD = atan2(C_lk, C_l3b);
+    if (argc >= 5 && strcmp(argv[1], "--count") == 0)
+        return count_one(getenv("BENCH_MECHANISMS") ? getenv("BENCH_MECHANISMS") : "mechanisms",
+                         argv[2], argv[3], atoi(argv[4]), argc > 5 && strcmp(argv[5], "forces") == 0);
+    const char *dir = argc > 1 ? argv[1] : "mechanisms";
     printf("the price of being general: time per driver step, interpreter (mech_solve, positions\n"
            "+ velocities + accelerations, no forces) against a solver written by hand for the\n"
            "mechanism (same steps, same outputs); us per step, median (and min) of %d sweeps;\n"
@@ -490,22 +747,29 @@ int main(int argc, char **argv)
     mech_model *m = load(dir, "fourbar.yaml");
     row("fourbar", "closed form", m, NULL, FB_COLS, 1e-12);
     row("fourbar", "closed form", m, NULL, FB_COLS, 1e-15);
+    hand_mech h = hand_of("fourbar");
+    row("fourbar", "Newton, 2x2 J, dense LU", m, &h, FB_COLS, 1e-12);
+    mech_model_free(&m);
+
+    m = load(dir, "offset-slider-crank.yaml");
+    h = hand_of("offset-slider-crank");
+    row("sl-crank", "Newton, 2x2 J, dense LU", m, &h, SC_COLS, 1e-12);
     mech_model_free(&m);
 
     m = load(dir, "stirling.yaml");
-    hand_mech st = {8, 0, stirling_eval, stirling_acc, stirling_out, ST_COLS,
-                    {1.2745, 0.070, 0.3818, 0.2101, 0.2003, 0.024, 1.0973, 0.017}};
-    /* lref: the largest distance between two ground points (H and M) */
-    st.lref = hypot(S_L3 + S_L5, S_L4 + S_L2);
-    row("stirling", "Newton, 8x8 J, dense LU", m, &st, ST_COLS, 1e-12);
-    row("stirling", "Newton, 8x8 J, dense LU", m, &st, ST_COLS, 1e-15);
+    h = hand_of("stirling");
+    row("stirling", "Newton, 8x8 J, dense LU", m, &h, ST_COLS, 1e-12);
+    row("stirling", "Newton, 8x8 J, dense LU", m, &h, ST_COLS, 1e-15);
     mech_model_free(&m);
 
     m = load(dir, "conveyor.yaml");
-    hand_mech cv = {4, C_l3a + C_l3b, conveyor_eval, conveyor_acc, conveyor_out, CV_COLS,
-                    {-155 * M_PI / 180, 0, -8 * M_PI / 180, -7 * M_PI / 180}};
-    row("conveyor", "Newton, 4x4 J, dense LU", m, &cv, CV_COLS, 1e-12);
-    row("conveyor", "Newton, 4x4 J, dense LU", m, &cv, CV_COLS, 1e-15);
+    h = hand_of("conveyor");
+    row("conveyor", "Newton, 4x4 J, dense LU", m, &h, CV_COLS, 1e-12);
+    row("conveyor", "Newton, 4x4 J, dense LU", m, &h, CV_COLS, 1e-15);
+    h = hand_of("conveyor-forces");
+    with_forces = 1;
+    row("conv+torq", "+ 15x15 forces, dense LU", m, &h, CVF_COLS, 1e-12);
+    with_forces = 0;
     mech_model_free(&m);
     return 0;
 }

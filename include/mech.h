@@ -67,6 +67,7 @@ typedef struct mech_point {
     int id;         /* index into mech_model.point_names (shared names = same pin) */
     double x, y;    /* in the link's own frame, m */
     mech_mark mark;
+    double dxy[2];  /* d(x, y)/dp for the parameter p a sensitivity load seeds, else 0 */
 } mech_point;
 
 typedef struct mech_link {
@@ -164,6 +165,8 @@ typedef struct mech_param {
     char *name;
     double value;      /* SI, or a pure number */
     mech_mark mark;
+    char unit[32];     /* SI unit of the value ("m", "rad", "kg/m^3"), "" for a bare number */
+    double tol;        /* tolerance: the value is value +- tol (same unit); 0 when none */
 } mech_param;
 
 typedef struct mech_outputs {
@@ -253,6 +256,12 @@ typedef struct mech_system mech_system;
 
 /* Build the system of a checked model (the model must outlive it). */
 int mech_system_new(const mech_model *m, mech_system **out, mech_diag *d);
+/* The same equations for printing (mech equations): lengths and angles
+ * that depend on the file's parameters appear as the parameters (`r`) or
+ * as named lengths |AB| and angles <AB; the file is read again once per
+ * parameter to see what depends on what (numbers are printed when it
+ * cannot be, or with more than 200 parameters). Not for solving. */
+int mech_system_new_named(const mech_model *m, mech_system **out, mech_diag *d);
 void mech_system_free(mech_system **s);
 int mech_system_size(const mech_system *s);   /* number of unknowns */
 
@@ -401,6 +410,29 @@ typedef struct mech_solve_stats {
  * MECH_EINPUT for an invalid system. `stats` may be NULL. */
 int mech_solve(const mech_model *m, const mech_solve_options *o, mech_table *out,
                mech_solve_stats *stats, mech_diag *d);
+
+/* Sensitivities (src/sensitivity.c, docs/sensitivity.md): to `table`, the
+ * result of mech_solve(m, o, ...), add for each parameter names[k] and each
+ * kinematic column COL (points' x, y, vx, vy, ax, ay; links' angle, omega,
+ * alpha; sliders' s, v, a) a column "d(COL)/d(NAME)" in COL's unit over
+ * NAME's SI unit (per 1 of a bare number), from the implicit-function
+ * theorem: J dx/dp = -df/dp at each row, and the derivatives of the
+ * velocity and acceleration equations for the rates; exact to rounding.
+ * m must come from a file (read again once per parameter, with the same
+ * overrides ov[0..nov-1]); force columns get none. MECH_OK, or an error in
+ * d (an unknown parameter, redundant constraints, a singular row). */
+int mech_sensitivity(const mech_model *m, const mech_override *ov, int nov,
+                     const mech_solve_options *o, const char *const *names, int nnames,
+                     mech_table *table, mech_diag *d);
+
+/* Tolerance stack-up (docs/sensitivity.md): to `table`, the result of
+ * mech_solve(m, o, ...), add for every kinematic column COL the columns
+ * "worst(COL)" = sum over the parameters p with a tolerance of
+ * |d(COL)/dp| tol_p, and "rss(COL)" = sqrt(sum (d(COL)/dp tol_p)^2), in
+ * COL's unit (first order: from mech_sensitivity's derivatives). An error
+ * when no parameter has a tolerance. */
+int mech_tolerances(const mech_model *m, const mech_override *ov, int nov,
+                    const mech_solve_options *o, mech_table *table, mech_diag *d);
 
 /* ---- The analysed system ----------------------------------------------
  * mech_solve is three steps that callers may also take themselves:

@@ -141,14 +141,19 @@ done:
 /* ---- one dense block, k x k column major ----------------------------- */
 
 /* LU with partial pivoting in place: P a = L U, unit L below the diagonal.
- * Returns the local column of a zero pivot, or -1. */
+ * Returns the local column of a zero pivot, or -1. A zero multiplier's
+ * update (x - 0 t) is skipped: the same values, but for the sign of a zero. */
 static int block_factor_general(double *a, int k, int *piv, int *swaps)
 {
+    int rows[BLOCKLU_MAX_BLOCK];
     for (int j = 0; j < k; j++) {
         int p = j;
+        double best = fabs(a[j + j * k]);
         for (int i = j + 1; i < k; i++)
-            if (fabs(a[i + j * k]) > fabs(a[p + j * k]))
+            if (fabs(a[i + j * k]) > best) {  /* the first of equal magnitudes, as before */
+                best = fabs(a[i + j * k]);
                 p = i;
+            }
         piv[j] = p;
         if (!(a[p + j * k] != 0.0))
             return j;
@@ -161,13 +166,17 @@ static int block_factor_general(double *a, int k, int *piv, int *swaps)
             }
         }
         double inv = 1.0 / a[j + j * k];
+        int nl = 0;  /* the rows with a nonzero multiplier: force blocks are sparse */
         for (int i = j + 1; i < k; i++)
-            a[i + j * k] *= inv;
-        for (int c = j + 1; c < k; c++) {
+            if (a[i + j * k] != 0.0) {
+                a[i + j * k] *= inv;
+                rows[nl++] = i;
+            }
+        for (int c = j + 1; c < k && nl > 0; c++) {
             double t = a[j + c * k];
             if (t != 0.0)
-                for (int i = j + 1; i < k; i++)
-                    a[i + c * k] -= a[i + j * k] * t;
+                for (int q = 0; q < nl; q++)
+                    a[rows[q] + c * k] -= a[rows[q] + j * k] * t;
         }
     }
     return -1;
@@ -415,7 +424,9 @@ void blocklu_solve(blocklu *b, double *x)
     const double *above = b->v + pl->ndense;
     for (int k = 0; k < pl->n; k++)
         y[k] = x[pl->P[k]];
-    for (int k = pl->nblocks - 1; k >= 0; k--) {
+    if (pl->nblocks == 1)  /* one loop or one coupled group: nothing above it */
+        block_solve(b->v, pl->n, b->piv, y);
+    for (int k = pl->nblocks - 1; k >= 0 && pl->nblocks > 1; k--) {
         int k0 = pl->R[k], size = pl->R[k + 1] - k0;
         block_solve(b->v + pl->at[k], size, b->piv + k0, y + k0);
         for (int j = k0; j < k0 + size; j++)

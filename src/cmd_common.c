@@ -1,9 +1,10 @@
 /* src/cmd_common.c: pieces several commands share: --help, loading a
- * checked file, usage errors, --shard, the default number of workers (the
- * CPU affinity mask), and
- * running independent jobs on worker threads (mech batch, mech sweep). */
+ * checked file, usage errors, --set and --from/--to/--steps (solve, plot,
+ * animate), --shard, the default number of workers (the CPU affinity mask),
+ * and running independent jobs on worker threads (mech batch, mech sweep). */
 #define _GNU_SOURCE  /* sched_getaffinity, CPU_COUNT */
 #include <errno.h>
+#include <math.h>
 #include <pthread.h>
 #include <sched.h>
 #include <stdatomic.h>
@@ -74,6 +75,83 @@ int cmd_refuse_input(const char *command, const char *out, const char *const *in
                     command, out, inputs[i]);
             return MECH_EXIT_INPUT;
         }
+    return -1;
+}
+
+/* ---- --set, --from/--to/--steps ------------------------------------------ */
+
+int cmd_parse_set(const char *command, const char *val, cmd_sets *s)
+{
+    const char *eq = strchr(val, '=');
+    if (!eq || eq == val || !eq[1] || s->n == CMD_MAX_SET)
+        return cmd_usage_error(command, "--set needs NAME=VALUE (at most 64), not '%s'", val);
+    char *copy = malloc(strlen(val) + 1);
+    if (!copy)
+        return fprintf(stderr, "mech %s: out of memory\n", command), MECH_EXIT_IO;
+    strcpy(copy, val);
+    copy[eq - val] = '\0';
+    s->copy[s->n] = copy;
+    s->set[s->n].name = copy;
+    s->set[s->n++].text = copy + (eq - val) + 1;
+    return -1;
+}
+
+void cmd_sets_free(cmd_sets *s)
+{
+    for (int i = 0; i < s->n; i++)
+        free(s->copy[i]);
+    s->n = 0;
+}
+
+int cmd_check_range_pair(const char *command, const char *from, const char *to)
+{
+    if ((from != NULL) != (to != NULL))
+        return cmd_usage_error(command, "%s", "--from and --to go together");
+    return -1;
+}
+
+/* The largest driver position on the command line, rad or m: beyond it a
+ * step of the sweep is lost in the rounding of the position itself
+ * (1e6 rad = 57 million degrees, ulp 1.2e-10 rad). */
+#define MAX_DRIVER 1e6
+
+/* One end of --from/--to into *si: a finite position within MAX_DRIVER, as
+ * the file's range must be finite (docs/limits.md). Returns -1 when fine,
+ * else the exit status (the problem printed). */
+static int parse_end(const char *command, const char *opt, const char *text, int is_angle,
+                     double *si)
+{
+    char err[256];
+    if (mech_parse_value(text, is_angle, si, err, sizeof err) != MECH_OK)
+        return fprintf(stderr, "mech %s: %s '%s': %s\n", command, opt, text, err),
+               MECH_EXIT_INPUT;
+    if (!(fabs(*si) <= MAX_DRIVER)) {
+        snprintf(err, sizeof err, "%s '%.40s' is %.3g %s: a driver %s must be within +-%s "
+                 "(beyond, a step is lost in the rounding of the position)", opt, text, *si,
+                 is_angle ? "rad" : "m", is_angle ? "angle" : "displacement",
+                 is_angle ? "1e6 rad (5.7e7 deg)" : "1e6 m");
+        return cmd_usage_error(command, "%s", err);
+    }
+    return -1;
+}
+
+int cmd_apply_range(const char *command, const char *from, const char *to, int steps,
+                    const mech_model *m, mech_solve_options *o)
+{
+    int is_angle = m->driver.kind == MECH_DRIVE_ANGLE, code;
+    if (from) {
+        if ((code = parse_end(command, "--from", from, is_angle, &o->from)) >= 0 ||
+            (code = parse_end(command, "--to", to, is_angle, &o->to)) >= 0)
+            return code;
+        o->has_range = 1;
+        o->steps = steps > 0 ? steps : 360;
+    } else if (steps > 0 && m->has_driver && m->driver.nvalues > 0) {
+        /* new spacing over the file's range */
+        o->has_range = 1;
+        o->from = m->driver.values[0];
+        o->to = m->driver.values[m->driver.nvalues - 1];
+        o->steps = steps;
+    }
     return -1;
 }
 

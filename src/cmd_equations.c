@@ -61,7 +61,7 @@ int cmd_equations(int argc, char **argv)
     mech_diag d;
     mech_diag_init(&d);
     mech_system *s = NULL;
-    int rc = mech_system_new(m, &s, &d);
+    int rc = mech_system_new_named(m, &s, &d);
     mech_diag_print(&d, stderr);
     mech_diag_free(&d);
     if (rc == MECH_OK)

@@ -11,24 +11,33 @@
 #include "plot.h"
 
 const char cmd_plot_help[] =
-    "usage: mech plot FILE [--out DIR] [--outputs NAME,...] [--steps N]\n"
-    "                 [--forces] [--friction on|off|both]\n"
+    "usage: mech plot FILE [--out DIR] [--outputs NAME,...] [--from A --to B]\n"
+    "                 [--steps N] [--set NAME=VALUE] [--forces]\n"
+    "                 [--friction on|off|both]\n"
     "\n"
     "Solve the driver sweep and draw one SVG figure per group of quantities\n"
     "against the driver (angle in deg, or displacement in mm): point positions,\n"
     "velocities and accelerations (x and y of each point), link angles, angular\n"
     "velocities and accelerations, slider displacements, velocities and\n"
     "accelerations, and with forces the reaction components Fx, Fy of every joint\n"
-    "and the driver torque, with and without friction when the file has friction.\n"
-    "The figures follow the file's outputs. Units: mm, deg, m/s, m/s^2, rad/s,\n"
-    "rad/s^2, N, N*m. Files are DIR/STEM-GROUP.svg, STEM the file's name without\n"
-    ".yaml; each written path is printed on standard output.\n"
+    "(the legend names the link the force acts on) and the driver torque, with\n"
+    "and without friction when the file has friction. Then the path of every\n"
+    "output point that moves (path-P: y against x in mm on equal axes, a start\n"
+    "marker, arrows in the direction of motion). The figures follow the file's\n"
+    "outputs. Units: mm, deg, m/s, m/s^2, rad/s, rad/s^2, N, N*m. Files are\n"
+    "DIR/STEM-GROUP.svg, STEM the file's name without .yaml; each written path\n"
+    "is printed on standard output. Long sweeps are thinned to within 0.25 px.\n"
     "\n"
     "options:\n"
     "  --out DIR, -d DIR   directory of the figures (created if missing; default .)\n"
     "  --outputs LIST      comma-separated point, link and slider names to plot\n"
-    "                      instead of the file's outputs\n"
-    "  --steps N           N intervals over the file's driver range\n"
+    "                      instead of the file's outputs (the points' paths too)\n"
+    "  --from A --to B     sweep the driver from A to B instead of the file's range\n"
+    "                      (as mech solve: bare numbers deg or mm, units allowed)\n"
+    "  --steps N           N intervals (with --from/--to: default 360; alone: over\n"
+    "                      the file's range)\n"
+    "  --set NAME=VALUE    replace the file's parameter NAME by VALUE (repeatable),\n"
+    "                      e.g. --set 'l=150 mm'\n"
     "  --forces            also the forces (as 'outputs: {forces: true}')\n"
     "  --friction MODE     on, off or both (default: both when a joint has friction)\n"
     "  -h, --help          show this help\n"
@@ -37,20 +46,28 @@ const char cmd_plot_help[] =
     "(nothing written), 2 invalid file or usage, 3 a file cannot be read or written\n";
 
 const char cmd_animate_help[] =
-    "usage: mech animate FILE [-o OUT.svg] [--duration S] [--steps N] [--frames N]\n"
+    "usage: mech animate FILE [-o OUT.svg] [--outputs POINT,...] [--from A --to B]\n"
+    "                    [--steps N] [--set NAME=VALUE] [--duration S] [--frames N]\n"
     "                    [--frame K] [--test-colours] [--pause-at T]\n"
     "\n"
     "Solve the positions over the driver range and write one self-contained\n"
     "animated SVG (SMIL, no script, no network) of the mechanism going through\n"
     "the range: links as bars (2 points) or plates (3 or more), pins as circles,\n"
-    "ground pivots hatched, sliders as blocks on their guides, and the paths of\n"
-    "the file's output points. It plays in any web browser.\n"
+    "ground pivots hatched, sliders as blocks on their guides, the paths of the\n"
+    "file's output points (or of --outputs), and a scale bar in mm. It plays in\n"
+    "any web browser.\n"
     "\n"
     "options:\n"
     "  -o, --output FILE   write the SVG to FILE (temporary file renamed when\n"
     "                      complete; default: standard output)\n"
+    "  --outputs LIST      comma-separated point names whose paths are drawn\n"
+    "                      instead of the file's output points\n"
+    "  --from A --to B     sweep the driver from A to B instead of the file's range\n"
+    "                      (as mech solve: bare numbers deg or mm, units allowed)\n"
+    "  --steps N           N intervals (with --from/--to: default 360; alone: over\n"
+    "                      the file's range)\n"
+    "  --set NAME=VALUE    replace the file's parameter NAME by VALUE (repeatable)\n"
     "  --duration S        seconds for one pass through the range (default 4)\n"
-    "  --steps N           N intervals over the file's driver range\n"
     "  --frames N          use at most N evenly spread positions (default 1000)\n"
     "  --frame K           a still picture of position K (0 = the first), no animation\n"
     "  --test-colours      draw in grey with every point a disc of its own colour\n"
@@ -64,7 +81,8 @@ const char cmd_animate_help[] =
 
 typedef struct plot_args {
     const char *cmd;          /* "plot" or "animate" */
-    const char *file, *out, *outputs;
+    const char *file, *out, *outputs, *from, *to;
+    cmd_sets set;             /* --set NAME=VALUE, as mech solve */
     int steps, forces, friction; /* friction: -1 = default */
     plot_anim_options anim;
 } plot_args;
@@ -78,7 +96,7 @@ static int parse_option(plot_args *a, int argc, char **argv, int *i)
     int animate = strcmp(a->cmd, "animate") == 0;
     static const char *const valued[] = {"--out", "-d", "-o", "--output", "--outputs", "--steps",
                                          "--friction", "--duration", "--frame", "--frames",
-                                         "--pause-at"};
+                                         "--pause-at", "--set", "--from", "--to"};
     int has_value = 0;
     for (size_t k = 0; k < sizeof valued / sizeof valued[0]; k++)
         has_value |= strcmp(arg, valued[k]) == 0;
@@ -98,10 +116,16 @@ static int parse_option(plot_args *a, int argc, char **argv, int *i)
     if (strcmp(arg, "--steps") == 0) {
         if (!cmd_parse_int(val, 1, 100000000, &a->steps))
             return cmd_usage_error(a->cmd, "--steps needs a whole number from 1 to 1e8, not '%s'", val);
+    } else if (strcmp(arg, "--set") == 0) {
+        return cmd_parse_set(a->cmd, val, &a->set);
+    } else if (strcmp(arg, "--from") == 0) {
+        a->from = val;
+    } else if (strcmp(arg, "--to") == 0) {
+        a->to = val;
+    } else if (strcmp(arg, "--outputs") == 0) {
+        a->outputs = val;
     } else if (!animate && (strcmp(arg, "--out") == 0 || strcmp(arg, "-d") == 0)) {
         a->out = val;
-    } else if (!animate && strcmp(arg, "--outputs") == 0) {
-        a->outputs = val;
     } else if (!animate && strcmp(arg, "--friction") == 0) {
         if (strcmp(val, "on") == 0)
             a->friction = MECH_FRICTION_ON;
@@ -158,18 +182,7 @@ static int parse_args(int argc, char **argv, plot_args *a)
     }
     if (!a->file)
         return cmd_usage_error(a->cmd, "%s", "no file given");
-    return -1;
-}
-
-/* --steps: re-space the file's driver range. */
-static void apply_steps(const plot_args *a, const mech_model *m, mech_solve_options *o)
-{
-    if (a->steps > 0 && m->has_driver && m->driver.nvalues > 0) {
-        o->has_range = 1;
-        o->from = m->driver.values[0];
-        o->to = m->driver.values[m->driver.nvalues - 1];
-        o->steps = a->steps;
-    }
+    return cmd_check_range_pair(a->cmd, a->from, a->to);
 }
 
 /* Solve, printing the diagnostics; returns an exit status. */
@@ -235,7 +248,7 @@ static int write_figures(const plot_args *a, const mech_model *m, const mech_tab
         free(paths);
         return MECH_EXIT_IO;
     }
-    int n = plot_plan(m, t, figs, MAXFIG);
+    int n = plot_plan_all(m, t, figs, MAXFIG);
     if (n == 0)
         fprintf(stderr, "mech plot: %s: nothing to plot (no outputs)\n", a->file);
     char stem[256];
@@ -270,9 +283,12 @@ static int begin(const char *cmd, int argc, char **argv, plot_args *a, mech_mode
     *a = (plot_args){.cmd = cmd, .friction = -1};
     plot_anim_options_default(&a->anim);
     int code = parse_args(argc, argv, a);
-    if (code >= 0)
+    if (code >= 0) {
+        cmd_sets_free(&a->set);
         return code;
-    code = cmd_load_checked(a->file, m);
+    }
+    code = cmd_load_checked_with(a->file, a->set.set, a->set.n, m);
+    cmd_sets_free(&a->set);
     return code == MECH_EXIT_OK ? -1 : code;
 }
 
@@ -302,9 +318,10 @@ int cmd_plot(int argc, char **argv)
         o.friction = a.friction;
     else if ((a.forces || view.outputs.forces) && any_friction(m))
         o.friction = MECH_FRICTION_BOTH;
-    apply_steps(&a, m, &o);
     mech_table t = {0};
-    code = solve(&a, &view, &o, &t);
+    code = cmd_apply_range("plot", a.from, a.to, a.steps, m, &o);
+    if (code < 0)
+        code = solve(&a, &view, &o, &t);
     if (code == MECH_EXIT_OK)
         code = write_figures(&a, &view, &t);
     mech_table_free(&t);
@@ -334,6 +351,29 @@ static int select_everything(const mech_model *m, mech_outputs *all)
     return 0;
 }
 
+/* --outputs of the animation: the points whose paths are drawn (*traced,
+ * owned by the caller); links and sliders have no path and are refused.
+ * Returns -1 to go on, else the exit status. */
+static int traced_points(const plot_args *a, const mech_model *m, mech_outputs *traced)
+{
+    char err[256];
+    if (!a->outputs)
+        return -1;
+    if (mech_outputs_parse(m, a->outputs, traced, err, sizeof err) != MECH_OK) {
+        fprintf(stderr, "mech animate: --outputs: %s\n", err);
+        return MECH_EXIT_INPUT;
+    }
+    const char *what = traced->nlinks > 0 ? m->links[traced->links[0]].name
+                       : traced->nsliders > 0 ? m->joints[traced->sliders[0]].name : NULL;
+    if (what) {
+        fprintf(stderr, "mech animate: --outputs: '%s' is a %s, not a point: the animation "
+                "traces the paths of points\n", what, traced->nlinks > 0 ? "link" : "slider");
+        mech_outputs_free(traced);
+        return MECH_EXIT_INPUT;
+    }
+    return -1;
+}
+
 int cmd_animate(int argc, char **argv)
 {
     plot_args a;
@@ -345,23 +385,30 @@ int cmd_animate(int argc, char **argv)
         mech_model_free(&m);
         return code;
     }
-    /* the file's output points are traced; every point and link is drawn,
-       through a view of the model with those outputs */
+    /* the file's output points (or those of --outputs) are traced; every
+       point and link is drawn, through a view of the model with those outputs */
+    mech_outputs traced = {0};
+    if ((code = traced_points(&a, m, &traced)) >= 0) {
+        mech_model_free(&m);
+        return code;
+    }
     mech_model view = *m;
     if (select_everything(m, &view.outputs) != 0) {
         fprintf(stderr, "mech animate: out of memory\n");
+        mech_outputs_free(&traced);
         mech_model_free(&m);
         return MECH_EXIT_IO;
     }
-    a.anim.trace = m->outputs.points;
-    a.anim.ntrace = m->outputs.npoints;
+    a.anim.trace = a.outputs ? traced.points : m->outputs.points;
+    a.anim.ntrace = a.outputs ? traced.npoints : m->outputs.npoints;
     mech_solve_options o;
     mech_solve_options_default(&o);
     o.want = MECH_WANT_POSITION;
     o.forces = -1;
-    apply_steps(&a, m, &o);
     mech_table t = {0};
-    code = solve(&a, &view, &o, &t);
+    code = cmd_apply_range("animate", a.from, a.to, a.steps, m, &o);
+    if (code < 0)
+        code = solve(&a, &view, &o, &t);
     if (code == MECH_EXIT_OK) {
         mech_diag d;
         mech_diag_init(&d);
@@ -371,6 +418,7 @@ int cmd_animate(int argc, char **argv)
         code = cmd_exit_status(rc);
     }
     mech_outputs_free(&view.outputs);
+    mech_outputs_free(&traced);
     mech_table_free(&t);
     mech_model_free(&m);
     return code;

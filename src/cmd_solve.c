@@ -11,6 +11,7 @@
 const char cmd_solve_help[] =
     "usage: mech solve FILE [-o OUT.csv] [--from A --to B --steps N] [--tol T]\n"
     "                  [--outputs NAME,...] [--level positions|velocities|accelerations]\n"
+    "                  [--sensitivity NAME,...] [--tolerances]\n"
     "                  [--forces] [--friction on|off|both]\n"
     "                  [--diagnostics] [--stats] [--verbose] [--all]\n"
     "                  [--within-assembly] [--range assembly]\n"
@@ -38,6 +39,16 @@ const char cmd_solve_help[] =
     "                      klu: SuiteSparse KLU always (docs/solver.md)\n"
     "  --set NAME=VALUE    replace the file's parameter NAME by VALUE (repeatable),\n"
     "                      e.g. --set 'l=150 mm'\n"
+    "  --sensitivity LIST  for each parameter NAME in the comma-separated LIST, add\n"
+    "                      a column d(COL)/d(NAME) [COL's unit/NAME's unit] after\n"
+    "                      the others for every position, velocity and\n"
+    "                      acceleration column COL: exact derivatives by the\n"
+    "                      implicit-function theorem, not finite differences\n"
+    "  --tolerances        for every position, velocity and acceleration column COL\n"
+    "                      add worst(COL) = sum |d(COL)/dp| tol_p over the parameters\n"
+    "                      with a tolerance ({value: 40 mm, tolerance: 0.05 mm}) and\n"
+    "                      rss(COL) = sqrt(sum (d(COL)/dp tol_p)^2); print the\n"
+    "                      largest of each over the sweep to standard error\n"
     "  --outputs LIST      comma-separated point, link and slider names to output\n"
     "                      instead of the file's outputs\n"
     "  --level L           positions, velocities or accelerations (default): the\n"
@@ -67,22 +78,16 @@ const char cmd_solve_help[] =
     "the rows that were solved are written, each gap is listed), 2 invalid file or\n"
     "usage, 3 a file cannot be read or written\n";
 
-enum { MAX_SET = 64 };
-
 /* The smallest --tol: a residual is a sum of products of lengths, rounded
  * to about DBL_EPSILON (2.2e-16) times the largest; below a few times that
  * Newton cannot get (docs/solver.md: 4e-15 or better on every file). */
 #define MIN_TOL 1e-15
-/* The largest driver position on the command line, rad or m: beyond it a
- * step of the sweep is lost in the rounding of the position itself
- * (1e6 rad = 57 million degrees, ulp 1.2e-10 rad). */
-#define MAX_DRIVER 1e6
 
 typedef struct solve_args {
     const char *file, *out, *from, *to, *outputs;
-    mech_override set[MAX_SET];  /* --set NAME=VALUE: parameters replaced */
-    char *set_text[MAX_SET];
-    int nset;
+    const char *sens;            /* --sensitivity NAME,... */
+    int tolerances;              /* --tolerances */
+    cmd_sets set;                /* --set NAME=VALUE: parameters replaced */
     int steps, stats, verbose, quiet;
     int within;                  /* --within-assembly or --range assembly */
     mech_outputs selected;       /* --outputs, parsed (opt.outputs points here) */
@@ -100,7 +105,7 @@ static int parse_number(const char *text, double *v)
 static const char *const value_options[] = {"-o", "--output", "--from", "--to", "--outputs",
                                            "--steps", "--tol", "--max-iter", "--min-rcond",
                                            "--level", "--friction", "--set", "--linear-solver",
-                                           "--range"};
+                                           "--range", "--sensitivity"};
 
 static int takes_value(const char *arg)
 {
@@ -108,6 +113,26 @@ static int takes_value(const char *arg)
         if (strcmp(arg, value_options[i]) == 0)
             return 1;
     return 0;
+}
+
+enum { MAX_SENS_NAMES = 64 };
+
+/* Split --sensitivity's list in place into names[], at most 64, different,
+ * none empty; 0 when it is not such a list. */
+static int split_names(char *list, const char **names, int *n)
+{
+    char *save = NULL;
+    size_t len = strlen(list);
+    int bad = len == 0 || list[0] == ',' || list[len - 1] == ',' || strstr(list, ",,");
+    for (char *tok = strtok_r(list, ",", &save); tok && !bad; tok = strtok_r(NULL, ",", &save)) {
+        for (int k = 0; k < *n; k++)
+            bad |= strcmp(names[k], tok) == 0;  /* a name twice: the same columns twice */
+        if (*n == MAX_SENS_NAMES)
+            bad = 1;
+        else
+            names[(*n)++] = tok;
+    }
+    return !bad;
 }
 
 /* One option with its value; returns -1 to go on, else the exit status. */
@@ -122,6 +147,16 @@ static int parse_valued(solve_args *a, const char *arg, const char *val)
         a->to = val;
     else if (strcmp(arg, "--outputs") == 0)
         a->outputs = val;
+    else if (strcmp(arg, "--sensitivity") == 0) {
+        char *copy = strdup(val);
+        const char *names[MAX_SENS_NAMES];
+        int n = 0, ok = copy && split_names(copy, names, &n);
+        free(copy);
+        if (!ok)
+            return cmd_usage_error("solve", "--sensitivity needs at most 64 different parameter "
+                                   "names separated by commas, not '%s'", val);
+        a->sens = val;
+    }
     else if (strcmp(arg, "--steps") == 0) {
         if (!cmd_parse_int(val, 1, 1000000, &a->steps))
             return cmd_usage_error("solve", "--steps needs a whole number from 1 to 1000000 (as in a file), "
@@ -147,16 +182,7 @@ static int parse_valued(solve_args *a, const char *arg, const char *val)
         else
             return cmd_usage_error("solve", "--linear-solver needs auto or klu, not '%s'", val);
     } else if (strcmp(arg, "--set") == 0) {
-        const char *eq = strchr(val, '=');
-        if (!eq || eq == val || !eq[1] || a->nset == MAX_SET)
-            return cmd_usage_error("solve", "--set needs NAME=VALUE (at most 64), not '%s'", val);
-        char *copy = strdup(val);
-        if (!copy)
-            return fprintf(stderr, "mech solve: out of memory\n"), MECH_EXIT_IO;
-        copy[eq - val] = '\0';
-        a->set_text[a->nset] = copy;
-        a->set[a->nset].name = copy;
-        a->set[a->nset++].text = copy + (eq - val) + 1;
+        return cmd_parse_set("solve", val, &a->set);
     } else if (strcmp(arg, "--range") == 0) {
         if (strcmp(val, "assembly") != 0)
             return cmd_usage_error("solve", "--range needs 'assembly', not '%s'", val);
@@ -208,6 +234,8 @@ static int parse_args(int argc, char **argv, solve_args *a)
             a->opt.diagnostics = 1;
         else if (strcmp(arg, "--all") == 0)
             a->opt.all_blocks = 1;
+        else if (strcmp(arg, "--tolerances") == 0)
+            a->tolerances = 1;
         else if (strcmp(arg, "--within-assembly") == 0)
             a->within = 1;
         else if (strcmp(arg, "--forces") == 0)
@@ -223,27 +251,7 @@ static int parse_args(int argc, char **argv, solve_args *a)
     }
     if (!a->file)
         return cmd_usage_error("solve", "%s", "no file given (usage: mech solve FILE [-o OUT.csv] ...)");
-    if ((a->from != NULL) != (a->to != NULL))
-        return cmd_usage_error("solve", "%s", "--from and --to go together");
-    return -1;
-}
-
-/* One end of --from/--to into *si: a finite position within MAX_DRIVER, as
- * the file's range must be finite (docs/limits.md). Returns -1 when fine,
- * else the exit status (the problem printed). */
-static int parse_end(const char *opt, const char *text, int is_angle, double *si)
-{
-    char err[256];
-    if (mech_parse_value(text, is_angle, si, err, sizeof err) != MECH_OK)
-        return fprintf(stderr, "mech solve: %s '%s': %s\n", opt, text, err), MECH_EXIT_INPUT;
-    if (!(fabs(*si) <= MAX_DRIVER)) {
-        snprintf(err, sizeof err, "%s '%.40s' is %.3g %s: a driver %s must be within +-%s "
-                 "(beyond, a step is lost in the rounding of the position)", opt, text, *si,
-                 is_angle ? "rad" : "m", is_angle ? "angle" : "displacement",
-                 is_angle ? "1e6 rad (5.7e7 deg)" : "1e6 m");
-        return cmd_usage_error("solve", "%s", err);
-    }
-    return -1;
+    return cmd_check_range_pair("solve", a->from, a->to);
 }
 
 /* --from/--to/--steps and --outputs into the options (the model is not
@@ -251,20 +259,9 @@ static int parse_end(const char *opt, const char *text, int is_angle, double *si
 static int apply_overrides(solve_args *a, const mech_model *m)
 {
     char err[256];
-    int is_angle = m->driver.kind == MECH_DRIVE_ANGLE, code;
-    if (a->from) {
-        if ((code = parse_end("--from", a->from, is_angle, &a->opt.from)) >= 0 ||
-            (code = parse_end("--to", a->to, is_angle, &a->opt.to)) >= 0)
-            return code;
-        a->opt.has_range = 1;
-        a->opt.steps = a->steps > 0 ? a->steps : 360;
-    } else if (a->steps > 0) {
-        /* new spacing over the file's range */
-        a->opt.has_range = 1;
-        a->opt.from = m->driver.values[0];
-        a->opt.to = m->driver.values[m->driver.nvalues - 1];
-        a->opt.steps = a->steps;
-    }
+    int code = cmd_apply_range("solve", a->from, a->to, a->steps, m, &a->opt);
+    if (code >= 0)
+        return code;
     if (a->outputs) {
         if (mech_outputs_parse(m, a->outputs, &a->selected, err, sizeof err) != MECH_OK)
             return fprintf(stderr, "mech solve: --outputs: %s\n", err), MECH_EXIT_INPUT;
@@ -386,27 +383,70 @@ static int write_rows(const solve_args *a, const mech_table *t)
     return code;
 }
 
-int cmd_solve(int argc, char **argv)
+/* --sensitivity: the derivative columns added to t (mech_sensitivity). */
+static int add_sensitivity(const solve_args *a, const mech_model *m, mech_table *t)
 {
-    solve_args a = {0};
-    int code = parse_args(argc, argv, &a);
-    if (code >= 0) {
-        for (int i = 0; i < a.nset; i++)
-            free(a.set_text[i]);
-        return code;
+    char *list = strdup(a->sens);
+    const char *names[MAX_SENS_NAMES];
+    int n = 0;
+    if (!list)
+        return fprintf(stderr, "mech solve: out of memory\n"), MECH_EXIT_IO;
+    split_names(list, names, &n);  /* checked by parse_valued */
+    mech_diag d;
+    mech_diag_init(&d);
+    int rc = mech_sensitivity(m, a->set.set, a->set.n, &a->opt, names, n, t, &d);
+    mech_diag_print(&d, stderr);
+    mech_diag_free(&d);
+    free(list);
+    return rc == MECH_OK ? -1 : cmd_exit_status(rc);
+}
+
+/* --tolerances: the summary of the worst(COL) and rss(COL) columns. */
+static void print_stackup(const mech_model *m, const mech_table *t, FILE *out)
+{
+    fprintf(out, "mech solve: tolerance stack-up, first order, from");
+    for (int i = 0; i < m->nparams; i++)
+        if (m->params[i].tol > 0)
+            fprintf(out, " %s +-%.6g %s", m->params[i].name, m->params[i].tol,
+                    m->params[i].unit[0] ? m->params[i].unit : "(bare)");
+    fprintf(out, "; largest over the %d rows:\n", t->nrows);
+    for (int c = 0; c + 1 < t->ncolumns; c++) {
+        const char *name = t->columns[c].name;
+        if (strncmp(name, "worst(", 6) != 0)
+            continue;
+        int at = 0;
+        double worst = 0, rss = 0;
+        for (int r = 0; r < t->nrows; r++) {
+            if (mech_table_get(t, r, c) > worst) {
+                worst = mech_table_get(t, r, c);
+                at = r;
+            }
+            rss = fmax(rss, mech_table_get(t, r, c + 1));
+        }
+        fprintf(out, "  %-24.*s worst case %-12.6g RSS %-12.6g [%s] (worst at q = %.6g)\n",
+                (int)strlen(name) - 7, name + 6, worst, rss, t->columns[c].unit,
+                t->nrows ? mech_table_get(t, at, 0) : 0.0);
     }
-    mech_model *m = NULL;
-    code = cmd_refuse_input("solve", a.out, &a.file, 1);
-    if (code < 0)
-        code = cmd_load_checked_with(a.file, a.set, a.nset, &m);
-    for (int i = 0; i < a.nset; i++)
-        free(a.set_text[i]);
-    if (code != MECH_EXIT_OK)
-        return code;
-    if ((code = apply_overrides(&a, m)) >= 0) {
-        mech_model_free(&m);
-        return code;
-    }
+}
+
+/* --tolerances: the columns (mech_tolerances) and the summary. */
+static int add_tolerances(const solve_args *a, const mech_model *m, mech_table *t)
+{
+    mech_diag d;
+    mech_diag_init(&d);
+    int rc = mech_tolerances(m, a->set.set, a->set.n, &a->opt, t, &d);
+    mech_diag_print(&d, stderr);
+    mech_diag_free(&d);
+    if (rc != MECH_OK)
+        return cmd_exit_status(rc);
+    print_stackup(m, t, stderr);
+    return -1;
+}
+
+static int solve_loaded(solve_args *pa, mech_model *m)
+{
+    solve_args a = *pa;
+    int code;
     if (a.verbose)
         a.opt.log = stderr;
     mech_diag d;
@@ -432,11 +472,39 @@ int cmd_solve(int argc, char **argv)
     code = cmd_exit_status(rc);
     if (rc == MECH_ESOLVE && a.within && only_assembly_gaps(&t))
         code = MECH_EXIT_OK;
+    if ((a.sens || a.tolerances) && t.nrows > 0 && (rc == MECH_OK || rc == MECH_ESOLVE)) {
+        a.opt.progress = NULL;
+        int sc = a.sens ? add_sensitivity(&a, m, &t) : -1;
+        if (sc < 0 && a.tolerances)
+            sc = add_tolerances(&a, m, &t);
+        if (sc >= 0) {
+            mech_table_free(&t);
+            return sc;
+        }
+    }
     if (rc == MECH_OK || (rc == MECH_ESOLVE && t.nrows > 0)) {
         int wc = write_rows(&a, &t);
         code = wc != MECH_EXIT_OK ? wc : code;
     }
     mech_table_free(&t);
+    return code;
+}
+
+int cmd_solve(int argc, char **argv)
+{
+    solve_args a = {0};
+    int code = parse_args(argc, argv, &a);
+    if (code >= 0) {
+        cmd_sets_free(&a.set);
+        return code;
+    }
+    mech_model *m = NULL;
+    code = cmd_refuse_input("solve", a.out, &a.file, 1);
+    if (code < 0)
+        code = cmd_load_checked_with(a.file, a.set.set, a.set.n, &m);
+    if (code == MECH_EXIT_OK && (code = apply_overrides(&a, m)) < 0)
+        code = solve_loaded(&a, m);
+    cmd_sets_free(&a.set);
     mech_outputs_free(&a.selected);
     mech_model_free(&m);
     return code;

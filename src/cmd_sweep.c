@@ -17,6 +17,7 @@
 #include "commands.h"
 #include "internal.h"
 #include "output.h"
+#include "sweep_variants.h"
 
 const char cmd_sweep_help[] =
     "usage: mech sweep FILE --vary NAME=FROM:TO:COUNT [--vary ...] [--list NAME=A,B,...]\n"
@@ -419,18 +420,8 @@ static void run_variant(const sweep_run *r, variant *var)
     variant_overrides(r, var->index, ov);
     mech_diag d;
     mech_diag_init(&d);
-    mech_model *m = NULL;
-    mech_summary sum;
     mech_table t = {0};
-    int rc = mech_load_file_with(r->file, ov, r->naxes, &m, &d);
-    if (rc == MECH_OK)
-        rc = mech_check(m, &sum, &d);
-    if (rc == MECH_OK) {
-        mech_solve_options o;
-        mech_solve_options_default(&o);
-        o.forces = r->forces;
-        rc = mech_solve(m, &o, &t, NULL, &d);
-    }
+    int rc = sweep_variant_solve(r->file, ov, r->naxes, r->forces, &t, &d);
     int singular = 0, locking = 0;
     for (size_t i = 0; i < d.count; i++) {  /* the errors say what failed, not the notes */
         const char *msgtext = d.entries[i].message ? d.entries[i].message : "";
@@ -455,7 +446,6 @@ static void run_variant(const sweep_run *r, variant *var)
     for (int k = 0; k < r->nmetrics; k++)
         var->value[k] = rc == MECH_OK ? metric_value(&r->metrics[k], &t, out) : NAN;
     mech_table_free(&t);
-    mech_model_free(&m);
     if (msg)
         fclose(msg);
 }

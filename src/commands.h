@@ -48,6 +48,29 @@ int cmd_default_jobs(void);  /* the CPUs of the affinity mask (else those online
 /* job(ctx, i) for i = 0 .. njobs-1 on up to nthreads threads (each i once). */
 void cmd_run_parallel(int njobs, int nthreads, void (*job)(void *ctx, int i), void *ctx);
 
+/* cmd_common.c: the options `mech solve`, `mech plot` and `mech animate`
+ * share, with the same meaning and messages (docs/cli.md).
+ * --set NAME=VALUE (repeatable): the parameters replaced when loading. */
+enum { CMD_MAX_SET = 64 };
+typedef struct cmd_sets {
+    mech_override set[CMD_MAX_SET];  /* [n] name and text point into copies below */
+    char *copy[CMD_MAX_SET];         /* [n] owned "NAME\0VALUE" */
+    int n;
+} cmd_sets;
+/* One --set value into s; returns -1 to go on, else the exit status (the
+ * problem printed as "mech COMMAND: ..."). */
+int cmd_parse_set(const char *command, const char *val, cmd_sets *s);
+void cmd_sets_free(cmd_sets *s);
+/* --from A --to B [--steps N]: "--from and --to go together" unless both
+ * or neither are given (returns -1 to go on, else the exit status). */
+int cmd_check_range_pair(const char *command, const char *from, const char *to);
+/* The driver range into o: --from/--to (each a finite position within
+ * +-1e6 rad or m, units allowed, bare numbers deg or mm) with `steps`
+ * intervals (default 360), or only --steps: the file's range re-spaced.
+ * Returns -1 to go on, else the exit status (the problem printed). */
+int cmd_apply_range(const char *command, const char *from, const char *to, int steps,
+                    const mech_model *m, mech_solve_options *o);
+
 extern const char cmd_check_help[];
 int cmd_check(int argc, char **argv);
 
@@ -63,6 +86,11 @@ int cmd_batch(int argc, char **argv);
 extern const char cmd_sweep_help[];
 int cmd_sweep(int argc, char **argv);
 
+/* `mech report FILE -o OUT.html` (cmd_report.c, docs/report.md). */
+extern const char cmd_report_help[];
+int cmd_report(int argc, char **argv);
+extern const char cmd_codegen_help[];
+int cmd_codegen(int argc, char **argv);
 /* `mech merge -o OUT SHARD...` (cmd_merge.c): shards of a sweep or batch. */
 extern const char cmd_merge_help[];
 int cmd_merge(int argc, char **argv);

@@ -311,6 +311,7 @@ static int precedence(const expr_node *n)
 static void print_const(double v, FILE *out) { fprintf(out, "%.10g", v); }
 
 static void print_rec(const expr_ctx *c, ex e, const expr_names *nm, int latex, FILE *out, int ctx);
+static void print_product(const expr_ctx *c, ex e, const expr_names *nm, int latex, FILE *out);
 
 /* A sum, flattened: a + b - c ... (a negated term prints as " - term"). */
 static void print_sum(const expr_ctx *c, ex e, const expr_names *nm, int latex, FILE *out,
@@ -345,6 +346,49 @@ static void print_sum(const expr_ctx *c, ex e, const expr_names *nm, int latex, 
     }
 }
 
+enum { MAX_FACTORS = 64 };
+
+/* The factors of a product tree, left to right (at most max; -1 if more). */
+static int factors(const expr_ctx *c, ex e, ex *f, int nf, int max)
+{
+    const expr_node *n = &c->nodes[e];
+    if (n->op != EX_MUL) {
+        if (nf < 0 || nf >= max)
+            return -1;
+        f[nf] = e;
+        return nf + 1;
+    }
+    return factors(c, n->b, f, factors(c, n->a, f, nf, max), max);
+}
+
+/* A product, its factors in order of first appearance, a repeated factor
+ * once with its power: l*cos(th)*th'*th' prints as l*cos(th)*th'^2. */
+static void print_product(const expr_ctx *c, ex e, const expr_names *nm, int latex, FILE *out)
+{
+    ex f[MAX_FACTORS];
+    int nf = factors(c, e, f, 0, MAX_FACTORS), printed = 0;
+    if (nf < 0) {  /* very long: as it is */
+        print_rec(c, c->nodes[e].a, nm, latex, out, PREC_PRODUCT);
+        fputs(latex ? " " : "*", out);
+        print_rec(c, c->nodes[e].b, nm, latex, out, PREC_PRODUCT);
+        return;
+    }
+    for (int i = 0; i < nf; i++) {
+        int power = 1, seen = 0;
+        for (int j = 0; j < i; j++)
+            seen |= f[j] == f[i];
+        if (seen)
+            continue;
+        for (int j = i + 1; j < nf; j++)
+            power += f[j] == f[i];
+        if (printed++)
+            fputs(latex ? " " : "*", out);
+        print_rec(c, f[i], nm, latex, out, power > 1 ? PREC_ATOM : PREC_PRODUCT);
+        if (power > 1)
+            fprintf(out, latex ? "^{%d}" : "^%d", power);
+    }
+}
+
 static void print_rec(const expr_ctx *c, ex e, const expr_names *nm, int latex, FILE *out, int ctx)
 {
     const expr_node *n = &c->nodes[e];
@@ -364,13 +408,11 @@ static void print_rec(const expr_ctx *c, ex e, const expr_names *nm, int latex, 
         break;
     }
     case EX_MUL:
-        print_rec(c, n->a, nm, latex, out, PREC_PRODUCT);
-        fputs(latex ? " " : "*", out);
-        print_rec(c, n->b, nm, latex, out, PREC_PRODUCT);  /* a*(b*c) = a*b*c */
+        print_product(c, e, nm, latex, out);
         break;
     case EX_NEG:
-        fputs("-", out);
-        print_rec(c, n->a, nm, latex, out, PREC_UNARY);
+        fputs("-", out);  /* -(a*b) reads as -a*b */
+        print_rec(c, n->a, nm, latex, out, PREC_PRODUCT);
         break;
     case EX_SIN:
     case EX_COS:

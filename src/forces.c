@@ -69,6 +69,14 @@ static void contact(const solver *sv, const mech_joint *jt, double *p, double *v
     point_motion(sv, jt->link[0], jt->point[0], p, v, a);
 }
 
+/* The contact point alone (no rates): what a column's entries need. */
+static void contact_point(const solver *sv, const mech_joint *jt, double *p)
+{
+    const mech_point *pt = &sv->p->m->links[jt->link[0]].points[jt->point[0]];
+    double r[2] = {pt->x, pt->y};
+    kin_on_link(&sv->ks, jt->link[0], r, p, NULL, NULL);
+}
+
 /* Guide direction u of a slider. */
 static void guide_dir(const solver *sv, const mech_joint *jt, double *u)
 {
@@ -114,10 +122,10 @@ static int push_moment(entry *e, int n, int l, double sign)
 static void column_geometry(const solver *sv, const mech_joint *jt, fc_kind kind, double *p,
                             double *dir)
 {
-    double v[2], u[2] = {1.0, 0.0};
+    double u[2] = {1.0, 0.0};
     p[0] = p[1] = 0.0;
     if (sv)
-        contact(sv, jt, p, v);
+        contact_point(sv, jt, p);
     if (sv && (kind == FC_NORMAL || kind == FC_DRIVE))
         guide_dir(sv, jt, u);
     switch (kind) {
@@ -129,8 +137,9 @@ static void column_geometry(const solver *sv, const mech_joint *jt, fc_kind kind
     }
 }
 
-/* Entries of column c, sorted by row: at the published position of sv
- * with the centres of mass g, or (sv NULL) just their rows. */
+/* Entries of column c, in the order they are made (the plan's slot puts
+ * them in row order: build_pattern sorts once): at the published position
+ * of sv with the centres of mass g, or (sv NULL) just their rows. */
 static int column_entries(const forces_plan *fp, const solver *sv, const double *g, int c,
                           entry *e)
 {
@@ -152,12 +161,6 @@ static int column_entries(const forces_plan *fp, const solver *sv, const double 
             n = push_force(e, n, g, b, p, dir, -1.0);
         }
     }
-    for (int i = 1; i < n; i++)  /* insertion sort: at most 6 entries */
-        for (int k = i; k > 0 && e[k - 1].row > e[k].row; k--) {
-            entry t = e[k];
-            e[k] = e[k - 1];
-            e[k - 1] = t;
-        }
     return n;
 }
 
@@ -195,14 +198,21 @@ static int build_pattern(forces_plan *fp)
     for (int c = 0; c < fp->ncols; c++)
         cap += column_entries(fp, NULL, NULL, c, e);
     fp->Ai = xcalloc((size_t)cap + 1, sizeof *fp->Ai);
-    if (!fp->Ai)
+    fp->slot = xcalloc((size_t)cap + 1, sizeof *fp->slot);
+    if (!fp->Ai || !fp->slot)
         return -1;
     int at = 0;
     for (int c = 0; c < fp->ncols; c++) {
         fp->Ap[c] = at;
         int n = column_entries(fp, NULL, NULL, c, e);
-        for (int k = 0; k < n; k++)
-            fp->Ai[at++] = e[k].row;
+        for (int k = 0; k < n; k++) {  /* rows are distinct: rank = place in row order */
+            int rank = 0;
+            for (int i = 0; i < n; i++)
+                rank += e[i].row < e[k].row;
+            fp->Ai[at + rank] = e[k].row;
+            fp->slot[at + k] = at + rank;
+        }
+        at += n;
     }
     fp->Ap[fp->ncols] = at;
     fp->nnz = at;
@@ -272,7 +282,7 @@ int forces_plan_init(forces_plan *fp, const solver_plan *sp, int friction, mech_
 void forces_plan_free(forces_plan *fp)
 {
     linsys_plan_free(&fp->lp);
-    void *blocks[] = {fp->kind, fp->joint, fp->jcol, fp->Ap, fp->Ai};
+    void *blocks[] = {fp->kind, fp->joint, fp->jcol, fp->Ap, fp->Ai, fp->slot};
     free_all(blocks, COUNT_OF(blocks));
     memset(fp, 0, sizeof *fp);
 }
@@ -440,11 +450,11 @@ static int factor(forces *fc, const solver *sv)
     for (int c = 0; c < fp->ncols; c++) {
         int n = column_entries(fp, sv, fc->g, c, e), at = fp->Ap[c];
         double big = 0.0;
-        for (int k = 0; k < n; k++)
-            big = fmax(big, fabs(e[k].val));
+        for (int k = 0; k < n; k++)  /* (fmax is a library call at -O2) */
+            big = fabs(e[k].val) > big ? fabs(e[k].val) : big;
         fc->cscale[c] = big > 0.0 ? 1.0 / big : 1.0;
         for (int k = 0; k < n; k++)
-            fc->Ax[at + k] = e[k].val * fc->cscale[c];
+            fc->Ax[fp->slot[at + k]] = e[k].val * fc->cscale[c];
     }
     if (linsys_factor(&fc->ls, fc->Ax) < 0) {
         fc->rcond = 0.0;

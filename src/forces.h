@@ -22,6 +22,8 @@ typedef struct forces_plan {
     int *joint;             /* [ncols] joint of a reaction column (-1: the driver) */
     int *jcol;              /* [njoints] first column of each joint */
     int *Ap, *Ai;           /* [ncols+1], [nnz] */
+    int *slot;              /* [nnz] where column c's k-th entry, in the order
+                               column_entries makes them, goes: Ax[slot[Ap[c] + k]] */
     int nnz;
     double speed_eps;       /* smoothing of sign(relative speed), rad/s */
     linsys_plan lp;         /* analysis of the pattern */

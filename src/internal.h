@@ -106,6 +106,8 @@ typedef struct expr_param {
     double value;
     dim d;
     int bare;  /* defined by a bare number: a pure number that adopts context */
+    double dvalue; /* d value / d seed: 1 for the seeded parameter itself, else through
+                      its definition (forward mode; 0 when nothing is seeded) */
 } expr_param;
 typedef struct expr_env {
     const unit_defaults *units;
@@ -113,12 +115,29 @@ typedef struct expr_env {
     int nparams;
     const name_map *param_index; /* name -> index into params, or NULL (linear search):
                                     a file may define many parameters */
+    double *dvalue;              /* NULL, or where quantity_eval writes the derivative of
+                                    the value it returns with respect to the seed */
 } expr_env;
 int quantity_eval(const char *text, quantity want, const expr_env *env,
                   double *value, char *err, size_t errsize, size_t *err_pos);
 /* Evaluate a parameter definition: keeps its own dimension (or bare). */
 int quantity_eval_param(const char *text, const expr_env *env, expr_param *out,
                         char *err, size_t errsize, size_t *err_pos);
+
+/* load.c: mech_load_file_with, carrying d/d(seed) of every point's
+ * coordinates into mech_point.dxy (forward mode through the quantity
+ * expressions; the parameter named `seed` has derivative 1). */
+int load_file_seeded(const char *path, const mech_override *ov, int nov, const char *seed,
+                     mech_model **out, mech_diag *d);
+
+/* load.c: a file read and parsed once (load_doc_read), then turned into
+ * models with different parameter replacements (load_doc_model, as
+ * mech_load_file_with; threads may share the document). */
+typedef struct load_doc load_doc;
+int load_doc_read(const char *path, load_doc **out, mech_diag *d);
+int load_doc_model(const load_doc *doc, const mech_override *ov, int nov, mech_model **out,
+                   mech_diag *d);
+void load_doc_free(load_doc **doc);
 
 /* ---- yamltree.c: a bounded YAML document tree with marks. */
 typedef enum { YNODE_SCALAR, YNODE_SEQ, YNODE_MAP } ynode_kind;

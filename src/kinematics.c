@@ -36,6 +36,30 @@ static void nearest_carriers(kin_tree *t)
     }
 }
 
+/* The points through which each link is placed from its parent (place_link),
+ * looked up once instead of at every step. */
+static void attach_points(kin_tree *t)
+{
+    const mech_model *m = t->model;
+    for (int l = 1; l < m->nlinks; l++) {
+        int j = t->span->parent_joint[l], pl = t->span->parent_link[l];
+        if (j < 0 || pl < 0)
+            continue;
+        const mech_joint *jt = &m->joints[j];
+        int ip, il;  /* the point in the parent, in l */
+        if (jt->kind == MECH_JOINT_REVOLUTE) {
+            ip = loops_attach(jt, pl);
+            il = loops_attach(jt, l);
+        } else {
+            ip = jt->point[l == jt->link[0] ? 1 : 0];
+            il = jt->point[l == jt->link[0] ? 0 : 1];
+        }
+        double *a = t->attach + 4 * l;
+        a[0] = m->links[pl].points[ip].x, a[1] = m->links[pl].points[ip].y;
+        a[2] = m->links[l].points[il].x, a[3] = m->links[l].points[il].y;
+    }
+}
+
 int kin_tree_build(kin_tree *t, const mech_system *s)
 {
     const mech_model *m = s->model;
@@ -49,8 +73,9 @@ int kin_tree_build(kin_tree *t, const mech_system *s)
     t->point_link = xcalloc(np, sizeof *t->point_link);
     t->point_index = xcalloc(np, sizeof *t->point_index);
     t->active = xcalloc(nl, sizeof *t->active);
-    if (!t->angle_var ||
-        !t->slide_var || !t->point_link || !t->point_index || !t->active) {
+    t->attach = xcalloc(4 * nl, sizeof *t->attach);
+    if (!t->angle_var || !t->slide_var || !t->point_link || !t->point_index || !t->active ||
+        !t->attach) {
         kin_tree_free(t);
         return MECH_ENOMEM;
     }
@@ -60,6 +85,7 @@ int kin_tree_build(kin_tree *t, const mech_system *s)
         t->slide_var[j] = m->joints[j].kind == MECH_JOINT_SLIDER
                               ? expr_variable(&s->ex, s->slide[j]) : -1;
     nearest_carriers(t);
+    attach_points(t);
     return MECH_OK;
 }
 
@@ -70,6 +96,7 @@ void kin_tree_free(kin_tree *t)
     free(t->point_link);
     free(t->point_index);
     free(t->active);
+    free(t->attach);
     memset(t, 0, sizeof *t);
 }
 
@@ -117,12 +144,16 @@ int kin_state_init(kin_state *st, const mech_model *m)
     st->o = xcalloc(2 * nl, sizeof *st->o);
     st->vo = xcalloc(2 * nl, sizeof *st->vo);
     st->ao = xcalloc(2 * nl, sizeof *st->ao);
-    if (!st->th || !st->om || !st->al || !st->c || !st->s || !st->o || !st->vo || !st->ao) {
+    st->guide = xcalloc(3 * (size_t)m->njoints + 1, sizeof *st->guide);
+    if (!st->th || !st->om || !st->al || !st->c || !st->s || !st->o || !st->vo || !st->ao ||
+        !st->guide) {
         kin_state_free(st);
         return MECH_ENOMEM;
     }
     for (size_t l = 0; l < nl; l++)
         st->c[l] = 1.0;  /* angle 0 until updated; the ground stays so */
+    for (int j = 0; j < m->njoints; j++)
+        st->guide[3 * j] = NAN;  /* no direction yet */
     return MECH_OK;
 }
 
@@ -136,13 +167,15 @@ void kin_state_free(kin_state *st)
     free(st->o);
     free(st->vo);
     free(st->ao);
+    free(st->guide);
     memset(st, 0, sizeof *st);
 }
 
 static double var_value(const double *v, int var) { return v && var >= 0 ? v[var] : 0.0; }
 
 /* Point r of link l: position, and rates when the link's rates are known. */
-void kin_on_link(const kin_state *st, int l, const double *r, double *p, double *v, double *a)
+static inline void on_link(const kin_state *st, int l, const double *r, double *p, double *v,
+                           double *a)
 {
     double c = st->c[l], s = st->s[l];
     double rx = c * r[0] - s * r[1], ry = s * r[0] + c * r[1];  /* R r */
@@ -157,6 +190,11 @@ void kin_on_link(const kin_state *st, int l, const double *r, double *p, double 
         a[0] = st->ao[2 * l] - al * ry - w * w * rx;
         a[1] = st->ao[2 * l + 1] + al * rx - w * w * ry;
     }
+}
+
+void kin_on_link(const kin_state *st, int l, const double *r, double *p, double *v, double *a)
+{
+    on_link(st, l, r, p, v, a);
 }
 
 /* Place link l so that its point r is at p (with rates v, a). */
@@ -183,12 +221,18 @@ static const double *point_xy(const mech_model *m, int l, int i, double *buf)
 
 /* Offset of the mover point from the guide point, and its rates, for a
  * slider with guide g: d = s u, with u at angle th_g + angle. */
-static void slide_offset(const kin_state *st, const mech_joint *jt, double s, double sd,
+static void slide_offset(kin_state *st, int j, const mech_joint *jt, double s, double sd,
                          double sdd, double *d, double *dv, double *da)
 {
     int g = jt->link[1];
     double ang = st->th[g] + jt->angle, w = st->om[g], al = st->al[g];
-    double ux = cos(ang), uy = sin(ang);  /* u; u_perp = (-uy, ux) */
+    double *u = st->guide + 3 * j;  /* angle, cos, sin: the same values while it holds */
+    if (!(u[0] == ang)) {
+        u[0] = ang;
+        u[1] = cos(ang);
+        u[2] = sin(ang);
+    }
+    double ux = u[1], uy = u[2];  /* u; u_perp = (-uy, ux) */
     d[0] = s * ux;
     d[1] = s * uy;
     double tang = sd, norm = s * w;                          /* along u, along u_perp */
@@ -205,24 +249,25 @@ static void place_link(const kin_tree *t, kin_state *st, int l, const double *po
     const mech_model *m = t->model;
     int j = t->span->parent_joint[l], pl = t->span->parent_link[l];
     const mech_joint *jt = &m->joints[j];
-    double rbuf[2], p[2], v[2], a[2];
+    const double *at = t->attach + 4 * l;
+    double p[2], v[2], a[2];
     if (jt->kind == MECH_JOINT_REVOLUTE) {
-        kin_on_link(st, pl, point_xy(m, pl, loops_attach(jt, pl), rbuf), p, v, a);
-        place_at(st, l, point_xy(m, l, loops_attach(jt, l), rbuf), p, v, a);
+        on_link(st, pl, at, p, v, a);
+        place_at(st, l, at + 2, p, v, a);
         return;
     }
     int sv = t->slide_var[j];
     double d[3][2];
-    slide_offset(st, jt, var_value(pos, sv), var_value(vel, sv), var_value(acc, sv), d[0], d[1],
-                 d[2]);
+    slide_offset(st, j, jt, var_value(pos, sv), var_value(vel, sv), var_value(acc, sv), d[0],
+                 d[1], d[2]);
     double sign = l == jt->link[0] ? 1.0 : -1.0;  /* mover = guide point + d */
-    kin_on_link(st, pl, point_xy(m, pl, jt->point[l == jt->link[0] ? 1 : 0], rbuf), p, v, a);
+    on_link(st, pl, at, p, v, a);
     for (int k = 0; k < 2; k++) {
         p[k] += sign * d[0][k];
         v[k] += sign * d[1][k];
         a[k] += sign * d[2][k];
     }
-    place_at(st, l, point_xy(m, l, jt->point[l == jt->link[0] ? 0 : 1], rbuf), p, v, a);
+    place_at(st, l, at + 2, p, v, a);
 }
 
 void kin_update(const kin_tree *t, kin_state *st, const double *pos, const double *vel,
@@ -254,6 +299,6 @@ void kin_point(const kin_tree *t, const kin_state *st, int name_id, double *p, d
         p[0] = p[1] = NAN;
         l = 0;
     }
-    kin_on_link(st, l, point_xy(t->model, l, t->point_index[name_id], rbuf), p, v ? v : vb,
+    on_link(st, l, point_xy(t->model, l, t->point_index[name_id], rbuf), p, v ? v : vb,
             a ? a : ab);
 }

@@ -20,6 +20,9 @@ typedef struct kin_tree {
     int *point_link;    /* [npoint_names] the carrier link of a point name nearest the ground */
     int *point_index;   /* [npoint_names] the point's index in that link */
     unsigned char *active; /* [nlinks] frames to compute (kin_mark_point/link) */
+    double *attach;     /* [4 nlinks] link l is placed from its parent through the joint's
+                           point: at attach[4l], [4l+1] in the parent's frame (revolute: the
+                           pin; slider: the guide's point), at [4l+2], [4l+3] in l's */
 } kin_tree;
 
 /* Positions, velocities and accelerations of every active link frame. */
@@ -28,6 +31,8 @@ typedef struct kin_state {
     double *c, *s;          /* [nlinks] cos and sin of th (ground: 1, 0); kept while th
                                does not change */
     double *o, *vo, *ao;    /* [2 nlinks] frame origin and its rates */
+    double *guide;          /* [3 njoints] a slider's guide angle, its cos and sin, kept
+                               while the angle does not change (a ground guide: always) */
 } kin_state;
 
 int kin_tree_build(kin_tree *t, const mech_system *s);

@@ -107,12 +107,12 @@ int linsys_factor(linsys *ls, double *Ax)
 {
     const linsys_plan *lp = ls->plan;
     ls->factored = 0;
-    int nnz = lp->Ap[lp->n];
-    for (int p = 0; p < nnz; p++)
-        if (!isfinite(Ax[p]))
-            return -1;
     int rc;
     if (lp->use_klu) {
+        int nnz = lp->Ap[lp->n];  /* (blocklu_factor checks its own) */
+        for (int p = 0; p < nnz; p++)
+            if (!isfinite(Ax[p]))
+                return -1;
         rc = klu_factor_values(ls, Ax);
     } else {
         ls->factorizations++;

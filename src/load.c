@@ -101,12 +101,13 @@ static void load_document(loader *ld, const ynode *root)
 }
 
 static int load_string_with(const char *text, size_t len, const char *name,
-                            const mech_override *ov, int nov, mech_model **out, mech_diag *d);
+                            const mech_override *ov, int nov, const char *seed,
+                            mech_model **out, mech_diag *d);
 
 int mech_load_string(const char *text, size_t len, const char *name, mech_model **out,
                      mech_diag *d)
 {
-    return load_string_with(text, len, name, NULL, 0, out, d);
+    return load_string_with(text, len, name, NULL, 0, NULL, out, d);
 }
 
 /* Overrides naming no parameter of the file. */
@@ -119,32 +120,44 @@ static void unused_overrides(loader *ld)
                        ld->ov[o].name);
 }
 
+static int load_tree_with(const ynode *root, const char *name, const mech_override *ov,
+                          int nov, const char *seed, mech_model **out, mech_diag *d);
+
 static int load_string_with(const char *text, size_t len, const char *name,
-                            const mech_override *ov, int nov, mech_model **out, mech_diag *d)
+                            const mech_override *ov, int nov, const char *seed,
+                            mech_model **out, mech_diag *d)
 {
     *out = NULL;
-    size_t errors_before = d->nerrors;
     ynode *root = ytree_parse(text, len, name, NULL, d);
     if (!root)
         return MECH_EINPUT;
+    int rc = load_tree_with(root, name, ov, nov, seed, out, d);
+    ytree_free(root);
+    return rc;
+}
+
+/* The model of a parsed document (read only: threads may share the tree). */
+static int load_tree_with(const ynode *root, const char *name, const mech_override *ov,
+                          int nov, const char *seed, mech_model **out, mech_diag *d)
+{
+    *out = NULL;
+    size_t errors_before = d->nerrors;
     loader ld = {0};
     ld.file = name;
     ld.d = d;
     ld.ov = ov;
     ld.nov = nov;
+    ld.seed = seed;
+    ld.env.dvalue = &ld.dlast;
     unsigned char used[64] = {0};
     ld.ov_used = used;
-    if (nov > 64) {
-        ytree_free(root);
+    if (nov > 64)
         return diag_error(d, name, (mech_mark){0, 0}, "at most 64 parameter replacements");
-    }
     ld.m = xcalloc(1, sizeof *ld.m);
     unit_defaults_init(&ld.units);
     ld.env.units = &ld.units;
-    if (!ld.m) {
-        ytree_free(root);
+    if (!ld.m)
         return diag_error(d, name, (mech_mark){0, 0}, "out of memory"), MECH_ENOMEM;
-    }
     ld.m->file = xstrdup(name);
     if (root->kind != YNODE_MAP)
         load_err(&ld, root, "a mechanism file must be a mapping of keys ('name:', 'ground:', "
@@ -152,7 +165,6 @@ static int load_string_with(const char *text, size_t len, const char *name,
     else
         load_document(&ld, root);
     unused_overrides(&ld);
-    ytree_free(root);
     free(ld.params);
     free(ld.link_failed);
     name_map_free(&ld.bad_params);
@@ -281,7 +293,65 @@ int mech_load_file_with(const char *path, const mech_override *ov, int nov, mech
     char *buf = read_file(path, yaml_default_limits.max_bytes, &len, d, &rc);
     if (!buf)
         return rc;
-    rc = load_string_with(buf, len, path, ov, nov, out, d);
+    rc = load_string_with(buf, len, path, ov, nov, NULL, out, d);
     free(buf);
     return rc;
+}
+
+int load_file_seeded(const char *path, const mech_override *ov, int nov, const char *seed,
+                     mech_model **out, mech_diag *d)
+{
+    *out = NULL;
+    size_t len = 0;
+    int rc;
+    char *buf = read_file(path, yaml_default_limits.max_bytes, &len, d, &rc);
+    if (!buf)
+        return rc;
+    rc = load_string_with(buf, len, path, ov, nov, seed, out, d);
+    free(buf);
+    return rc;
+}
+
+/* ---- a document parsed once, loaded many times (mech sweep) --------- */
+
+struct load_doc {
+    char *path;
+    ynode *root;
+};
+
+int load_doc_read(const char *path, load_doc **out, mech_diag *d)
+{
+    *out = NULL;
+    size_t len = 0;
+    int rc;
+    char *buf = read_file(path, yaml_default_limits.max_bytes, &len, d, &rc);
+    if (!buf)
+        return rc;
+    load_doc *doc = xcalloc(1, sizeof *doc);
+    if (doc && (doc->path = xstrdup(path)))
+        doc->root = ytree_parse(buf, len, path, NULL, d);
+    free(buf);
+    if (!doc || !doc->root) {
+        rc = doc && doc->path ? MECH_EINPUT : MECH_ENOMEM;
+        load_doc_free(&doc);
+        return rc;
+    }
+    *out = doc;
+    return MECH_OK;
+}
+
+int load_doc_model(const load_doc *doc, const mech_override *ov, int nov, mech_model **out,
+                   mech_diag *d)
+{
+    return load_tree_with(doc->root, doc->path, ov, nov, NULL, out, d);
+}
+
+void load_doc_free(load_doc **doc)
+{
+    if (!doc || !*doc)
+        return;
+    ytree_free((*doc)->root);
+    free((*doc)->path);
+    free(*doc);
+    *doc = NULL;
 }

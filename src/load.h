@@ -51,6 +51,9 @@ typedef struct loader {
     int nov;
     unsigned char *ov_used;  /* [nov] the file defines it */
     int angle_unit_given; /* 'units:' names the angle unit: bare driver angles are meant */
+    const char *seed;     /* the parameter p whose derivatives d/dp are carried (sensitivities:
+                             mech_point.dxy), or NULL */
+    double dlast;         /* d/dp of the last quantity evaluated (env.dvalue points here) */
 } loader;
 
 /* Index of a point, link or joint name, or -1. */

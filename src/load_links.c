@@ -105,6 +105,55 @@ static int eval_parameter(loader *ld, const ynode *k, const ynode *v, const char
     return 0;
 }
 
+/* A parameter's definition: the scalar `40 mm`, or the `value` of
+ * {value: 40 mm, tolerance: 0.05 mm} (*tol: the tolerance's node). NULL
+ * when reported. */
+static const ynode *parameter_value(loader *ld, const ynode *v, const char *name,
+                                    const ynode **tol)
+{
+    if (v->kind != YNODE_MAP)
+        return load_want_kind(ld, v, YNODE_SCALAR, "a parameter value") ? v : NULL;
+    static const char *const keys[] = {"value", "tolerance"};
+    char where[128];
+    snprintf(where, sizeof where, "parameter '%s'", name);
+    load_check_keys(ld, v, keys, COUNT(keys), where);
+    const ynode *val = ymap_get(v, "value");
+    if (!val && load_misspelt(v, "value", keys, COUNT(keys)))
+        return NULL;  /* reported as a typo */
+    if (!val) {
+        load_err(ld, v, "parameter '%s' needs a 'value' (as {value: 40 mm, tolerance: "
+                        "0.05 mm})", name);
+        return NULL;
+    }
+    *tol = ymap_get(v, "tolerance");
+    return load_want_kind(ld, val, YNODE_SCALAR, "a parameter value") ? val : NULL;
+}
+
+/* The tolerance of parameter p (+-, SI): a quantity of p's dimension (a bare
+ * number only for a bare p), not negative. 0, or -1 with the problem reported. */
+static int eval_tolerance(loader *ld, const ynode *t, const char *name, const expr_param *p,
+                          double *out)
+{
+    char msg[256];
+    size_t pos = 0;
+    expr_param tp = {0};
+    if (!load_want_kind(ld, t, YNODE_SCALAR, "a tolerance"))
+        return -1;
+    if (quantity_eval_param(t->text, &ld->env, &tp, msg, sizeof msg, &pos) < 0)
+        return load_err(ld, t, "tolerance of parameter '%s': %s", name, msg), -1;
+    char du[32], dt[32];
+    dim_format(p->d, du, sizeof du);
+    dim_format(tp.d, dt, sizeof dt);
+    if (tp.bare != p->bare || (!p->bare && !dim_equal(tp.d, p->d)))
+        return load_err(ld, t, "tolerance of parameter '%s' must be in the value's unit (%s), "
+                               "not '%s'", name, p->bare ? "a bare number" : du, t->text), -1;
+    if (tp.value < 0)
+        return load_err(ld, t, "tolerance of parameter '%s' is negative (write the +- "
+                               "half-width: 0.05 mm)", name), -1;
+    *out = tp.value;
+    return 0;
+}
+
 void load_parameters(loader *ld, const ynode *map)
 {
     if (!load_check_map(ld, map, NULL, 0, "'parameters'", "parameter"))
@@ -135,11 +184,19 @@ void load_parameters(loader *ld, const ynode *map)
         }
         if (k->dup_of)
             continue; /* duplicate key, already reported */
-        if (!load_want_kind(ld, v, YNODE_SCALAR, "a parameter value"))
-            continue;
+        const ynode *tol = NULL;
+        const ynode *def = parameter_value(ld, v, name, &tol);
         expr_param p = {0};
-        if (eval_parameter(ld, k, v, name, &p) != 0)
+        double tolerance = 0.0;
+        if (def && eval_parameter(ld, k, def, name, &p) != 0)
+            continue;  /* reported, and its uses are not reported again */
+        if (!def || (tol && eval_tolerance(ld, tol, name, &p, &tolerance) != 0)) {
+            if (name_map_put(&ld->bad_params, k->text, 1) < 0)  /* no echo from its uses */
+                load_err(ld, k, "out of memory");
             continue;
+        }
+        if (ld->seed && strcmp(ld->seed, name) == 0)
+            p.dvalue = 1.0;  /* the parameter the derivatives are taken by */
         mech_param *mp = &m->params[m->nparams];
         mp->name = xstrdup(name);
         if (!mp->name || name_map_put(&ld->param_map, mp->name, m->nparams) < 0) {
@@ -149,7 +206,10 @@ void load_parameters(loader *ld, const ynode *map)
             continue;
         }
         mp->value = p.value;
+        mp->tol = tolerance;
         mp->mark = k->mark;
+        if (!p.bare)
+            dim_format(p.d, mp->unit, sizeof mp->unit);
         p.name = mp->name;
         ld->params[m->nparams++] = p;
         ld->env.nparams = m->nparams;
@@ -194,18 +254,30 @@ static int point_of_link(const mech_link *l, const name_map *index, const char *
     return -1;
 }
 
-/* A point: [x, y] or {length, angle, from}. `l` holds the points read so far. */
-static int load_point_coords(loader *ld, const mech_link *l, const name_map *index,
-                             const ynode *v, const char *what, double *x, double *y)
+/* [x, y], with d(x, y)/d(seed) in dxy. */
+static int load_xy(loader *ld, const ynode *v, const char *what, double *x, double *y,
+                   double *dxy)
 {
-    if (v->kind == YNODE_SEQ) {
-        double xy[2];
-        if (!load_get_vec2(ld, v, Q_LENGTH, what, xy))
-            return 0;
-        *x = xy[0];
-        *y = xy[1];
-        return 1;
-    }
+    if (v->n != 2)
+        return load_get_vec2(ld, v, Q_LENGTH, what, dxy);  /* reports the shape */
+    ld->dlast = 0.0;
+    int ok = load_get_quantity(ld, v->items[0], Q_LENGTH, what, x);
+    dxy[0] = ld->dlast;
+    ld->dlast = 0.0;
+    ok = load_get_quantity(ld, v->items[1], Q_LENGTH, what, y) && ok;
+    dxy[1] = ld->dlast;
+    return ok;
+}
+
+/* A point: [x, y] or {length, angle, from}. `l` holds the points read so far.
+ * dxy: d(x, y)/d(seed parameter) (loader.seed), 0 when nothing is seeded. */
+static int load_point_coords(loader *ld, const mech_link *l, const name_map *index,
+                             const ynode *v, const char *what, double *x, double *y,
+                             double *dxy)
+{
+    dxy[0] = dxy[1] = 0.0;
+    if (v->kind == YNODE_SEQ)
+        return load_xy(ld, v, what, x, y, dxy);
     if (v->kind != YNODE_MAP) {
         load_err(ld, v, "%s must be [x, y] or {length: ..., angle: ...}", what);
         return 0;
@@ -218,15 +290,21 @@ static int load_point_coords(loader *ld, const mech_link *l, const name_map *ind
                  len ? "angle" : "length");
         return 0;
     }
-    double r, a, x0 = 0, y0 = 0;
+    double r, a, x0 = 0, y0 = 0, dx0 = 0, dy0 = 0;
+    ld->dlast = 0.0;
     int ok = load_get_quantity(ld, len, Q_LENGTH, what, &r);
+    double dr = ld->dlast;
+    ld->dlast = 0.0;
     ok = load_get_quantity(ld, ang, Q_ANGLE, what, &a) && ok;
+    double da = ld->dlast;
     if (from) {
         const char *fname = load_get_name(ld, from, "'from'");
         int i = fname ? point_of_link(l, index, fname) : -1;
         if (i >= 0) {
             x0 = l->points[i].x;
             y0 = l->points[i].y;
+            dx0 = l->points[i].dxy[0];
+            dy0 = l->points[i].dxy[1];
         }
         if (fname && i < 0) {
             load_err(ld, from, "'from: %s' must name a point listed earlier in link '%s'", fname,
@@ -238,6 +316,8 @@ static int load_point_coords(loader *ld, const mech_link *l, const name_map *ind
         return 0;  /* r or a may be unset */
     *x = x0 + r * cos(a);
     *y = y0 + r * sin(a);
+    dxy[0] = dx0 + dr * cos(a) - r * sin(a) * da;
+    dxy[1] = dy0 + dr * sin(a) + r * cos(a) * da;
     return 1;
 }
 
@@ -277,7 +357,7 @@ static int load_points(loader *ld, mech_link *l, const ynode *map)
         char what[128];
         snprintf(what, sizeof what, "point '%s' of link '%s'", name, l->name);
         mech_point *p = &l->points[l->npoints];
-        if (!load_point_coords(ld, l, &index, v, what, &p->x, &p->y)) {
+        if (!load_point_coords(ld, l, &index, v, what, &p->x, &p->y, p->dxy)) {
             p->x = p->y = 0;
             ld->link_failed[l - ld->m->links] |= LINK_UNPLACED;
         }
@@ -336,7 +416,8 @@ static void load_mass(loader *ld, mech_link *l, const ynode *map)
             load_err(ld, center, "%s: '%s' is not a point of link '%s'", what, center->text, l->name);
             return;
         }
-    } else if (!load_point_coords(ld, l, NULL, center, what, &l->center[0], &l->center[1])) {
+    } else if (!load_point_coords(ld, l, NULL, center, what, &l->center[0], &l->center[1],
+                                  (double[2]){0, 0})) {
         return;
     }
     snprintf(what, sizeof what, "inertia of link '%s'", l->name);

@@ -32,6 +32,10 @@ static const command commands[] = {
      cmd_merge_help},
     {"plot", cmd_plot, "draw SVG figures of the sweep (docs/plots.md)", cmd_plot_help},
     {"animate", cmd_animate, "write an animated SVG of the mechanism", cmd_animate_help},
+    {"report", cmd_report, "write one self-contained HTML page of the mechanism (docs/report.md)",
+     cmd_report_help},
+    {"codegen", cmd_codegen, "write a standalone C solver for one mechanism (docs/codegen.md)",
+     cmd_codegen_help},
 };
 #define NCOMMANDS (sizeof commands / sizeof commands[0])
 

@@ -153,7 +153,18 @@ static void plan_sliders(plan *p, const mech_model *m)
               a_, none, 1);
 }
 
-/* Forces: one figure per joint, with and without friction when both exist. */
+/* The links a joint's reaction acts on and comes from (docs/forces.md,
+ * "Sign conventions"): a revolute's is the force on the later link in the
+ * file from the earlier one; a slider's, on the sliding link from the guide. */
+static void reaction_links(const mech_joint *jt, int *on, int *from)
+{
+    int later = jt->kind != MECH_JOINT_SLIDER && jt->link[1] > jt->link[0];
+    *on = later ? jt->link[1] : jt->link[0];
+    *from = later ? jt->link[0] : jt->link[1];
+}
+
+/* Forces: one figure per joint, with and without friction when both exist;
+ * the title and the legend say which link the force acts on. */
 static void plan_forces(plan *p, const mech_model *m)
 {
     static const char *const fxy[] = {".Fx", ".Fy", ".Fx.nofriction", ".Fy.nofriction"};
@@ -161,19 +172,27 @@ static void plan_forces(plan *p, const mech_model *m)
     for (int j = 0; j < m->njoints; j++) {
         const mech_joint *jt = &m->joints[j];
         char stem[96], title[160], nf[96];
+        int on, from, n0 = p->n;
+        reaction_links(jt, &on, &from);
         snprintf(nf, sizeof nf, "%s.Fx.nofriction", jt->name);
         int per = mech_table_column(p->t, nf) >= 0 ? 4 : 2;
         snprintf(stem, sizeof stem, "force-%s", jt->name);
-        snprintf(title, sizeof title, "Reaction at %s joint %s (%s-%s)",
+        snprintf(title, sizeof title, "Reaction at %s joint %s: force on %s from %s",
                  jt->kind == MECH_JOINT_SLIDER ? "slider" : "revolute", jt->name,
-                 m->links[jt->link[0]].name, m->links[jt->link[1]].name);
+                 m->links[on].name, m->links[from].name);
         const char *it[1] = {jt->name}, *lb[1] = {""};
         add_group(p, stem, title, "force", it, lb, 1, fxy, fxy_l, per);
+        for (int k = n0; k < p->n; k++) {
+            snprintf(p->figs[k].note[0], sizeof p->figs[k].note[0], "%s: force on %s",
+                     jt->name, m->links[on].name);
+            snprintf(p->figs[k].note[1], sizeof p->figs[k].note[1], "from %s",
+                     m->links[from].name);
+        }
     }
 }
 
 /* The driver torque (or force), with and without friction when both exist. */
-static void plan_driver(plan *p)
+static void plan_driver(plan *p, const mech_model *m)
 {
     const mech_table *t = p->t;
     const char *drv = mech_table_column(t, "driver.torque") >= 0 ? "driver.torque"
@@ -190,9 +209,20 @@ static void plan_driver(plan *p)
     static const char *const sfx_one[] = {""};
     const char *it[1] = {drv};
     const char *lb[1] = {both ? "" : torque ? "driver torque" : "driver force"};
+    int n0 = p->n;
     add_group(p, torque ? "driver-torque" : "driver-force",
               torque ? "Driver torque" : "Driver force", torque ? "torque" : "force", it, lb,
               1, sfx, both ? sfx_both : sfx_one, both ? 2 : 1);
+    /* applied by the ground to the driver link (docs/forces.md); a driving
+       slider's force acts along its guide on the sliding link */
+    int on = !m->has_driver ? -1 : torque ? m->driver.index
+             : m->joints[m->driver.index].link[0];
+    for (int k = n0; k < p->n && on >= 0; k++) {
+        snprintf(p->figs[k].note[0], sizeof p->figs[k].note[0], "%s on %s",
+                 torque ? "torque" : "force", m->links[on].name);
+        snprintf(p->figs[k].note[1], sizeof p->figs[k].note[1], "from %s",
+                 torque ? m->links[0].name : "the guide");
+    }
 }
 
 int plot_plan(const mech_model *m, const mech_table *t, plot_figure *figs, int max)
@@ -207,7 +237,7 @@ int plot_plan(const mech_model *m, const mech_table *t, plot_figure *figs, int m
         plan_links(&p, m);
         plan_sliders(&p, m);
         plan_forces(&p, m);
-        plan_driver(&p);
+        plan_driver(&p, m);
     }
     free(p.items);
     free(p.labels);
@@ -217,24 +247,6 @@ int plot_plan(const mech_model *m, const mech_table *t, plot_figure *figs, int m
 
 /* ------------------------------------------------------------------ */
 /* One figure.                                                         */
-
-static const char *const series_colour[PLOT_MAX_SERIES] = {
-    "#1f4e99", "#c0392b", "#1e7b3c", "#7d3c98", "#b86e00", "#0f7c8c", "#404040", "#a0306a"};
-static const char *const series_dash[4] = {"", "7,4", "2,3", "9,3,2,3"};
-/* markers centred on 0,0: circle, square, triangle, diamond */
-static const char *const marker_path[4] = {
-    "M-3.5,0a3.5,3.5 0 1 0 7,0a3.5,3.5 0 1 0-7,0z", "M-3.2-3.2h6.4v6.4h-6.4z",
-    "M0-4.3L3.9,2.7H-3.9z", "M0-4.5L4.5,0 0,4.5-4.5,0z"};
-
-/* Style s: colour s, marker shape s % 4 (open for s < 4, filled after),
- * dash (s + s / 4) % 4, so that no two of the 8 styles share shape, fill and dash. */
-static void style_of(int s, const char **colour, const char **dash, int *shape, int *filled)
-{
-    *colour = series_colour[s % PLOT_MAX_SERIES];
-    *dash = series_dash[(s + s / 4) % 4];
-    *shape = s % 4;
-    *filled = s >= 4;
-}
 
 typedef struct fig_ctx {
     const mech_model *m;
@@ -304,19 +316,23 @@ static void fig_axes(const fig_ctx *c, plot_axis *ax, plot_axis *ay)
 
 /* The document's start: root element, title, markers and clip path,
  * background, the figure's title and subtitle. */
-static void fig_head(FILE *f, const fig_ctx *c)
+static void fig_head(FILE *f, const fig_ctx *c, const plot_axis *ax, const plot_axis *ay)
 {
     const plot_figure *fg = c->f;
+    /* data-mech-axes "sx ox sy oy": page x = ox + sx X, y = oy - sy Y for X, Y
+       in the axes' display units (what px_of, py_of compute; for tests) */
+    double sx = (AX_R - AX_L) / (ax->hi - ax->lo), sy = (AX_B - AX_T) / (ay->hi - ay->lo);
     fprintf(f, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
                "<svg xmlns=\"http://www.w3.org/2000/svg\" "
                "xmlns:xlink=\"http://www.w3.org/1999/xlink\" width=\"%d\" height=\"%d\" "
                "viewBox=\"0 0 %d %d\" font-family=\"DejaVu Sans,Arial,Helvetica,sans-serif\" "
-               "font-size=\"12\">\n", FIG_W, FIG_H, FIG_W, FIG_H);
+               "font-size=\"12\" data-mech-axes=\"%.12g %.12g %.12g %.12g\">\n", FIG_W, FIG_H,
+            FIG_W, FIG_H, sx, AX_L - ax->lo * sx, sy, AX_B + ay->lo * sy);
     fputs("<title>", f);
     plot_put_text(f, fg->title);
     fputs("</title>\n<defs>", f);
     for (int k = 0; k < 4; k++)
-        fprintf(f, "<path id=\"m%d\" d=\"%s\"/>", k, marker_path[k]);
+        fprintf(f, "<path id=\"m%d\" d=\"%s\"/>", k, plot_marker_path[k]);
     fprintf(f, "<clipPath id=\"plot\"><rect x=\"%d\" y=\"%d\" width=\"%d\" height=\"%d\"/>"
                "</clipPath></defs>\n", AX_L, AX_T, AX_R - AX_L, AX_B - AX_T);
     fprintf(f, "<rect width=\"%d\" height=\"%d\" fill=\"#fff\"/>\n", FIG_W, FIG_H);
@@ -351,37 +367,63 @@ static void fig_frame(FILE *f, const fig_ctx *c, const plot_axis *ax, const plot
     fputs("</text>\n", f);
 }
 
+/* Series s of a figure as page pixels (plot_vertex_fn). */
+typedef struct curve_ctx {
+    const fig_ctx *c;
+    const plot_axis *ax, *ay;
+    int s;
+} curve_ctx;
+
+static int curve_vertex(const void *vctx, int r, double *px, double *py)
+{
+    const curve_ctx *k = vctx;
+    double x = xval(k->c, r), y = mech_table_get(k->c->t, r, k->c->f->col[k->s]) * k->c->f->yscale;
+    *px = px_of(k->ax, x);
+    *py = py_of(k->ay, y);
+    return isfinite(x) && isfinite(y);
+}
+
+/* A curve of more than 4 points per pixel column, that the thinning to
+ * PLOT_THIN_TOL cannot bring to that many vertices (a scribble at the scale
+ * of the pixels): each column keeps its first, lowest, highest and last
+ * point, in row order, so the curve covers the same pixels. */
+static void curve_columns(plot_pen *p, const curve_ctx *k, int nrows)
+{
+    plot_run run = {0};
+    for (int r = 0; r < nrows; r++) {
+        double px, py;
+        if (!curve_vertex(k, r, &px, &py)) {
+            plot_run_flush(&run, p);
+            p->state = 0;
+            continue;
+        }
+        plot_run_add(&run, p, r, px, py, (long)floor(px - AX_L));
+    }
+    plot_run_flush(&run, p);
+}
+
 /* The curve of series s: a path broken at non-finite values. */
 static void fig_curve(FILE *f, const fig_ctx *c, const plot_axis *ax, const plot_axis *ay,
                       int s, const char *colour, const char *dash)
 {
     const mech_table *t = c->t;
-    const plot_figure *fg = c->f;
     fprintf(f, "<path stroke=\"%s\"%s%s%s d=\"", colour, *dash ? " stroke-dasharray=\"" : "",
             dash, *dash ? "\"" : "");
-    /* A 10^6-step sweep would write 10^6 vertices (350 MB of SVG) that
-     * land on 504 pixel columns: past THIN_FROM rows each column keeps
-     * its first, lowest, highest and last point, in row order. Every
-     * point dropped lies in its column between the kept extremes, on a
-     * stretch the kept vertices span, so the drawn curve is the same
-     * to the pixel, spikes included. */
-    plot_pen p = {f, 0};
-    plot_run run = {0};
-    int thin = t->nrows > THIN_FROM;
-    for (int r = 0; r < t->nrows; r++) {
-        double x = xval(c, r), y = mech_table_get(t, r, fg->col[s]) * fg->yscale;
-        if (!isfinite(x) || !isfinite(y)) {
-            plot_run_flush(&run, &p);
-            p.state = 0;
-            continue;
-        }
-        double px = px_of(ax, x), py = py_of(ay, y);
-        if (thin)
-            plot_run_add(&run, &p, r, px, py, (long)floor(px - AX_L));
+    /* A 10^6-step sweep would write 10^6 vertices (350 MB of SVG) on 504
+     * pixel columns: past THIN_FROM rows the curve is thinned to within
+     * PLOT_THIN_TOL px of every row (extremes kept), or, when that leaves
+     * more than THIN_FROM vertices, to its pixel columns. */
+    curve_ctx k = {c, ax, ay, s};
+    plot_pen p = {f, 0, 2, 0};
+    if (t->nrows <= THIN_FROM) {
+        plot_draw_all(&p, curve_vertex, &k, t->nrows);
+    } else {
+        plot_pen count = {NULL, 0, 2, 0};
+        if (plot_thin_draw(&count, PLOT_THIN_TOL, curve_vertex, &k, t->nrows) <= THIN_FROM)
+            plot_thin_draw(&p, PLOT_THIN_TOL, curve_vertex, &k, t->nrows);
         else
-            plot_pen_to(&p, px, py);
+            curve_columns(&p, &k, t->nrows);
     }
-    plot_run_flush(&run, &p);
     fputs("\"/>\n", f);
 }
 
@@ -394,7 +436,7 @@ static void fig_markers(FILE *f, const fig_ctx *c, const plot_axis *ax, const pl
     const char *colour, *dash;
     int shape, filled;
     char b1[32], b2[32];
-    style_of(s, &colour, &dash, &shape, &filled);
+    plot_style(s, &colour, &dash, &shape, &filled);
     fprintf(f, "<g stroke=\"%s\" fill=\"%s\">", colour, filled ? colour : "#fff");
     for (int r = (s * every) / (fg->nseries > 0 ? fg->nseries : 1); r < t->nrows; r += every) {
         double x = xval(c, r), y = mech_table_get(t, r, fg->col[s]) * fg->yscale;
@@ -415,24 +457,36 @@ static void fig_series(FILE *f, const fig_ctx *c, const plot_axis *ax, const plo
     for (int s = 0; s < fg->nseries; s++) {
         const char *colour, *dash;
         int shape, filled;
-        style_of(s, &colour, &dash, &shape, &filled);
+        plot_style(s, &colour, &dash, &shape, &filled);
         fig_curve(f, c, ax, ay, s, colour, dash);
         fig_markers(f, c, ax, ay, s, every);
     }
     fputs("</g>\n", f);
 }
 
-/* The legend, right of the plot: each series' style and name. */
+/* The legend, right of the plot: its heading (fg->note: which link a force
+ * acts on), then each series' style and name. */
 static void fig_legend(FILE *f, const fig_ctx *c)
 {
     const plot_figure *fg = c->f;
     int lx = AX_R + 14, ly = AX_T;
+    int nnote = (fg->note[0][0] != '\0') + (fg->note[1][0] != '\0');
     fprintf(f, "<rect x=\"%d\" y=\"%d\" width=\"%d\" height=\"%d\" fill=\"#fff\" "
-               "stroke=\"#999\"/>\n", lx, ly, FIG_W - lx - 6, 12 + 22 * fg->nseries);
+               "stroke=\"#999\"/>\n", lx, ly, FIG_W - lx - 6,
+            12 + 22 * fg->nseries + 16 * nnote + (nnote ? 4 : 0));
+    for (int k = 0, y = ly + 16; k < 2; k++)
+        if (fg->note[k][0]) {
+            fprintf(f, "<text x=\"%d\" y=\"%d\" font-size=\"11\" class=\"legend-note\">",
+                    lx + 8, y);
+            plot_put_text(f, fg->note[k]);
+            fputs("</text>\n", f);
+            y += 16;
+        }
+    ly += 16 * nnote + (nnote ? 4 : 0);
     for (int s = 0; s < fg->nseries; s++) {
         const char *colour, *dash;
         int shape, filled;
-        style_of(s, &colour, &dash, &shape, &filled);
+        plot_style(s, &colour, &dash, &shape, &filled);
         int y = ly + 17 + 22 * s;
         fprintf(f, "<path d=\"M%d,%dh36\" fill=\"none\" stroke=\"%s\" stroke-width=\"1.6\"%s%s%s/>",
                 lx + 8, y, colour, *dash ? " stroke-dasharray=\"" : "", dash, *dash ? "\"" : "");
@@ -447,9 +501,11 @@ static void fig_legend(FILE *f, const fig_ctx *c)
 static int emit_figure(FILE *f, const void *vctx)
 {
     const fig_ctx *c = vctx;
+    if (c->f->kind == PLOT_PATH)
+        return plot_path_svg(f, c->m, c->t, c->f, c->subtitle);
     plot_axis ax, ay;
     fig_axes(c, &ax, &ay);
-    fig_head(f, c);
+    fig_head(f, c, &ax, &ay);
     fig_frame(f, c, &ax, &ay);
     fig_series(f, c, &ax, &ay);
     fig_legend(f, c);

@@ -1,9 +1,9 @@
 /* src/plot.h: SVG figures of a solved sweep and an animated SVG of the
  * mechanism (docs/plots.md). Used by src/cmd_plot.c (`mech plot`,
  * `mech animate`). Defined in src/plot.c (plot_plan, plot_figure_write),
- * src/plot_anim.c (plot_anim_options_default, plot_animation_write) and
- * src/plot_svg.c (plot_nice_step, plot_fmt); src/plot_svg.h is private to
- * those three files.
+ * src/plot_path.c (plot_path_plan), src/plot_anim.c
+ * (plot_anim_options_default, plot_animation_write) and src/plot_svg.c
+ * (plot_nice_step, plot_fmt); src/plot_svg.h is private to those files.
  *
  * Display units (docs/plots.md, "Units"): lengths mm, angles deg, linear
  * velocities m/s and accelerations m/s^2, angular velocities rad/s and
@@ -18,7 +18,12 @@
 
 #define PLOT_MAX_SERIES 8   /* series per figure: 8 line styles (dash x marker) */
 
-/* One figure: up to PLOT_MAX_SERIES columns of a table against column 0 (q). */
+/* What a figure draws: series against the driver, or paths (y against x). */
+typedef enum { PLOT_AGAINST_DRIVER = 0, PLOT_PATH = 1 } plot_kind;
+
+/* One figure: up to PLOT_MAX_SERIES columns of a table against column 0 (q),
+ * or (kind PLOT_PATH) the paths of up to PLOT_MAX_SERIES points: column
+ * ycol[s] against column col[s]. A zeroed figure is PLOT_AGAINST_DRIVER. */
 typedef struct plot_figure {
     char name[96];                    /* file stem, e.g. "points-position-1" */
     char title[160];                  /* "Point positions: D, L, J" */
@@ -28,6 +33,10 @@ typedef struct plot_figure {
     int col[PLOT_MAX_SERIES];         /* [nseries] table columns */
     char label[PLOT_MAX_SERIES][48];  /* [nseries] legend texts */
     int nseries;
+    plot_kind kind;
+    int ycol[PLOT_MAX_SERIES];        /* [nseries] PLOT_PATH: the y column of series s */
+    char note[2][48];                 /* legend heading lines, e.g. "B: force on rocker",
+                                         "from coupler" (empty: none) */
 } plot_figure;
 
 /* The figures a table calls for, in order: points (positions, velocities,
@@ -37,6 +46,20 @@ typedef struct plot_figure {
  * force. Groups with more than PLOT_MAX_SERIES series are split evenly.
  * Returns the number of figures written to figs[0 .. max-1] (at most max). */
 int plot_plan(const mech_model *m, const mech_table *t, plot_figure *figs, int max);
+
+/* The path (coupler-curve) figures of a table, defined in src/plot_path.c:
+ * one per output point of m that moves and has position columns in t
+ * ("path-P", in the order of the outputs), so each curve fills its figure.
+ * Each is kind PLOT_PATH, written by plot_figure_write: y against x in mm
+ * on equal axes, a start marker, arrows in the direction of motion (a
+ * PLOT_PATH figure may hold up to PLOT_MAX_SERIES paths, on one scale).
+ * Returns the number of figures written to figs[0 .. max-1]. */
+int plot_path_plan(const mech_model *m, const mech_table *t, plot_figure *figs, int max);
+
+/* Every figure `mech plot` draws, in its order: plot_plan's figures, then
+ * plot_path_plan's (defined in src/plot_path.c). The report (src/report.c)
+ * uses this too, so both always draw the same set. */
+int plot_plan_all(const mech_model *m, const mech_table *t, plot_figure *figs, int max);
 
 /* Write one figure of table t as a standalone SVG document to `path`
  * (a temporary file beside it, renamed when complete; "-" = stdout).

@@ -25,6 +25,7 @@ void plot_anim_options_default(plot_anim_options *o)
 }
 
 enum { ANIM_DRAW = 760, ANIM_PAD = 40, ANIM_TOP = 56, ANIM_DEC = 1 };
+enum { ANIM_SCALE_BAR = 18 };  /* px below the bottom pad: the scale bar's strip */
 
 /* The animation: the table's positions on screen, the frames, the outlines. */
 typedef struct anim_ctx {
@@ -262,7 +263,7 @@ static void set_scale(anim_ctx *c, const box *b)
     double size = fmax(fmax(xmax - xmin, ymax - ymin), 1e-9);
     c->s = ANIM_DRAW / size;
     c->width = (int)ceil((xmax - xmin) * c->s) + 2 * ANIM_PAD;
-    c->height = (int)ceil((ymax - ymin) * c->s) + ANIM_PAD + ANIM_TOP;
+    c->height = (int)ceil((ymax - ymin) * c->s) + ANIM_PAD + ANIM_TOP + ANIM_SCALE_BAR;
     if (c->width < 320)
         c->width = 320;
     c->ox = (c->width - (xmax - xmin) * c->s) / 2 - xmin * c->s;
@@ -486,23 +487,65 @@ static void put_caption(FILE *f, const anim_ctx *c, const char *dur)
     fputs("</text>\n", f);
 }
 
-/* Traced paths of the output points (not of ground points), of every row
- * (every nrows / 2000-th past 2000 rows). */
+/* Point p of the animation, row r, in page px (plot_vertex_fn). */
+typedef struct trace_ref {
+    const anim_ctx *c;
+    int p;
+} trace_ref;
+
+static int trace_vertex(const void *v, int r, double *px, double *py)
+{
+    const trace_ref *k = v;
+    *px = k->c->X[(size_t)r * k->c->np + k->p];
+    *py = k->c->Y[(size_t)r * k->c->np + k->p];
+    return isfinite(*px) && isfinite(*py);
+}
+
+/* Traced paths of the chosen points (not of ground points), through every
+ * solved row, not only the frames: whole up to THIN_FROM rows, else thinned
+ * to within PLOT_THIN_TOL px (docs/plots.md, "Long sweeps"). */
 static void put_traces(FILE *f, const anim_ctx *c)
 {
     int test = c->o->test_colours;
     for (int k = 0; k < c->o->ntrace; k++) {
         int p = c->o->trace[k];
-        if (c->on_ground[p])
+        if (p < 0 || p >= c->np || c->on_ground[p])
             continue;
-        fprintf(f, "<polyline fill=\"none\" stroke=\"%s\" stroke-width=\"1.2\" "
-                   "stroke-dasharray=\"4,2\" points=\"", test ? "#bbb" : "#e07b39");
-        int step = c->nrows > 2000 ? c->nrows / 2000 : 1;
-        for (int r = 0, first = 1; r < c->nrows; r += step, first = 0)
-            plot_put_xy(f, first ? "" : " ", c->X[(size_t)r * c->np + p],
-                        c->Y[(size_t)r * c->np + p], ANIM_DEC);
+        fprintf(f, "<path fill=\"none\" stroke=\"%s\" stroke-width=\"1.2\" "
+                   "stroke-dasharray=\"4,2\" data-trace=\"%s\" d=\"", test ? "#bbb" : "#e07b39",
+                c->m->point_names[p]);
+        trace_ref ref = {c, p};
+        plot_pen pen = {f, 0, ANIM_DEC, 0};
+        if (c->nrows <= THIN_FROM)
+            plot_draw_all(&pen, trace_vertex, &ref, c->nrows);
+        else
+            plot_thin_draw(&pen, plot_thin_tolerance(trace_vertex, &ref, c->nrows, 2 * THIN_FROM),
+                           trace_vertex, &ref, c->nrows);
         fputs("\"/>\n", f);
     }
+}
+
+/* The scale bar, bottom left: 1, 2 or 5 x 10^k mm, 60 to 150 px long, with
+ * end ticks and its length written beside it; data-mech-scale-bar holds its
+ * length in metres and its left end, right end and y on the page. */
+static void put_scale_bar(FILE *f, const anim_ctx *c)
+{
+    double mm = plot_nice_step(60.0 * 1e3 / c->s, 1);  /* the bar in mm */
+    double len = mm * 1e-3 * c->s, x0 = 12, y = c->height - 14;
+    char b1[32], b2[32], b3[32];
+    const char *colour = c->o->test_colours ? "#00a0ff" : "#222";
+    fprintf(f, "<g id=\"scale-bar\" data-mech-scale-bar=\"%.9g %s %s %s\" fill=\"%s\" "
+               "shape-rendering=\"crispEdges\">", mm * 1e-3, plot_fmt(b1, x0, 2),
+            plot_fmt(b2, x0 + len, 2), plot_fmt(b3, y, 2), colour);
+    fprintf(f, "<rect x=\"%s\" y=\"%s\" width=\"%s\" height=\"3\"/>", b1,
+            plot_fmt(b3, y - 1.5, 2), plot_fmt(b2, len, 2));
+    fprintf(f, "<rect x=\"%s\" y=\"%s\" width=\"1.5\" height=\"9\"/>", b1,
+            plot_fmt(b3, y - 4.5, 2));
+    fprintf(f, "<rect x=\"%s\" y=\"%s\" width=\"1.5\" height=\"9\"/>",
+            plot_fmt(b2, x0 + len - 1.5, 2), b3);
+    fprintf(f, "<text x=\"%s\" y=\"%s\" font-size=\"11\" fill=\"#222\" "
+               "shape-rendering=\"auto\">%s mm</text></g>\n", plot_fmt(b1, x0 + len + 6, 2),
+            plot_fmt(b2, y + 4, 2), plot_fmt(b3, mm, 6));
 }
 
 /* Slider guides, hatched when on the ground; ground pivots under the
@@ -614,6 +657,7 @@ static int emit_animation(FILE *f, const void *vctx)
     const char *dur = plot_fmt(b3, c->o->duration, 3);
     put_caption(f, c, dur);
     put_traces(f, c);
+    put_scale_bar(f, c);
     put_guides_and_pivots(f, c, xs, ys);
     put_links_and_blocks(f, c, xs, ys);
     for (int p = 0; p < c->np; p++)

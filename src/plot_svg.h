@@ -35,6 +35,10 @@ typedef struct plot_axis {
  * by 2 % and to whole steps, a constant range becomes a band of +-10 %. */
 void plot_axis_make(plot_axis *a, double lo, double hi, int target, int round_out);
 
+/* An axis over exactly [lo, hi] with tick step `step`: the label scaling
+ * and decimals as plot_axis_make chooses them. */
+void plot_axis_fixed(plot_axis *a, double lo, double hi, double step);
+
 /* Axis title with its unit, and "x10^k" when the labels are scaled. */
 void plot_put_axis_title(FILE *f, const char *what, const char *unit, int exp10);
 
@@ -42,16 +46,63 @@ void plot_put_axis_title(FILE *f, const char *what, const char *unit, int exp10)
  * pixel p0 (a->lo) to p1 (a->hi); vertical: the y axis. */
 void plot_put_ticks(FILE *f, const plot_axis *a, int vertical, double p0, double p1);
 
-/* ---- polylines: path data, thinned to the pixel columns -------------- */
+/* The plot area of a figure whose size is not the fixed AX_* one (the
+ * path figures), px. */
+typedef struct plot_area {
+    double l, r, t, b;
+} plot_area;
 
-/* A path's vertices, in pixels: "M" after a break, then "L", then blanks. */
+/* plot_put_ticks for a plot area of any size. */
+void plot_put_ticks_in(FILE *f, const plot_axis *a, int vertical, const plot_area *area);
+
+/* ---- series styles ------------------------------------------------- */
+
+/* Style s of a figure's series: colour s, marker shape s % 4 (open for
+ * s < 4, filled after), dash (s + s / 4) % 4, so that no two of the 8
+ * styles share shape, fill and dash. Markers are <path id="mK"> with the
+ * shapes plot_marker_path[K], centred on 0,0: circle, square, triangle,
+ * diamond. */
+void plot_style(int s, const char **colour, const char **dash, int *shape, int *filled);
+extern const char *const plot_marker_path[4];
+
+/* ---- polylines: path data, thinned ---------------------------------- */
+
+/* A path's vertices, in pixels: "M" after a break, then "L", then blanks.
+ * With f NULL the vertices are only counted. */
 typedef struct plot_pen {
     FILE *f;
     int state;  /* 0: next vertex starts a piece (M); 1: the first L; 2: more */
+    int dec;    /* decimals of the coordinates */
+    long nvert; /* vertices so far */
 } plot_pen;
 
-/* The next vertex (px, py), 2 decimals. */
+/* The next vertex (px, py), with p->dec decimals. */
 void plot_pen_to(plot_pen *p, double px, double py);
+
+/* The tolerance of the thinning, page px: every point of a long curve lies
+ * within it of the drawn polyline, and the drawn polyline within it of the
+ * full one (docs/plots.md, "Long sweeps"). */
+#define PLOT_THIN_TOL 0.25
+
+/* Vertex i of a curve in page px; returns 0 when it is not finite (the
+ * curve is broken there). */
+typedef int (*plot_vertex_fn)(const void *ctx, int i, double *px, double *py);
+
+/* Draw vertices 0 .. n-1 of a curve (pen->f NULL: count them), thinned to
+ * within `tol` px: a vertex is dropped only when every vertex since the
+ * last one drawn lies within tol of the segment from that one to the next
+ * one drawn (the sleeve of Zhao and Saalfeld, one pass, no memory per
+ * vertex), so the extremes of a spike are kept. Pieces between non-finite
+ * vertices are drawn separately. Returns the vertices drawn. */
+long plot_thin_draw(plot_pen *pen, double tol, plot_vertex_fn fn, const void *ctx, int n);
+
+/* Draw every vertex 0 .. n-1 of a curve, broken at non-finite ones. */
+void plot_draw_all(plot_pen *pen, plot_vertex_fn fn, const void *ctx, int n);
+
+/* The smallest tolerance, PLOT_THIN_TOL doubled as often as needed, that
+ * leaves at most maxv vertices of the curve (a scribble denser than the
+ * pixels would otherwise be written whole). */
+double plot_thin_tolerance(plot_vertex_fn fn, const void *ctx, int n, long maxv);
 
 /* The rows of one pixel column of the plot: the first, lowest, highest and
  * last point (pixels; lo/hi are the extremes of py, i.e. of the value). */
@@ -73,5 +124,10 @@ void plot_run_add(plot_run *c, plot_pen *p, int row, double px, double py, long 
 
 /* Draw a column's run: its up to 4 points in row order, each once; empties it. */
 void plot_run_flush(plot_run *c, plot_pen *p);
+
+/* A path figure (kind PLOT_PATH) as a whole document (src/plot_path.c);
+ * returns 0, or -1 when writing failed. */
+int plot_path_svg(FILE *f, const mech_model *m, const mech_table *t, const plot_figure *fg,
+                  const char *subtitle);
 
 #endif

@@ -37,6 +37,22 @@ static void print_loop(const mech_system *s, int k, FILE *out)
     }
 }
 
+/* SYS_NAMED: the parameters and named lengths and angles the equations use. */
+static void print_coefficients(const mech_system *s, FILE *out)
+{
+    int first = SYS_NVARS(s->n), ncoef = s->nvars - first;
+    if (ncoef <= 0)
+        return;
+    fprintf(out, "parameters (SI units) and the lengths and angles named after them:\n");
+    for (int k = 0; k < ncoef; k++) {
+        if (s->coef_desc[k])
+            fprintf(out, "  %s\n", s->coef_desc[k]);
+        else
+            fprintf(out, "  %s = %.10g\n", s->names[first + k], s->params->values[k]);
+    }
+    fputc('\n', out);
+}
+
 static expr_names names_of(const mech_system *s)
 {
     return (expr_names){(const char *const *)s->names, (const char *const *)s->latex};
@@ -57,6 +73,7 @@ static void print_text(const mech_system *s, FILE *out)
     fprintf(out, "input q: %s = %s, with rates %s and %s\n\n", s->names[n],
             m->driver.kind == MECH_DRIVE_ANGLE ? "driver link angle" : "driver slider displacement",
             s->names[SYS_VAR_QDOT(n)], s->names[SYS_VAR_QDDOT(n)]);
+    print_coefficients(s, out);
     fprintf(out, "loops (%d, %s):\n", s->loops.nloops,
             s->loops.from_file ? "as listed in the file" : "found automatically");
     for (int k = 0; k < s->loops.nloops; k++) {
@@ -104,6 +121,21 @@ static void latex_text(const char *t, FILE *out)
     }
 }
 
+/* A loop's walk in LaTeX text: "->" as an arrow, the rest escaped. */
+static void latex_loop_text(const char *t, FILE *out)
+{
+    char piece[2] = {0, 0};
+    for (; *t; t++) {
+        if (t[0] == '-' && t[1] == '>') {
+            fputs("$\\to$", out);
+            t++;
+            continue;
+        }
+        piece[0] = *t;
+        latex_text(piece, out);
+    }
+}
+
 static void latex_rows(const mech_system *s, const char *lhs, const ex *rows, const char *rhs,
                        FILE *out)
 {
@@ -115,6 +147,45 @@ static void latex_rows(const mech_system *s, const char *lhs, const ex *rows, co
         fprintf(out, "%s%s\n", rhs, r + 1 < s->m ? " \\\\" : "");
     }
     fputs("\\end{align*}\n", out);
+}
+
+static void latex_coefficients(const mech_system *s, FILE *out)
+{
+    int first = SYS_NVARS(s->n), ncoef = s->nvars - first;
+    if (ncoef <= 0)
+        return;
+    fputs("\\subsection*{Parameters (SI units)}\n\\begin{itemize}\n", out);
+    for (int k = 0; k < ncoef; k++) {
+        if (!s->coef_desc[k]) {
+            fprintf(out, "\\item $%s = %.10g$\n", s->latex[first + k], s->params->values[k]);
+            continue;
+        }
+        fprintf(out, "\\item $%s$", s->latex[first + k]);
+        const char *colon = strstr(s->coef_desc[k], ": ");
+        fputs(": ", out);
+        latex_text(colon ? colon + 2 : s->coef_desc[k], out);
+        fputc('\n', out);
+    }
+    fputs("\\end{itemize}\n", out);
+}
+
+static void latex_loops(const mech_system *s, FILE *out)
+{
+    fprintf(out, "\\subsection*{Loops (%s)}\n\\begin{enumerate}\n",
+            s->loops.from_file ? "as listed in the file" : "found automatically");
+    for (int k = 0; k < s->loops.nloops; k++) {
+        char buf[4096];
+        FILE *mem = fmemopen(buf, sizeof buf, "w");
+        if (!mem)
+            continue;
+        print_loop(s, k, mem);
+        fclose(mem);
+        buf[sizeof buf - 1] = '\0';
+        fputs("\\item ", out);
+        latex_loop_text(buf, out);
+        fputc('\n', out);
+    }
+    fputs("\\end{enumerate}\n", out);
 }
 
 static void print_latex(const mech_system *s, FILE *out)
@@ -140,6 +211,8 @@ static void print_latex(const mech_system *s, FILE *out)
     }
     fprintf(out, "\\item input $q = %s$, rates $%s$, $%s$\n\\end{itemize}\n", s->latex[n],
             s->latex[SYS_VAR_QDOT(n)], s->latex[SYS_VAR_QDDOT(n)]);
+    latex_coefficients(s, out);
+    latex_loops(s, out);
     fputs("\\subsection*{Position equations $f(x, q) = 0$}\n", out);
     latex_rows(s, "f", s->f, " = 0", out);
     fputs("\\subsection*{Jacobian $\\partial f / \\partial x$ (nonzeros)}\n\\begin{align*}\n", out);

@@ -254,6 +254,34 @@ done:
     return rc;
 }
 
+/* Where the per-step code reads and writes the tape's registers, looked up
+ * once here instead of through the node and variable maps at every step. */
+static int root_registers(solver_plan *sp)
+{
+    const tape *t = &sp->tp;
+    int nr = sp->nr, ns = sp->ns, n = sp->n;
+    sp->preg = xcalloc((size_t)(nr + sp->nnzJ) + 1, sizeof *sp->preg);
+    sp->vreg = xcalloc((size_t)nr + 1, sizeof *sp->vreg);
+    sp->areg = xcalloc((size_t)nr + 1, sizeof *sp->areg);
+    sp->xreg = xcalloc((size_t)ns + 1, sizeof *sp->xreg);
+    sp->xdreg = xcalloc((size_t)ns + 1, sizeof *sp->xdreg);
+    sp->unit = xcalloc((size_t)ns + 1, sizeof *sp->unit);
+    if (!sp->preg || !sp->vreg || !sp->areg || !sp->xreg || !sp->xdreg || !sp->unit)
+        return -1;
+    for (int i = 0; i < nr + sp->nnzJ; i++)
+        sp->preg[i] = t->node_reg[sp->proot[i]];
+    for (int i = 0; i < nr; i++) {
+        sp->vreg[i] = t->node_reg[sp->vroot[i]];
+        sp->areg[i] = t->node_reg[sp->aroot[i]];
+    }
+    for (int i = 0; i < ns; i++) {
+        sp->xreg[i] = t->var_reg[sp->col[i]];
+        sp->xdreg[i] = t->var_reg[SYS_VAR_XDOT(n, sp->col[i])];
+        sp->unit[i] = sp->sys->unk_kind[sp->col[i]] == UNK_SLIDE ? sp->lref : 1.0;
+    }
+    return 0;
+}
+
 /* The tape of the solved rows: the residuals and Jacobian entries, then the
  * velocity and acceleration right-hand sides, with the part that depends
  * on the driver alone hoisted. */
@@ -275,7 +303,9 @@ static int compile_tape(solver_plan *sp)
     invariant[SYS_VAR_Q(n)] = 1;
     tape_hoist(&sp->tp, PHASE_POSITION, invariant);
     free(invariant);
-    return 0;
+    if (tape_fuse(&sp->tp, roots, nroots) < 0)
+        return -1;
+    return root_registers(sp);
 }
 
 /* The solved rows (row) and columns (col); rowmap[r]: solved index of
@@ -438,7 +468,8 @@ void solver_plan_free(solver_plan *sp)
     kin_tree_free(&sp->tree);
     mech_system_free(&sp->sys);
     void *blocks[] = {sp->col, sp->row, sp->Ap, sp->Ai, sp->Ax0, sp->jpos, sp->proot,
-                      sp->vroot, sp->aroot};
+                      sp->vroot, sp->aroot, sp->preg, sp->vreg, sp->areg, sp->xreg,
+                      sp->xdreg, sp->unit};
     free_all(blocks, COUNT_OF(blocks));
     memset(sp, 0, sizeof *sp);
 }
@@ -495,9 +526,7 @@ double solver_step_size(const solver_plan *sp, const double *dx)
 {
     double r = 0.0;
     for (int i = 0; i < sp->ns; i++) {
-        double v = fabs(dx[i]);
-        if (sp->sys->unk_kind[sp->col[i]] == UNK_SLIDE)
-            v /= sp->lref;
+        double v = fabs(dx[i]) / sp->unit[i];  /* exact for angles (unit 1) */
         r = v > r || v != v ? v : r;
     }
     return r;
@@ -515,12 +544,13 @@ static double evaluate(solver *sv, const double *x, double q, double *f)
         sv->tape_q = q;
     }
     for (int i = 0; i < sp->ns; i++)
-        tape_set_var(t, reg, sp->col[i], x[i]);
+        if (sp->xreg[i] >= 0)
+            reg[sp->xreg[i]] = x[i];
     tape_run_variant(t, reg, PHASE_POSITION);
     for (int i = 0; i < sp->nr; i++)
-        f[i] = tape_value(t, reg, sp->proot[i]);
+        f[i] = reg[sp->preg[i]];
     for (int k = 0; k < sp->nnzJ; k++)
-        sv->Jv[k] = tape_value(t, reg, sp->proot[sp->nr + k]);
+        sv->Jv[k] = reg[sp->preg[sp->nr + k]];
     return vec_norm_inf(f, sp->nr);
 }
 
@@ -672,7 +702,7 @@ void solver_velocity_rhs(solver *sv, double *out)
     tape_set_var(t, reg, SYS_VAR_QDOT(sp->n), 1.0);
     tape_run(t, reg, PHASE_VELOCITY);
     for (int i = 0; i < sp->nr; i++)
-        out[i] = tape_value(t, reg, sp->vroot[i]);
+        out[i] = reg[sp->vreg[i]];
 }
 
 void solver_rates(solver *sv)
@@ -687,11 +717,12 @@ void solver_rates(solver *sv)
     solver_velocity_rhs(sv, sv->ft);
     linear_solve(sv, sv->ft, sv->xq);
     for (int i = 0; i < sp->ns; i++)
-        tape_set_var(t, reg, SYS_VAR_XDOT(sp->n, sp->col[i]), sv->xq[i]);
+        if (sp->xdreg[i] >= 0)
+            reg[sp->xdreg[i]] = sv->xq[i];
     tape_set_var(t, reg, SYS_VAR_QDDOT(sp->n), 0.0);
     tape_run(t, reg, PHASE_ACCELERATION);
     for (int i = 0; i < sp->nr; i++)
-        sv->ft[i] = tape_value(t, reg, sp->aroot[i]);
+        sv->ft[i] = reg[sp->areg[i]];
     linear_solve(sv, sv->ft, sv->xqq);
 }
 

@@ -44,6 +44,10 @@ typedef struct solver_plan {
     int *jpos;                 /* [2 nnzJ] least squares: where each J value goes in Ax */
     tape tp;                   /* evaluator of the solved rows only (no registers) */
     ex *proot, *vroot, *aroot; /* roots of the three phases */
+    int *preg, *vreg, *areg;   /* [nr + nnzJ], [nr], [nr] their registers in tp */
+    int *xreg, *xdreg;         /* [ns] register of each solved unknown and of its rate
+                                  (-1: the tape does not read it) */
+    double *unit;              /* [ns] 1 for an angle, lref for a slide (step sizes) */
     linsys_plan lp;            /* analysis of the factored matrix's pattern */
     kin_tree tree;             /* link frames: the spanning tree, active links */
 } solver_plan;

@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "param_grad.h"
 #include "system.h"
 
 enum { PHASE_POSITION, PHASE_VELOCITY, PHASE_ACCELERATION, NPHASES };
@@ -177,6 +178,7 @@ static int make_names(mech_system *s)
     s->latex = xcalloc((size_t)nv, sizeof *s->latex);
     if (!s->names || !s->latex)
         return -1;
+    s->nnames = nv;
     for (int v = 0; v <= n; v++) {  /* positions and q */
         if (position_names(s, v, &s->names[v], &s->latex[v]) < 0)
             return -1;
@@ -243,6 +245,14 @@ static void term_vector(mech_system *s, const loop_term *t, ex *x, ex *y)
 {
     const mech_model *m = s->model;
     expr_ctx *c = &s->ex;
+    if (t->kind == TERM_BODY && s->mode == SYS_CARTESIAN) {
+        sys_cartesian_body(s, t, x, y);
+        return;
+    }
+    if (t->kind == TERM_BODY && s->mode == SYS_NAMED) {
+        sys_named_body(s, t, x, y);
+        return;
+    }
     if (t->kind == TERM_BODY) {
         const mech_link *l = &m->links[t->link];
         double dx = l->points[t->p1].x - l->points[t->p0].x;
@@ -313,9 +323,11 @@ static int build_jacobian(mech_system *s, int *vars)
     if (!ti || !tj || !tx || !s->fq || !s->Jp)
         goto oom;
     for (int r = 0; r < rows; r++) {
-        int nv = expr_vars(c, s->f[r], vars, SYS_NVARS(n));
+        int nv = expr_vars(c, s->f[r], vars, s->nvars);
         s->fq[r] = c->zero;
         for (int k = 0; k < nv; k++) {
+            if (vars[k] >= SYS_NVARS(n))
+                continue;  /* a coefficient (SYS_NAMED, SYS_CARTESIAN): held constant */
             ex dr = expr_diff(c, s->f[r], vars[k]);
             if (vars[k] == SYS_VAR_Q(n)) {
                 s->fq[r] = dr;
@@ -401,7 +413,7 @@ static int build_rates(mech_system *s, int *vars)
     for (int r = 0; r < rows; r++) {
         s->vel[r] = expr_neg(c, expr_mul(c, s->fq[r], qdot));
         ex vr = expr_add(c, v[r], expr_mul(c, s->fq[r], qdot));
-        int nv = expr_vars(c, vr, vars, SYS_NVARS(n)), nt = 0;
+        int nv = expr_vars(c, vr, vars, s->nvars), nt = 0;
         for (int k = 0; k < nv; k++) {
             int var = vars[k];
             ex rate;  /* d var / dt */
@@ -453,10 +465,18 @@ void mech_system_free(mech_system **ps)
     if (!s)
         return;
     if (s->names)
-        for (int v = 0; v < SYS_NVARS(s->n); v++) {
+        for (int v = 0; v < s->nnames; v++) {
             free(s->names[v]);
             free(s->latex[v]);
         }
+    if (s->coef_desc)
+        for (int k = 0; k < s->nvars - SYS_NVARS(s->n); k++)
+            free(s->coef_desc[k]);
+    free(s->coef_desc);
+    free(s->point_base);
+    if (s->grad)
+        pgrad_free(s->grad);
+    free(s->grad);
     free(s->names);
     free(s->latex);
     free(s->unk_kind);
@@ -483,6 +503,12 @@ void mech_system_free(mech_system **ps)
 
 int mech_system_new(const mech_model *m, mech_system **out, mech_diag *d)
 {
+    return sys_new_with(m, SYS_NUMERIC, NULL, out, d);
+}
+
+int sys_new_with(const mech_model *m, sys_mode mode, const sys_params *params,
+                 mech_system **out, mech_diag *d)
+{
     *out = NULL;
     if (!m->has_driver)
         return diag_error(d, m->file, (mech_mark){0, 0}, "the mechanism has no driver");
@@ -492,6 +518,8 @@ int mech_system_new(const mech_model *m, mech_system **out, mech_diag *d)
         return diag_error(d, m->file, (mech_mark){0, 0}, "out of memory"), MECH_ENOMEM;
     }
     s->model = m;
+    s->mode = mode;
+    s->params = params;
     int rc = MECH_ENOMEM;
     int *vars = NULL;
     if (assign_unknowns(s) < 0)
@@ -512,13 +540,15 @@ int mech_system_new(const mech_model *m, mech_system **out, mech_diag *d)
         goto fail;
     }
     rc = MECH_ENOMEM;
-    vars = xcalloc((size_t)SYS_NVARS(s->n), sizeof *vars);
-    if (!vars || make_names(s) < 0)
+    s->nvars = SYS_NVARS(s->n);
+    if (make_names(s) < 0 || sys_coefficients_init(s) < 0)
         goto fail;
     if ((rc = link_angles(s, d)) != MECH_OK || (rc = build_residual(s, d)) != MECH_OK)
         goto fail;
     rc = MECH_ENOMEM;
-    if (build_jacobian(s, vars) < 0 || build_rates(s, vars) < 0 || compile(s) < 0)
+    vars = xcalloc((size_t)s->nvars, sizeof *vars);
+    if (!vars || s->ex.failed || build_jacobian(s, vars) < 0 || build_rates(s, vars) < 0 ||
+        (mode == SYS_NUMERIC && compile(s) < 0))
         goto fail;
     free(vars);
     *out = s;

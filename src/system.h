@@ -25,6 +25,26 @@ typedef struct loop_set {
     int from_file;      /* 1 when the file listed the loops */
 } loop_set;
 
+/* How the model's numbers enter the equations (sys_new_with). */
+typedef enum {
+    SYS_NUMERIC,   /* folded constants: the solver's system (mech_system_new) */
+    SYS_NAMED,     /* the lengths and angles of body vectors that depend on parameters
+                      are named leaves: the parameter itself (`r`), or |AB| and <AB
+                      defined in coef_desc (mech equations); not compiled */
+    SYS_CARTESIAN  /* each body vector written R(theta) (P1 - P0) with the points'
+                      coordinates as variables (sensitivity.c); not compiled */
+} sys_mode;
+
+/* The parameters and d(point coordinates)/d(parameter), from seeded loads
+ * (load_file_seeded): what SYS_NAMED needs to see which numbers depend on
+ * which parameter. */
+typedef struct sys_params {
+    int nparams;
+    const char *const *names;   /* [nparams] */
+    const double *values;       /* [nparams] SI */
+    double **dxy;               /* [nparams] -> [2 * points of all links, link by link] */
+} sys_params;
+
 /* Unknown kinds */
 typedef enum { UNK_ANGLE, UNK_SLIDE } unknown_kind;
 
@@ -36,6 +56,10 @@ typedef enum { UNK_ANGLE, UNK_SLIDE } unknown_kind;
 #define SYS_VAR_QDOT(n) (2 * (n) + 1)
 #define SYS_VAR_QDDOT(n) (2 * (n) + 2)
 #define SYS_NVARS(n) (2 * (n) + 3)
+/* SYS_NAMED: coefficient k is variable SYS_NVARS(n) + k (the parameters
+ * first, then |AB| and <AB); SYS_CARTESIAN: point gp's coordinates (gp =
+ * point_base[link] + index) are variables SYS_COORD(n, gp) and + 1. */
+#define SYS_COORD(n, gp) (SYS_NVARS(n) + 2 * (gp))
 
 struct mech_system {
     const mech_model *model;   /* borrowed; must outlive the system */
@@ -61,11 +85,30 @@ struct mech_system {
     ex *fq;                    /* [m] df/dq */
     ex *vel;                   /* [m] velocity right-hand side  -df/dq qdot */
     ex *acc;                   /* [m] acceleration right-hand side */
+    sys_mode mode;
+    const sys_params *params;  /* SYS_NAMED: borrowed */
+    int *point_base;           /* [nlinks + 1] global index of each link's first point */
+    int nvars;                 /* variables in the DAG: SYS_NVARS(n) + coefficients */
+    int nnames;                /* entries of names and latex (SYS_NAMED: nvars) */
+    char **coef_desc;          /* [nvars - SYS_NVARS(n)] SYS_NAMED: what a coefficient is
+                                  ("length of E - B in link 'tray' = 564.97 mm"), or NULL
+                                  for a parameter */
+    struct param_grad *grad;   /* owned by mech_system_new_named, or NULL */
     tape tp;                   /* compiled evaluator of every row */
     double *reg;               /* [tp.nreg] its registers, for sys_eval_* (so those
                                   are not for threads sharing the system; the solver
                                   compiles its own tape and keeps registers per state) */
 };
+
+/* mech_system_new in another mode (SYS_NAMED needs params). */
+int sys_new_with(const mech_model *m, sys_mode mode, const sys_params *params,
+                 mech_system **out, mech_diag *d);
+
+/* system_coef.c: the body vectors of SYS_NAMED and SYS_CARTESIAN, and
+ * their coefficients (point_base, the parameters' names). */
+int sys_coefficients_init(mech_system *s);
+void sys_named_body(mech_system *s, const loop_term *t, ex *x, ex *y);
+void sys_cartesian_body(mech_system *s, const loop_term *t, ex *x, ex *y);
 
 /* Evaluation through the tape (no allocation). The velocity and
  * acceleration phases reuse the position phase's registers, so they must

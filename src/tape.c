@@ -91,7 +91,7 @@ static int emit(tape *t, const expr_ctx *c, ex root, work_stack *st, size_t *cap
         }
         t->node_reg[e] = t->nreg++;
         t->ins[t->nins++] = (tape_ins){op_of(n->op), t->node_reg[e], t->node_reg[n->a],
-                                       n->b >= 0 ? t->node_reg[n->b] : 0};
+                                       n->b >= 0 ? t->node_reg[n->b] : 0, 0};
         st->n--;
     }
     return 0;
@@ -119,7 +119,7 @@ static int fuse_sincos(tape *t)
                     t->ins[f].op != TOP_SINCOS) {
                     int sin_d = in.op == TOP_SIN ? in.d : t->ins[f].d;
                     int cos_d = in.op == TOP_COS ? in.d : t->ins[f].d;
-                    t->ins[f] = (tape_ins){TOP_SINCOS, sin_d, in.a, cos_d};
+                    t->ins[f] = (tape_ins){TOP_SINCOS, sin_d, in.a, cos_d, 0};
                     continue;  /* dropped */
                 }
                 if (f < t->phase_start[k])
@@ -131,6 +131,116 @@ static int fuse_sincos(tape *t)
     }
     t->phase_start[t->nphases] = t->nins = out;
     free(first);
+    return 0;
+}
+
+/* Give back what compiling over-allocated: the instruction array grew by
+ * doubling and the image was sized for every node of the DAG (a chain of
+ * 10^5 loops: megabytes). A failed shrink keeps the larger block. */
+static void trim(tape *t)
+{
+    if (t->nins > 0) {
+        tape_ins *ins = xrealloc_array(t->ins, (size_t)t->nins, sizeof *ins);
+        if (ins)
+            t->ins = ins;
+    }
+    if (t->nreg > 0) {
+        double *reg0 = xrealloc_array(t->reg0, (size_t)t->nreg, sizeof *reg0);
+        if (reg0)
+            t->reg0 = reg0;
+    }
+}
+
+/* Registers an instruction reads: a; then b; then c. */
+static int operands(int op)
+{
+    switch (op) {
+    case TOP_ADD: case TOP_MUL: return 2;
+    case TOP_MULADD: case TOP_MULMUL: case TOP_ADDADD: return 3;
+    default: return 1;  /* NEG, SIN, COS; SINCOS writes b */
+    }
+}
+
+/* How many instructions (of any phase) read each register; a root, which
+ * the caller reads, counts as a use that can never be fused away. */
+static int *count_uses(const tape *t, const ex *const *roots, const int *nroots)
+{
+    int *uses = xcalloc((size_t)t->nreg + 1, sizeof *uses);
+    if (!uses)
+        return NULL;
+    for (int i = 0; i < t->nins; i++) {
+        const tape_ins *in = &t->ins[i];
+        int k = operands(in->op);
+        uses[in->a]++;
+        if (k >= 2)
+            uses[in->b]++;
+        if (k == 3)
+            uses[in->c]++;
+    }
+    for (int k = 0; k < t->nphases; k++)
+        for (int i = 0; i < nroots[k]; i++)
+            uses[t->node_reg[roots[k][i]]] += 2;
+    return uses;
+}
+
+/* The superinstruction of consumer `use` (ADD or MUL) reading the result of
+ * `def` (ADD or MUL), or -1 when there is none. */
+static int fused_op(int use, int def)
+{
+    if (use == TOP_ADD && def == TOP_MUL)
+        return TOP_MULADD;
+    if (use == TOP_MUL && def == TOP_MUL)
+        return TOP_MULMUL;
+    if (use == TOP_ADD && def == TOP_ADD)
+        return TOP_ADDADD;
+    return -1;
+}
+
+/* Fuse the instructions of [from, to) into ins[out..]; returns the new out. */
+static int fuse_range(tape *t, const int *uses, const int *def, int from, int to, int out)
+{
+    for (int i = from; i < to; i++) {
+        tape_ins *in = &t->ins[i];
+        for (int side = 0; side < 2 && (in->op == TOP_ADD || in->op == TOP_MUL); side++) {
+            int r = side ? in->b : in->a, p = def[r] - 1;
+            if (p < from || uses[r] != 1)
+                continue;
+            int op = fused_op(in->op, t->ins[p].op);
+            if (op < 0)
+                continue;
+            *in = (tape_ins){op, in->d, t->ins[p].a, t->ins[p].b, side ? in->a : in->b};
+            t->ins[p].op = -1;  /* dropped */
+        }
+    }
+    for (int i = from; i < to; i++)
+        if (t->ins[i].op >= 0)
+            t->ins[out++] = t->ins[i];
+    return out;
+}
+
+int tape_fuse(tape *t, const ex *const *roots, const int *nroots)
+{
+    int *uses = count_uses(t, roots, nroots);
+    int *def = xcalloc((size_t)t->nreg + 1, sizeof *def);  /* 1 + instruction writing reg */
+    if (!uses || !def) {
+        free(uses);
+        free(def);
+        return -1;
+    }
+    for (int i = 0; i < t->nins; i++)
+        def[t->ins[i].d] = i + 1;
+    int out = 0;
+    for (int k = 0; k < t->nphases; k++) {  /* within each part of each phase */
+        int start = t->phase_start[k], split = t->phase_split[k], end = t->phase_start[k + 1];
+        t->phase_start[k] = out;
+        out = fuse_range(t, uses, def, start, split, out);
+        t->phase_split[k] = out;
+        out = fuse_range(t, uses, def, split, end, out);
+    }
+    t->phase_start[t->nphases] = t->nins = out;
+    free(uses);
+    free(def);
+    trim(t);
     return 0;
 }
 
@@ -157,8 +267,8 @@ void tape_hoist(tape *t, int phase, const unsigned char *invariant)
     int nfixed = 0, nvar = 0;
     for (int i = start; i < end; i++) {
         tape_ins in = t->ins[i];
-        int binary = in.op == TOP_ADD || in.op == TOP_MUL;
-        int v = variant[in.a] | (binary ? variant[in.b] : 0);
+        int v = variant[in.a] | (operands(in.op) >= 2 ? variant[in.b] : 0) |
+                (operands(in.op) == 3 ? variant[in.c] : 0);
         variant[in.d] = (unsigned char)v;
         if (in.op == TOP_SINCOS)
             variant[in.b] = (unsigned char)v;
@@ -203,6 +313,7 @@ int tape_compile(tape *t, expr_ctx *c, int nvars, int nphases, const ex *const *
     free(stack.v);
     if (fuse_sincos(t) < 0)
         goto fail;
+    trim(t);
     return 0;
 fail:
     free(stack.v);
@@ -227,6 +338,9 @@ static void run_range(const tape *t, double *r, int from, int to)
             r[p->b] = cos(x);
             break;
         }
+        case TOP_MULADD: r[p->d] = r[p->a] * r[p->b] + r[p->c]; break;
+        case TOP_MULMUL: r[p->d] = r[p->a] * r[p->b] * r[p->c]; break;
+        case TOP_ADDADD: r[p->d] = r[p->a] + r[p->b] + r[p->c]; break;
         }
     }
 }

@@ -18,12 +18,17 @@ typedef enum {
     TOP_NEG, /* r[d] = -r[a] */
     TOP_SIN, /* r[d] = sin(r[a]) */
     TOP_COS, /* r[d] = cos(r[a]) */
-    TOP_SINCOS /* r[d] = sin(r[a]), r[b] = cos(r[a]): one sincos call */
+    TOP_SINCOS, /* r[d] = sin(r[a]), r[b] = cos(r[a]): one sincos call */
+    /* superinstructions (tape_compile fuses a MUL or ADD whose result has
+       one use into its user; the same roundings in the same order) */
+    TOP_MULADD, /* r[d] = r[a] * r[b] + r[c] */
+    TOP_MULMUL, /* r[d] = r[a] * r[b] * r[c] */
+    TOP_ADDADD  /* r[d] = r[a] + r[b] + r[c] */
 } tape_op;
 
 typedef struct tape_ins {
     int op;
-    int d, a, b;
+    int d, a, b, c;     /* c: the third operand of a superinstruction */
 } tape_ins;
 
 enum { TAPE_MAX_PHASES = 4 };
@@ -51,6 +56,14 @@ void tape_free(tape *t);
  * variables with invariant[var] != 0 to its start, so that they can be run
  * once while the other variables change (tape_run_invariant). */
 void tape_hoist(tape *t, int phase, const unsigned char *invariant);
+/* Superinstructions: an ADD or MUL whose result has one use, by an ADD or
+ * MUL of the same phase and the same part (hoisted or not), is computed
+ * there: (x * y) + z, (x * y) * z, (x + y) + z, the same two roundings in
+ * the same order (addition and multiplication commute exactly), so no value
+ * changes; one dispatch fewer. The roots (the registers the caller reads)
+ * are kept. Call after tape_hoist; 0, or -1 when out of memory (the tape is
+ * then unchanged and still correct). */
+int tape_fuse(tape *t, const ex *const *roots, const int *nroots);
 /* Run the instructions of one phase; or only its invariant part, or only
  * the rest (valid while the invariant variables have not changed). */
 void tape_run(const tape *t, double *reg, int phase);

@@ -244,6 +244,8 @@ typedef struct qval {
     double v;
     dim d;
     int bare;  /* a number without unit whose quantity is not known yet */
+    double dv; /* dv/dp for the parameter p the environment seeds (expr_param.dvalue):
+                  forward-mode derivative, carried beside v through every operation */
 } qval;
 
 typedef struct qparser {
@@ -295,7 +297,7 @@ static void describe_dim(dim d, char *buf, size_t size)
 
 static qval parse_expr(qparser *p);
 
-static qval make_bare(double v) { return (qval){v, {{0, 0, 0, 0}}, 1}; }
+static qval make_bare(double v) { return (qval){v, {{0, 0, 0, 0}}, 1, 0.0}; }
 
 static qval parse_number(qparser *p)
 {
@@ -358,7 +360,7 @@ static qval parse_number(qparser *p)
         return make_bare(v);
     }
     p->s = uend;
-    return (qval){v * scale, d, 0};
+    return (qval){v * scale, d, 0, 0.0};
 }
 
 /* Under + or -, a bare operand takes the other operand's quantity. */
@@ -366,10 +368,12 @@ static void unify(qparser *p, qval *a, qval *b, const char *at, char op)
 {
     if (a->bare && !b->bare) {
         a->v *= default_scale(p->env, b->d);
+        a->dv *= default_scale(p->env, b->d);
         a->d = b->d;
         a->bare = 0;
     } else if (b->bare && !a->bare) {
         b->v *= default_scale(p->env, a->d);
+        b->dv *= default_scale(p->env, a->d);
         b->d = a->d;
         b->bare = 0;
     } else if (!dim_equal(a->d, b->d)) {
@@ -406,7 +410,9 @@ static qval call_function(qparser *p, const char *name, size_t n, const char *at
             return a;
         }
         unify(p, &a, &b, at, '-');
-        return (qval){atan2(a.v, b.v), angle, 0};
+        double r2 = a.v * a.v + b.v * b.v;  /* d atan2(y, x) = (x dy - y dx) / (x^2 + y^2) */
+        double dv = r2 > 0 ? (b.v * a.dv - a.v * b.dv) / r2 : 0.0;
+        return (qval){atan2(a.v, b.v), angle, 0, dv};
     }
     if (two) {
         qfail(p, at, "%.*s takes one argument", (int)n, name);
@@ -423,17 +429,21 @@ static qval call_function(qparser *p, const char *name, size_t n, const char *at
         for (int i = 0; i < NDIMS; i++)
             a.d.e[i] = (signed char)(a.d.e[i] / 2);
         a.v = sqrt(a.v);
+        a.dv = a.v > 0 ? a.dv / (2.0 * a.v) : 0.0;
         return a;
     }
     if (IS("sin") || IS("cos") || IS("tan")) {
         if (a.bare) {
             a.v *= p->env->units->scale[Q_ANGLE];
+            a.dv *= p->env->units->scale[Q_ANGLE];
         } else if (!dim_equal(a.d, angle) && !dim_is_none(a.d)) {
             qfail(p, at, "%.*s needs an angle", (int)n, name);
             return a;
         }
         double r = IS("sin") ? sin(a.v) : IS("cos") ? cos(a.v) : tan(a.v);
-        return make_bare(r);  /* a pure number: 100 * cos(60) takes the default length unit */
+        qval out = make_bare(r);
+        out.dv = a.dv * (IS("sin") ? cos(a.v) : IS("cos") ? -sin(a.v) : 1.0 + r * r);
+        return out;  /* a pure number: 100 * cos(60) takes the default length unit */
     }
 #undef IS
     qfail(p, at, "unknown function '%.*s' (known: sqrt, sin, cos, tan, atan2)", (int)n, name);
@@ -481,11 +491,11 @@ static qval parse_atom(qparser *p)
             return call_function(p, at, n, at);
         }
         if (n == 2 && memcmp(at, "pi", 2) == 0)  /* pi rad: angle: pi/2 is 90 deg whatever the default */
-            return (qval){PI, quantity_table[Q_ANGLE].d, 0};
+            return (qval){PI, quantity_table[Q_ANGLE].d, 0, 0.0};
         int found = find_param(p->env, at, n);
         if (found >= 0) {
             const expr_param *q = &p->env->params[found];
-            return (qval){q->value, q->d, q->bare};
+            return (qval){q->value, q->d, q->bare, q->dvalue};
         }
         if (unit_lookup(at, n))
             qfail(p, at, "unit '%.*s' without a number (write 1 %.*s)", (int)n, at, (int)n, at);
@@ -520,8 +530,10 @@ static qval parse_unary(qparser *p)
         int neg = *p->s == '-';
         p->s++;
         v = parse_unary(p);
-        if (neg)
+        if (neg) {
             v.v = -v.v;
+            v.dv = -v.dv;
+        }
     } else {
         v = parse_power(p);
     }
@@ -540,6 +552,7 @@ static qval parse_power(qparser *p)
         return a;
     }
     if (r == 1) {
+        a.dv = e == 0 ? 0.0 : e * pow(a.v, e - 1) * a.dv;
         a.v = pow(a.v, e);
         int was_bad = dim_is_bad(a.d);
         a.d = dim_scale(a.d, e);
@@ -559,12 +572,14 @@ static qval parse_term(qparser *p)
         p->s = at + 1;
         qval b = parse_unary(p);
         if (*at == '*') {
+            a.dv = a.dv * b.v + a.v * b.dv;
             a.v *= b.v;
         } else {
             if (b.v == 0) {
                 qfail(p, at, "division by zero");
                 return a;
             }
+            a.dv = (a.dv * b.v - a.v * b.dv) / (b.v * b.v);
             a.v /= b.v;
         }
         a.d = dim_add(a.d, b.d, *at == '*' ? 1 : -1);
@@ -587,6 +602,7 @@ static qval parse_expr(qparser *p)
         qval b = parse_term(p);
         unify(p, &a, &b, at, *at);
         a.v = *at == '+' ? a.v + b.v : a.v - b.v;
+        a.dv = *at == '+' ? a.dv + b.dv : a.dv - b.dv;
     }
 }
 
@@ -611,6 +627,8 @@ int quantity_eval(const char *text, quantity want, const expr_env *env, double *
         return -1;
     }
     const quantity_info *qi = &quantity_table[want];
+    if (env->dvalue)
+        *env->dvalue = v.bare ? v.dv * env->units->scale[want] : v.dv;
     if (v.bare) {
         *value = v.v * env->units->scale[want];
         return 0;
@@ -636,6 +654,7 @@ int quantity_eval_param(const char *text, const expr_env *env, expr_param *out, 
         return -1;
     }
     out->value = v.v;
+    out->dvalue = v.dv;
     out->d = v.d;
     out->bare = v.bare;
     return 0;

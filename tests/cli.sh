@@ -342,6 +342,59 @@ if run "mech plot --steps 200000" 0 "$MECH" plot mechanisms/fourbar.yaml --steps
     [ "$kb" -lt 3000 ] && pass || fail "plot of 200 000 steps: $kb KB of SVG, expected under 3 MB"
 fi
 
+# --set, --from, --to: the semantics and messages of mech solve
+if run "mech plot --set --from --to" 0 "$MECH" plot mechanisms/slider-crank.yaml --set 'r=50 mm' --from 0 --to 180 --steps 4 --outputs B --out "$tmp/pst"; then
+    has_line "$tmp/out" "/slider-crank-path-B.svg\$" "plot: a path figure for the moving point B"
+    # the path of B, through data-mech-transform, ends at l - r = 90 mm (r = 50 mm, 180 deg)
+    tr=$(sed -n 's/.*data-mech-transform="\([^"]*\)".*/\1/p' "$tmp/pst/slider-crank-path-B.svg")
+    last=$(sed -n 's/.*<path stroke="#1f4e99" d="\([^"]*\)".*/\1/p' "$tmp/pst/slider-crank-path-B.svg" | awk '{print $NF}')
+    echo "$tr $last" | awk '{ split($4, v, ","); x = (v[1] - $2) / $1; exit !(x > 0.08999 && x < 0.09001) }' && pass ||
+        fail "plot --set r=50mm --to 180: path of B ends at $last (transform $tr), not at x = 90 mm"
+    "$MECH" solve mechanisms/slider-crank.yaml --set 'r=50 mm' --from 0 --to 180 --steps 4 --outputs B --level positions -o "$tmp/pst.csv" &&
+        has_line "$tmp/pst.csv" '^3.14159[0-9]*,0.09[0-9]*,' "solve --set r=50mm --to 180: B.x = l - r = 90 mm"
+fi
+for cmd in plot animate; do
+    if run "mech $cmd --from without --to" 2 "$MECH" $cmd mechanisms/fourbar.yaml --from 10; then
+        has_line "$tmp/err" "^mech $cmd: --from and --to go together (see 'mech $cmd --help')$" "$cmd --from alone"
+    fi
+    if run "mech $cmd --set without =" 2 "$MECH" $cmd mechanisms/fourbar.yaml --set r; then
+        has_line "$tmp/err" "^mech $cmd: --set needs NAME=VALUE (at most 64), not 'r' (see 'mech $cmd --help')$" "$cmd --set r"
+    fi
+    if run "mech $cmd --set unknown parameter" 2 "$MECH" $cmd mechanisms/slider-crank.yaml --set rr=4mm; then
+        has_line "$tmp/err" "no parameter 'rr'" "$cmd --set rr="
+    fi
+    if run "mech $cmd --from not a number" 2 "$MECH" $cmd mechanisms/fourbar.yaml --from ten --to 20; then
+        has_line "$tmp/err" "^mech $cmd: --from 'ten': " "$cmd --from ten"
+    fi
+    if run "mech $cmd --to too far" 2 "$MECH" $cmd mechanisms/fourbar.yaml --from 0 --to 1e9; then
+        has_line "$tmp/err" "^mech $cmd: --to '1e9' is 1.75e+07 rad: a driver angle must be within" "$cmd --to 1e9"
+    fi
+done
+# the same words as mech solve
+"$MECH" solve mechanisms/fourbar.yaml --from ten --to 20 2>"$tmp/e1" >/dev/null
+"$MECH" plot mechanisms/fourbar.yaml --from ten --to 20 --out "$tmp/f2" 2>"$tmp/e2" >/dev/null
+[ "$(sed 's/^mech solve/mech X/' "$tmp/e1")" = "$(sed 's/^mech plot/mech X/' "$tmp/e2")" ] && pass ||
+    fail "plot --from ten: '$(cat "$tmp/e2")' is not solve's '$(cat "$tmp/e1")'"
+# animate --outputs: the traced points
+if run "mech animate --outputs" 0 "$MECH" animate mechanisms/fourbar.yaml --outputs P --frame 3 -o "$tmp/tr.svg"; then
+    [ "$(grep -c 'data-trace=' "$tmp/tr.svg")" -eq 1 ] && grep -q 'data-trace="P"' "$tmp/tr.svg" && pass ||
+        fail "animate --outputs P: traces $(grep -o 'data-trace="[^"]*"' "$tmp/tr.svg" | paste -sd' ' -)"
+    grep -q 'data-mech-scale-bar=' "$tmp/tr.svg" && pass || fail "animate: no scale bar"
+fi
+if run "mech animate --outputs link" 2 "$MECH" animate mechanisms/fourbar.yaml --outputs P,coupler -o "$tmp/tr2.svg"; then
+    has_line "$tmp/err" "^mech animate: --outputs: 'coupler' is a link, not a point: the animation traces the paths of points$" "animate --outputs coupler"
+    [ ! -e "$tmp/tr2.svg" ] && pass || fail "animate --outputs coupler wrote $tmp/tr2.svg"
+fi
+if run "mech animate --outputs unknown" 2 "$MECH" animate mechanisms/fourbar.yaml --outputs Q -o "$tmp/tr2.svg"; then
+    has_line "$tmp/err" "^mech animate: --outputs: 'Q' is not a point" "animate --outputs Q"
+fi
+# 10^6 steps: every figure of bounded size (the paths and the curves thinned)
+if run "mech plot --steps 1000000" 0 "$MECH" plot mechanisms/fourbar.yaml --steps 1000000 --outputs P,coupler --out "$tmp/fig6"; then
+    big=$(find "$tmp/fig6" -name '*.svg' -size +200k | head -n 1)
+    [ -z "$big" ] && pass || fail "plot of 10^6 steps: $big is over 200 kB"
+    [ -s "$tmp/fig6/fourbar-path-P.svg" ] && pass || fail "plot of 10^6 steps: no path figure"
+fi
+
 # ---- mech sweep -----------------------------------------------------------
 
 if run "mech sweep" 0 "$MECH" sweep mechanisms/slider-crank.yaml --vary r=30mm:60mm:4 --list l=45mm,140mm --metric range:x_B.s -j 2 -o "$tmp/sw.csv"; then
@@ -456,5 +509,49 @@ fi
 if run "mech batch, progress" 0 env MECH_PROGRESS_SECONDS=0 "$MECH" batch -j 1 mechanisms/fourbar.yaml mechanisms/slider-crank.yaml; then
     has_line "$tmp/err" '^mech batch: 1 of 2 files (50%), [0-9]* s$' "batch: progress lines"
 fi
+
+# issue 20: parameters kept symbolic (mech equations) and sensitivities
+if run "mech equations, parameter names" 0 "$MECH" equations mechanisms/offset-slider-crank.yaml; then
+    has_line "$tmp/out" "^  f1 = l\*cos(th_rod) - x_B + r\*cos(th_crank) " "equations: r and l by name"
+    has_line "$tmp/out" "^  f2 = l\*sin(th_rod) - e + r\*sin(th_crank) " "equations: e by name"
+fi
+if run "mech solve --sensitivity" 0 "$MECH" solve mechanisms/offset-slider-crank.yaml --steps 4 -q --sensitivity r,l; then
+    has_line "$tmp/out" '^q \[rad\],.*,d(A\.x)/d(r) \[m/m\],.*,d(x_B\.a)/d(l) \[m/s^2/m\]$' "sensitivity: header"
+    # A = r (cos q, sin q): d(A.x)/d(r) = cos q, 1 at q = 0; d(A.vy)/d(r) = w cos q = 314.159...
+    ax=$(awk -F, 'NR == 2 { print $20 }' "$tmp/out")
+    [ "$ax" = "1" ] && pass || fail "sensitivity: d(A.x)/d(r) at q = 0 is '$ax', not 1"
+fi
+if run "mech solve --sensitivity, unknown name" 2 "$MECH" solve mechanisms/offset-slider-crank.yaml --steps 4 -q --sensitivity rr; then
+    has_line "$tmp/err" "no parameter 'rr' in the file (its parameters: r, l, e)" "sensitivity: unknown name"
+fi
+
+# issue 20 item 4: tolerances
+sed 's/^  r: 40 mm .*/  r: {value: 40 mm, tolerance: 0.05 mm}/; s/^  l: 120 mm .*/  l: {value: 120 mm, tolerance: 0.1 mm}/' \
+    mechanisms/offset-slider-crank.yaml >"$tmp/tol.yaml"
+if run "mech solve --tolerances" 0 "$MECH" solve "$tmp/tol.yaml" -q --tolerances --outputs B -o "$tmp/tol.csv"; then
+    has_line "$tmp/err" '^mech solve: tolerance stack-up, first order, from r +-5e-05 m l +-0.0001 m; largest over the 361 rows:$' "tolerances: summary head"
+    # by hand at q = 240 deg: |dx/dr| tol_r + |dx/dl| tol_l = 1.05371 * 5e-5 + 1.18692 * 1e-4 (docs/sensitivity.md)
+    has_line "$tmp/err" '^  B.x  *worst case 0.000171378  *RSS 0.000130621  *\[m\] (worst at q = 4.18879)$' "tolerances: B.x stack-up"
+    has_line "$tmp/tol.csv" '^q \[rad\],B.x \[m\],.*,worst(B.x) \[m\],rss(B.x) \[m\],' "tolerances: columns"
+fi
+sed 's/tolerance: 0.05 mm/tolerance: 0.05/' "$tmp/tol.yaml" >"$tmp/tol-bad.yaml"
+if run "tolerance without a unit" 2 "$MECH" check "$tmp/tol-bad.yaml"; then
+    has_line "$tmp/err" "tol-bad.yaml:53:32: error: tolerance of parameter 'r' must be in the value's unit (m), not '0.05'" "tolerance: unit"
+    [ "$(wc -l <"$tmp/err")" -eq 1 ] && pass || fail "tolerance without a unit: echoed errors: $(cat "$tmp/err")"
+fi
+if run "mech solve --tolerances without tolerances" 2 "$MECH" solve mechanisms/offset-slider-crank.yaml -q --tolerances; then
+    has_line "$tmp/err" "no parameter has a tolerance" "tolerances: none"
+fi
+for bad in "r,,l" "r," "r,r" ""; do
+    if run "mech solve --sensitivity '$bad'" 2 "$MECH" solve mechanisms/offset-slider-crank.yaml -q --sensitivity "$bad"; then
+        has_line "$tmp/err" "sensitivity needs at most 64 different parameter names separated by commas" "sensitivity: '$bad'"
+    fi
+done
+sed 's/^  e: 30 mm .*/  e: 30 mm\n  alpha: 0 deg/; s/^    angle: 0 deg .*/    angle: alpha/' \
+    mechanisms/offset-slider-crank.yaml >"$tmp/angle.yaml"
+if run "mech solve --sensitivity, a slider's angle" 2 "$MECH" solve "$tmp/angle.yaml" -q --steps 4 --sensitivity alpha; then
+    has_line "$tmp/err" "error: parameter 'alpha' sets the angle of slider 'x_B': sensitivities through a slider's angle are not computed" "sensitivity: slider angle refused"
+fi
+run "mech solve --sensitivity r, a slider's angle elsewhere" 0 "$MECH" solve "$tmp/angle.yaml" -q --steps 4 --sensitivity r && pass
 
 summary

@@ -26,8 +26,17 @@ check() {  # check LABEL ARGS...: valgrind must report nothing (exit 99 on error
 for f in mechanisms/*.yaml tests/solve/*.yaml tests/hard/*.yaml; do
     check "mech solve --forces $f" solve "$f" --forces --friction both -o "$tmp/x.csv"
 done
+for f in mechanisms/*.yaml tests/hard/redundant-parallelogram.yaml; do
+    check "mech codegen $f" codegen "$f" -o "$tmp/gen.c" --header "$tmp/gen.h"
+done
 check "mech batch" batch -j 2 -q mechanisms/*.yaml tests/solve/*.yaml
 check "mech sweep" sweep mechanisms/slider-crank.yaml --list l=45mm,140mm --metric range:x_B.s -j 2
+check "mech equations (named parameters)" equations mechanisms/conveyor.yaml
+check "mech equations --format latex" equations --format latex mechanisms/stirling.yaml
+check "mech solve --sensitivity" solve mechanisms/conveyor.yaml --sensitivity l1,xF --steps 36 -q -o "$tmp/s.csv"
+sed 's/^  r: 40 mm .*/  r: {value: 40 mm, tolerance: 0.05 mm}/' mechanisms/offset-slider-crank.yaml >"$tmp/tol.yaml"
+check "mech solve --tolerances" solve "$tmp/tol.yaml" --tolerances --sensitivity e -q -o "$tmp/t.csv"
+check "mech solve --sensitivity, unknown name" solve mechanisms/conveyor.yaml --sensitivity zz -q
 check "mech plot" plot mechanisms/fourbar.yaml --out "$tmp/plots"
 check "mech animate" animate mechanisms/fourbar.yaml -o "$tmp/a.svg"
 echo "valgrind: $passed passed, $failed failed"

@@ -14,6 +14,17 @@
       the row of POSITIONS.csv whose positions best match the discs of a
       screenshot of the animation (--test-colours); prints "row N" last and
       fails when even that row is off by more than TOL_PX (default 3).
+  pngcheck.py path SHOT.png FIG.svg POSITIONS.csv POINT [TOL_PX]
+      a path figure (`mech plot`, path-POINT.svg): the pixels of the curve's
+      colour in the plot area lie within TOL_PX (default 1.5) of the solved
+      positions of POINT (every row of POSITIONS.csv, joined in order)
+      mapped through the SVG's data-mech-transform, and every solved position
+      has such a pixel within TOL_PX; the start marker and the arrows (their
+      data-at) are left out, 9 px around.
+  pngcheck.py scalebar SHOT.png ANIM.svg
+      the scale bar of a --test-colours animation (colour #00a0ff) is drawn
+      as long as its label says, at the SVG's data-mech-transform, within
+      1 px.
   pngcheck.py blank SHOT.png
       fails when the screenshot is one flat colour.
 
@@ -214,6 +225,117 @@ def moved(a, b, svg, csvfile, ra, rb):
     return bad + (not same)
 
 
+def curve_alpha(rgb, colour):
+    """How much of `colour` over white a pixel is (0..1), or None when its
+    channels disagree (another colour: grid, text, a blend with those)."""
+    a = [(255 - p) / (255 - c) for p, c in zip(rgb, colour) if 255 - c > 60]
+    if not a or max(a) - min(a) > 0.15:
+        return None
+    return sum(a) / len(a)
+
+
+class Segments:
+    """The polyline through pts, bucketed on a grid of `cell` px, for the
+    distance from a pixel to it."""
+
+    def __init__(self, pts, cell=8.0):
+        self.cell, self.grid = cell, {}
+        for a, b in zip(pts, pts[1:]):
+            x0, x1 = sorted((a[0], b[0]))
+            y0, y1 = sorted((a[1], b[1]))
+            for i in range(int(x0 // cell), int(x1 // cell) + 1):
+                for j in range(int(y0 // cell), int(y1 // cell) + 1):
+                    self.grid.setdefault((i, j), []).append((a, b))
+
+    def dist(self, x, y):
+        best = float("inf")
+        i0, j0 = int(x // self.cell), int(y // self.cell)
+        for i in (i0 - 1, i0, i0 + 1):
+            for j in (j0 - 1, j0, j0 + 1):
+                for (a, b) in self.grid.get((i, j), ()):
+                    vx, vy = b[0] - a[0], b[1] - a[1]
+                    l2 = vx * vx + vy * vy
+                    u = ((x - a[0]) * vx + (y - a[1]) * vy) / l2 if l2 else 0.0
+                    u = min(1.0, max(0.0, u))
+                    best = min(best, ((x - a[0] - u * vx) ** 2 + (y - a[1] - u * vy) ** 2) ** 0.5)
+        return best
+
+
+def path(shot, svg, csvfile, point, tol=1.5):
+    w, h, px = read_png(shot)
+    doc = xml.dom.minidom.parse(svg)
+    root = doc.documentElement
+    tr = tuple(float(v) for v in root.getAttribute("data-mech-transform").split())
+    x0, y0, x1, y1 = (float(v) for v in root.getAttribute("data-mech-plot").split())
+    colour = None  # the first curve: the first path of the group clipped to the plot
+    for g in doc.getElementsByTagName("g"):
+        if g.getAttribute("clip-path") and colour is None:
+            e = g.getElementsByTagName("path")[0]
+            colour = tuple(int(e.getAttribute("stroke")[i:i + 2], 16) for i in (1, 3, 5))
+    marks = []
+    for e in doc.getElementsByTagName("use"):
+        if e.getAttribute("data-at"):
+            marks.append(tuple(float(v) for v in e.getAttribute("data-at").split(",")))
+    with open(csvfile) as f:
+        rows = list(csv.reader(f))
+    head = [c.split(" [")[0] for c in rows[0]]
+    ix, iy = head.index(point + ".x"), head.index(point + ".y")
+    pts = [to_screen(tr, (float(r[ix]), float(r[iy]))) for r in rows[1:]]
+    near_mark = lambda x, y: any((x - m[0]) ** 2 + (y - m[1]) ** 2 < 81 for m in marks)
+    inside = lambda x, y: x0 + 2 <= x <= x1 - 2 and y0 + 2 <= y <= y1 - 2
+    line = Segments(pts)
+    curve, worst, bad = [], 0.0, 0
+    for y in range(int(y0) + 2, int(y1) - 1):
+        for x in range(int(x0) + 2, int(x1) - 1):
+            a = curve_alpha(px[y][x], colour)
+            if a is None or a < 0.5 or near_mark(x + 0.5, y + 0.5):
+                continue
+            curve.append((x + 0.5, y + 0.5))
+            d = line.dist(x + 0.5, y + 0.5)
+            worst = max(worst, d)
+            bad += d > tol
+    print(f"  {len(curve)} curve pixels, farthest {worst:.2f} px from the solved path "
+          f"({bad} beyond {tol} px) [{'ok' if bad == 0 and curve else 'FAIL'}]")
+    grid = {}
+    for c in curve:
+        grid.setdefault((int(c[0] // 4), int(c[1] // 4)), []).append(c)
+    missing, checked = 0, 0
+    for (x, y) in pts[::max(1, len(pts) // 2000)]:
+        if not inside(x, y) or near_mark(x, y):
+            continue
+        checked += 1
+        i0, j0 = int(x // 4), int(y // 4)
+        d = min([((x - c[0]) ** 2 + (y - c[1]) ** 2) ** 0.5 for i in (i0 - 1, i0, i0 + 1)
+                 for j in (j0 - 1, j0, j0 + 1) for c in grid.get((i, j), ())] + [float("inf")])
+        missing += d > tol
+    print(f"  {checked} solved positions, {missing} without a curve pixel within {tol} px "
+          f"[{'ok' if missing == 0 and checked else 'FAIL'}]")
+    return (bad > 0) + (not curve) + (missing > 0) + (checked == 0)
+
+
+def scalebar(shot, svg):
+    w, h, px = read_png(shot)
+    doc = xml.dom.minidom.parse(svg)
+    s = float(doc.documentElement.getAttribute("data-mech-transform").split()[0])
+    bar = None
+    for g in doc.getElementsByTagName("g"):
+        if g.getAttribute("data-mech-scale-bar"):
+            bar = g
+    metres, bx0, bx1, by = (float(v) for v in bar.getAttribute("data-mech-scale-bar").split())
+    label = bar.getElementsByTagName("text")[0].firstChild.data
+    mm = float(label.split()[0])
+    want = mm * 1e-3 * s
+    xs = [x for y in range(int(by) - 1, int(by) + 2) for x in range(w) if px[y][x] == (0, 160, 255)]
+    if not xs:
+        print("  scale bar: no pixel of its colour #00a0ff")
+        return 1
+    got = max(xs) - min(xs) + 1
+    ok = abs(got - want) <= 1 and abs(metres - mm * 1e-3) < 1e-12
+    print(f"  scale bar '{label}': drawn {got} px, {mm} mm at {s:.6g} px/m is {want:.2f} px "
+          f"[{'ok' if ok else 'FAIL'}]")
+    return 0 if ok else 1
+
+
 def blank(shot):
     w, h, px = read_png(shot)
     colours = set()
@@ -233,6 +355,10 @@ def main(argv):
         bad = moved(argv[2], argv[3], argv[4], argv[5], int(argv[6]), int(argv[7]))
     elif len(argv) >= 5 and argv[1] == "fit":
         bad = fit(argv[2], argv[3], argv[4], float(argv[5]) if len(argv) > 5 else 3.0)
+    elif len(argv) >= 6 and argv[1] == "path":
+        bad = path(argv[2], argv[3], argv[4], argv[5], float(argv[6]) if len(argv) > 6 else 1.5)
+    elif len(argv) == 4 and argv[1] == "scalebar":
+        bad = scalebar(argv[2], argv[3])
     elif len(argv) == 3 and argv[1] == "blank":
         bad = blank(argv[2])
     else:

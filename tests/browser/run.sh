@@ -14,7 +14,13 @@
 #   4. the animation itself (SMIL), stopped at 1 s and 2 s of its 4 s cycle
 #      (`--pause-at T` adds an inline script that pauses it there): the discs
 #      are those of rows (N-1)/4 and (N-1)/2 of the sweep within 3 px; and,
-#      left playing for 2 s of virtual time, the picture is a solved position.
+#      left playing for 2 s of virtual time, the picture is a solved position;
+#   5. every path figure (path-P.svg): the curve's pixels lie within 1.5 px of
+#      the solved positions of P mapped through data-mech-transform, and every
+#      solved position has a curve pixel within 1.5 px;
+#   6. a 20 000-step path figure, thinned to within 0.25 px: the same check
+#      against all 20 001 solved positions;
+#   7. the animation's scale bar is drawn as long as its label says.
 #
 # Needs (Debian): chromium, libxml2-utils (xmllint), python3 (standard
 # library only: tests/browser/pngcheck.py decodes the PNGs), fonts-dejavu-core.
@@ -144,6 +150,38 @@ for name in stirling conveyor; do
     else
         fail "$name: no screenshot of the playing animation"
     fi
+
+    # 5. the path figures: curve pixels where the solved positions map
+    for svg in $(grep -- '-path-' "$dir/figures.txt"); do
+        point=${svg##*-path-}
+        point=${point%.svg}
+        echo "  path of $point ($(basename "$svg")) against positions.csv:"
+        $CHECK path "${svg%.svg}.png" "$svg" "$dir/positions.csv" "$point" ||
+            fail "$name: the path of $point is not drawn where it was solved"
+    done
+    npath=$(grep -c -- '-path-' "$dir/figures.txt")
+    [ "$npath" -ge 1 ] || fail "$name: no path figure"
+
+    # 6. a long sweep's path, thinned, against every solved position
+    point=$(grep -- '-path-' "$dir/figures.txt" | head -n 1)
+    point=${point##*-path-}
+    point=${point%.svg}
+    long=$dir/long
+    if "$MECH" plot "$yaml" --steps 20000 --outputs "$point" --out "$long" >/dev/null &&
+        "$MECH" solve "$yaml" --steps 20000 --outputs "$point" --level positions -o "$long/positions.csv" &&
+        shot "$long/$name-path-$point.svg" "$long/path.png"; then
+        nv=$(sed -n 's/.*<path stroke="#1f4e99" d="\([^"]*\)".*/\1/p' "$long/$name-path-$point.svg" | tr -cd , | wc -c)
+        echo "  path of $point over 20 000 steps, $nv vertices drawn, against its 20 001 positions:"
+        [ "$nv" -gt 1 ] && [ "$nv" -lt 4032 ] || fail "$name: the 20 000-step path has $nv vertices"
+        $CHECK path "$long/path.png" "$long/$name-path-$point.svg" "$long/positions.csv" "$point" ||
+            fail "$name: the thinned path is not where the solved positions are"
+    else
+        fail "$name: the 20 000-step path figure"
+    fi
+
+    # 7. the scale bar (the --test-colours still of step 2)
+    $CHECK scalebar "$dir/frame$k1-test.png" "$dir/frame$k1-test.svg" ||
+        fail "$name: the scale bar is not as long as its label"
 done
 
 if [ "$fails" -ne 0 ]; then

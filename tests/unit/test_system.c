@@ -248,6 +248,60 @@ static void check_hoisted(const char *path)
     mech_model_free(&m);
 }
 
+/* Superinstructions (tape_fuse, after hoisting, as the solver compiles its
+ * tape): fewer instructions, and every root still equal, bit for bit, to
+ * the DAG's value, run whole or hoisted part then the rest. */
+static void check_fused(const char *path)
+{
+    mech_model *m = load_path(path);
+    mech_system *s = build(m);
+    int n = s->n, nv = SYS_NVARS(n);
+    tape *t = &s->tp;
+    double *vars = calloc((size_t)nv, sizeof *vars);
+    double *f = calloc((size_t)n, sizeof *f), *Jx = calloc((size_t)s->nnz + 1, sizeof *Jx);
+    double *b = calloc((size_t)n, sizeof *b), *c = calloc((size_t)n, sizeof *c);
+    ex *pos = calloc((size_t)(n + s->nnz), sizeof *pos);
+    memcpy(pos, s->f, (size_t)n * sizeof *pos);
+    memcpy(pos + n, s->Jx, (size_t)s->nnz * sizeof *pos);
+    const ex *roots[3] = {pos, s->vel, s->acc};
+    int nroots[3] = {n + s->nnz, n, n};
+    unsigned char *inv = calloc((size_t)nv, 1);
+    inv[SYS_VAR_Q(n)] = 1;
+    tape_hoist(t, 0, inv);
+    int before = t->nins;
+    cr_assert_eq(tape_fuse(t, roots, nroots), 0);
+    cr_assert(t->nins < before, "%s: %d instructions before fusing, %d after", path, before,
+              t->nins);
+    for (int trial = 0; trial < 10; trial++) {
+        random_state(s, mechanism_size(m), vars);
+        if (trial % 2) {  /* the solver's way: hoisted part, then the rest */
+            for (int v = 0; v < nv; v++)
+                tape_set_var(t, s->reg, v, vars[v]);
+            tape_run_invariant(t, s->reg, 0);
+            tape_run_variant(t, s->reg, 0);
+            for (int r = 0; r < n; r++)
+                cr_assert_eq(tape_value(t, s->reg, s->f[r]),
+                             expr_eval(&s->ex, s->f[r], vars), "%s f%d hoisted", path, r + 1);
+        }
+        sys_eval_position(s, vars, vars[SYS_VAR_Q(n)], f, Jx);
+        sys_eval_velocity_rhs(s, vars[SYS_VAR_QDOT(n)], b);
+        sys_eval_accel_rhs(s, vars + SYS_VAR_XDOT(n, 0), vars[SYS_VAR_QDOT(n)],
+                           vars[SYS_VAR_QDDOT(n)], c);
+        for (int r = 0; r < n; r++) {
+            cr_assert_eq(f[r], expr_eval(&s->ex, s->f[r], vars), "%s f%d", path, r + 1);
+            cr_assert_eq(b[r], expr_eval(&s->ex, s->vel[r], vars), "%s b%d", path, r + 1);
+            cr_assert_eq(c[r], expr_eval(&s->ex, s->acc[r], vars), "%s c%d", path, r + 1);
+        }
+        for (int k = 0; k < s->nnz; k++)
+            cr_assert_eq(Jx[k], expr_eval(&s->ex, s->Jx[k], vars), "%s J[%d]", path, k);
+    }
+    void *blocks[] = {vars, f, Jx, b, c, pos, inv};
+    for (size_t i = 0; i < sizeof blocks / sizeof *blocks; i++)
+        free(blocks[i]);
+    mech_system_free(&s);
+    mech_model_free(&m);
+}
+
 static int for_each_mechanism(void (*fn)(const char *))
 {
     DIR *dir = opendir("mechanisms");
@@ -280,6 +334,11 @@ Test(system, tape_matches_dag_bit_for_bit)
 Test(system, hoisted_tape_matches_the_whole_phase)
 {
     cr_assert_geq(for_each_mechanism(check_hoisted), 2);
+}
+
+Test(system, fused_tape_matches_dag_bit_for_bit)
+{
+    cr_assert_geq(for_each_mechanism(check_fused), 2);
 }
 
 /* ---- loops from the file against automatic loops --------------------- */

@@ -1,0 +1,74 @@
+/* src/codegen.h: `mech codegen`, a standalone C11 solver for one mechanism
+ * (docs/codegen.md). codegen_init analyses the mechanism as `mech solve`
+ * does (the same solver plan: the blocks the outputs need, the same tape
+ * roots); the emitters print the header and the source: straight-line code
+ * for the residual, the Jacobian and the rate right-hand sides, tables for
+ * the block triangular form's dense solves, and the Newton, condition and
+ * branch logic of src/solve.c and src/continuation.c. */
+#ifndef MECH_CODEGEN_H
+#define MECH_CODEGEN_H
+
+#include <stdio.h>
+
+#include "blocklu.h"
+#include "columns.h"
+#include "solve.h"
+
+/* Largest number of unknowns solved that codegen writes code for (the
+ * dense blocks and the straight-line code grow with it). */
+enum { CODEGEN_MAX_UNKNOWNS = 400 };
+
+typedef struct codegen_options {
+    const char *prefix;      /* C identifier prefix of the public names ("fourbar") */
+    const char *header;      /* the header's name as #included by the source, or NULL:
+                                the source declares everything itself */
+    int all_blocks;          /* 1: solve every unknown, not only those the outputs need */
+} codegen_options;
+
+typedef struct codegen {
+    const mech_model *m;     /* borrowed */
+    codegen_options opt;
+    char lower[64], upper[64]; /* the prefix, as given and upper-cased */
+    solver_plan sp;          /* what mech solve would solve */
+    blocklu_plan bp;         /* block triangular form of the solved Jacobian (any block size) */
+    column_layout cols;      /* the kinematic output columns, as mech solve names them */
+    char **col_ident;        /* [cols.ncols] enum identifier of each column */
+    char **unk_ident;        /* [sp.ns] enum identifier of each solved unknown */
+    /* expression emission (codegen_expr.c) */
+    int *phase;              /* [DAG nodes] phase (0 driver alone, 1 position, 2 velocity,
+                                3 acceleration) whose function computes the node, -1: none */
+    int *keep;               /* [DAG nodes] slot in the state's keep[] for a node used by a
+                                later phase, -1: none */
+    int nkeep;
+    int *driver_only;        /* [DAG nodes] 1: depends on the driver q alone, 0 not, -1 unknown */
+    int *unk_col;            /* [n] solved column of each unknown of the system, -1: not solved */
+} codegen;
+
+/* Analyse m for code generation: MECH_OK, or MECH_EINPUT (redundant
+ * constraints, too many unknowns, an expression the emitter does not know)
+ * or MECH_ENOMEM, with the message in d. */
+int codegen_init(codegen *g, const mech_model *m, const codegen_options *o, mech_diag *d);
+void codegen_free(codegen *g);
+
+/* Emitters for write_file_whole: ctx is the codegen; 0, or -1 when a
+ * write failed. */
+int codegen_emit_header(FILE *f, const void *ctx);
+int codegen_emit_source(FILE *f, const void *ctx);
+
+/* ---- codegen_expr.c: the DAG as C statements ---------------------------- */
+
+/* Assign each node of the three phases' roots a phase and keep slots;
+ * MECH_OK, MECH_EINPUT (an unknown node kind or a variable outside the
+ * solved set, with the message in d) or MECH_ENOMEM. */
+int codegen_expr_plan(codegen *g, mech_diag *d);
+/* The functions eval_driver, eval_position, eval_velocity, eval_accel; 0 or -1. */
+int codegen_expr_emit(const codegen *g, FILE *f);
+/* The function kinematics: link frames, output columns, branch values. */
+int codegen_kin_emit(const codegen *g, FILE *f);
+/* codegen_runtime.c: the fixed solver text, one line each, NULL-terminated. */
+extern const char *const codegen_runtime[];
+
+/* "1.5", "(-2)", as a C double literal that reads back to v. */
+void codegen_number(char *buf, size_t size, double v);
+
+#endif
