@@ -256,7 +256,7 @@ fi
 # a file edited between two shards: the input hash covers the contents
 cp "$tmp/many/c100.yaml" "$tmp/c100.orig"
 echo "# edited" >>"$tmp/many/c100.yaml"
-"$MECH" batch -q -j 1 --shard 1/2 --files-from "$tmp/mlist" -o "$tmp/edited.txt" 2>/dev/null
+"$MECH" batch -q -j 1 --shard 1/2 --files-from "$tmp/mlist" --out-dir "$tmp/mcsv" --skip-existing -o "$tmp/edited.txt" 2>/dev/null
 merge_refused "a batch file edited between shards" 'shard 1/2 (.*edited.txt) is not from the same run as shard 0/2 .*: its input file (its contents) differs' \
     "$tmp/msum.0.txt" "$tmp/edited.txt"
 cp "$tmp/c100.orig" "$tmp/many/c100.yaml"
