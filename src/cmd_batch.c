@@ -69,7 +69,8 @@ const char cmd_batch_help[] =
 
 typedef struct job {
     const char *path;
-    char name[256];
+    const char *name;    /* NAME: its base name without .yaml, in path ... */
+    int name_len;        /* ... name_len bytes (no copy: memory per file is small) */
     char *csv;           /* --out-dir: DIR/NAME.csv, owned */
     char *golden_path;   /* --golden: GOLDEN/NAME.csv, owned */
     int code;            /* exit status of this file */
@@ -98,16 +99,17 @@ typedef struct batch {
     char *partial_path;       /* owned */
 } batch;
 
-static void base_name(const char *path, char *out, size_t size)
+static void base_name(const char *path, const char **name, int *len)
 {
     const char *b = strrchr(path, '/');
     b = b ? b + 1 : path;
-    snprintf(out, size, "%s", b);
-    size_t n = strlen(out);
-    if (n > 5 && strcmp(out + n - 5, ".yaml") == 0)
-        out[n - 5] = '\0';
-    else if (n > 4 && strcmp(out + n - 4, ".yml") == 0)
-        out[n - 4] = '\0';
+    size_t n = strlen(b);
+    if (n > 5 && strcmp(b + n - 5, ".yaml") == 0)
+        n -= 5;
+    else if (n > 4 && strcmp(b + n - 4, ".yml") == 0)
+        n -= 4;
+    *name = b;
+    *len = n > 65535 ? 65535 : (int)n;
 }
 
 static int exit_of(int rc)
@@ -195,8 +197,15 @@ static void run_job(const batch *b, job *jb)
 static int by_name(const void *a, const void *b)
 {
     const job *x = *(const job *const *)a, *y = *(const job *const *)b;
-    int c = strcmp(x->name, y->name);
+    int c = memcmp(x->name, y->name, (size_t)(x->name_len < y->name_len ? x->name_len : y->name_len));
+    if (!c)
+        c = (x->name_len > y->name_len) - (x->name_len < y->name_len);
     return c ? c : (x < y ? -1 : x > y);
+}
+
+static int same_name(const job *x, const job *y)
+{
+    return x->name_len == y->name_len && memcmp(x->name, y->name, (size_t)x->name_len) == 0;
 }
 
 /* Two files with the same NAME would both write DIR/NAME.csv. */
@@ -210,7 +219,7 @@ static int refuse_collisions(const batch *b)
     qsort(order, (size_t)b->njobs, sizeof *order, by_name);
     int code = -1;
     for (int i = 1; i < b->njobs; i++)
-        if (strcmp(order[i - 1]->name, order[i]->name) == 0) {
+        if (same_name(order[i - 1], order[i])) {
             fprintf(stderr, "mech batch: %s and %s would both be written to %s; nothing "
                     "solved (give files with distinct names)\n", order[i - 1]->path,
                     order[i]->path, order[i]->csv);
@@ -279,10 +288,10 @@ static int prepare_outputs(batch *b)
         for (int k = 0; k < 2; k++) {
             if (!dirs[k])
                 continue;
-            size_t len = strlen(dirs[k]) + strlen(jb->name) + 6;
+            size_t len = strlen(dirs[k]) + (size_t)jb->name_len + 6;
             if (!(*paths[k] = malloc(len)))
                 return fprintf(stderr, "mech batch: out of memory\n"), MECH_EXIT_INPUT;
-            snprintf(*paths[k], len, "%s/%s.csv", dirs[k], jb->name);
+            snprintf(*paths[k], len, "%s/%.*s.csv", dirs[k], jb->name_len, jb->name);
         }
     }
     if (!b->out_dir)
@@ -311,7 +320,7 @@ static void put_head(const manifest *mf, FILE *out)
 static void put_row(const job *jb, const manifest *mf, FILE *out)
 {
     static const char *const words[] = {"ok", "FAILED", "INPUT", "IO"};
-    fprintf(out, "%-28s %-6s %7d %12.3g %12.3g %s", jb->name, jb->kept ? "kept"
+    fprintf(out, "%-28.*s %-6s %7d %12.3g %12.3g %s", jb->name_len, jb->name, jb->kept ? "kept"
             : jb->code >= 0 && jb->code <= 3 ? words[jb->code] : "?", jb->steps,
             jb->worst_residual, jb->us_per_step, jb->golden ? jb->golden : "-");
     if (mf)
@@ -593,7 +602,7 @@ static int make_jobs(batch *b, const batch_opts *bo, const char **files, int nfi
         job *jb = &b->jobs[b->njobs++];
         jb->index = i;
         jb->path = files[i];
-        base_name(files[i], jb->name, sizeof jb->name);
+        base_name(files[i], &jb->name, &jb->name_len);
     }
     int code = prepare_outputs(b), kept = 0;
     for (int i = 0; i < b->njobs; i++)
