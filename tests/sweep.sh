@@ -242,6 +242,7 @@ if [ ! -e "$tmp/msum.1.txt" ]; then
     (kbatch 1 2>"$tmp/err") || fail "the killed batch shard rerun: exit $? ($(head -n 1 "$tmp/err"))"
     if [ -f "$tmp/msum.1.txt" ]; then
         [ "$(grep -c ' kept ' "$tmp/msum.1.txt")" -ge "$kept" ] && pass || fail "the rerun shard solved again what was there"
+        [ ! -e "$tmp/msum.1.txt.partial" ] && pass || fail "the rerun shard left its TABLE.partial"
         "$MECH" batch -q -j 1 --files-from "$tmp/mlist" -o "$tmp/mone.txt" 2>/dev/null
         if run "merge after the rerun" 0 "$MECH" merge -o "$tmp/mmerged.txt" "$tmp"/msum.*.txt; then
             # file and status (a kept file's row has no steps nor times)
@@ -252,6 +253,12 @@ if [ ! -e "$tmp/msum.1.txt" ]; then
 else
     echo "sweep.sh: the batch shard finished before it was killed, the kill test skipped"
 fi
+
+# a TABLE.partial that is a link is not written through
+ln -s "$tmp/list" "$tmp/linked.txt.partial"
+run "batch -o, TABLE.partial a link" 2 "$MECH" batch -q -j 1 mechanisms/fourbar.yaml -o "$tmp/linked.txt" &&
+    has_line "$tmp/err" 'linked.txt.partial exists and is not a regular file' "batch -o, TABLE.partial a link: message"
+cmp -s "$tmp/list" "$tmp/list.copy" && [ ! -e "$tmp/linked.txt" ] && pass || fail "batch -o, TABLE.partial a link: written"
 
 # a file edited between two shards: the input hash covers the contents
 cp "$tmp/many/c100.yaml" "$tmp/c100.orig"
