@@ -10,9 +10,9 @@
  * counter; --shard K/M keeps only the files whose index i satisfies
  * i % M == K, for running one batch over several machines (GNU Parallel,
  * Slurm job arrays). */
+#include <errno.h>
 #include <fcntl.h>
 #include <pthread.h>
-#include <errno.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
