@@ -46,7 +46,9 @@ measure() {  # measure LABEL ITEMS COMMAND...: one row of the table
     label=$1 items=$2
     shift 2
     $TIME -f "%e %U %S %M" -o "$tmp/time" "$@" >/dev/null 2>&1
-    read -r wall user sys kb <"$tmp/time"
+    # the last line: GNU time writes "Command exited with non-zero status" first
+    set -- $(tail -n 1 "$tmp/time")
+    wall=$1 user=$2 sys=$3 kb=$4
     awk -v l="$label" -v n="$items" -v w="$wall" -v u="$user" -v s="$sys" -v k="$kb" \
         'BEGIN { c = u + s; if (c < 0.01) c = 0.01
                  printf "%-34s %8d %8.2f %8.2f %12.1f %9.1f\n", l, n, w, c, n / c, k / 1024 }'
@@ -71,3 +73,21 @@ row=$(awk 'NR > 1 { n += length($0) + 1 } END { printf "%.0f", n / (NR - 1) }' "
 awk -v a="$kb1" -v b="$kb2" -v r="$row" 'BEGIN {
     printf "sweep memory per variant: %.0f bytes (peak %.1f MB at 1000, %.1f MB at 8000 variants; a row of the output is %d bytes)\n",
         (b - a) * 1024 / 7000, a / 1024, b / 1024, r }'
+
+# A batch's memory per file, the same way: 1000 and 16000 invalid files
+# (a parse error each: about 250 bytes of messages, no solve). The messages
+# are printed as each file finishes, so the slope is the per-file state kept
+# for the table in list order (its job: name, status, numbers), not the
+# messages.
+bad=tests/bad/01-bad-indentation.yaml
+yes $bad | head -n 1000 >"$tmp/bad1"
+yes $bad | head -n 16000 >"$tmp/bad2"
+measure "batch, 1000 invalid files" 1000 "$MECH" batch -j 1 --files-from "$tmp/bad1" -o "$tmp/b1.txt"
+kb1=$(cat "$tmp/kb")
+measure "batch, 16000 invalid files" 16000 "$MECH" batch -j 1 --files-from "$tmp/bad2" -o "$tmp/b2.txt"
+kb2=$(cat "$tmp/kb")
+msg=$("$MECH" batch -j 1 $bad 2>&1 >/dev/null | wc -c)
+row=$(awk 'NR > 1 { n += length($0) + 1 } END { printf "%.0f", n / (NR - 1) }' "$tmp/b2.txt")
+awk -v a="$kb1" -v b="$kb2" -v m="$msg" -v r="$row" 'BEGIN {
+    printf "batch memory per file: %.0f bytes (peak %.1f MB at 1000, %.1f MB at 16000 files; a file'"'"'s messages are %d bytes, its row of the table %d)\n",
+        (b - a) * 1024 / 15000, a / 1024, b / 1024, m, r }'

@@ -2,12 +2,17 @@
  * threads (docs/batch.md).
  *
  * Each file is independent: its own model, solver and diagnostics, written
- * to a memory stream and printed in file order at the end, so a failing file
- * never disturbs the others and the output does not depend on the number of
- * workers. Work is handed out by an atomic counter; --shard K/M keeps only
- * the files whose index i satisfies i % M == K, for running one batch over
- * several machines (GNU Parallel, Slurm job arrays). */
+ * to a memory stream and printed as one block when the file is done (so a
+ * failing file never garbles the others, and nothing piles up in memory);
+ * the table is in list order whatever the number of workers. With -o TABLE
+ * each row also goes to TABLE.partial as its file finishes, so a killed run
+ * leaves a record mech merge can name. Work is handed out by an atomic
+ * counter; --shard K/M keeps only the files whose index i satisfies
+ * i % M == K, for running one batch over several machines (GNU Parallel,
+ * Slurm job arrays). */
 #include <errno.h>
+#include <fcntl.h>
+#include <pthread.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -19,20 +24,24 @@
 #include "cmd_manifest.h"
 #include "commands.h"
 #include "compare.h"
+#include "output.h"
 
 const char cmd_batch_help[] =
     "usage: mech batch FILE... [-j N] [--out-dir DIR] [--golden DIR] [--shard K/M]\n"
     "                  [--rtol R] [--atol A] [--forces] [-q] [--files-from LIST]\n"
-    "                  [--skip-existing] [--unsolvable-ok]\n"
+    "                  [--skip-existing] [--unsolvable-ok] [-o TABLE]\n"
     "\n"
     "Solve many mechanism files on N worker threads, each exactly as 'mech solve\n"
     "FILE' would, and print a summary table: file, status, steps, worst residual,\n"
     "time per step, and the golden comparison. A failing file does not stop or\n"
-    "change the others. Messages are printed per file, in the order given.\n"
+    "change the others. Each file's messages are printed when it is done.\n"
     "\n"
     "options:\n"
     "  -j, --jobs N      worker threads (default: the processors this process may\n"
     "                    run on: its CPU affinity, as set by taskset or Slurm)\n"
+    "  -o, --output TABLE  write the table to TABLE (whole, when all are done;\n"
+    "                    meanwhile each row goes to TABLE.partial as its file\n"
+    "                    finishes); default: standard output\n"
     "  --files-from LIST  also the files named in LIST, one path per line ('-':\n"
     "                    standard input), after those given as arguments\n"
     "  --out-dir DIR     write DIR/NAME.csv for each FILE (NAME = its base name\n"
@@ -60,7 +69,8 @@ const char cmd_batch_help[] =
 
 typedef struct job {
     const char *path;
-    char name[256];
+    const char *name;    /* NAME: its base name without .yaml, in path ... */
+    int name_len;        /* ... name_len bytes (no copy: memory per file is small) */
     char *csv;           /* --out-dir: DIR/NAME.csv, owned */
     char *golden_path;   /* --golden: GOLDEN/NAME.csv, owned */
     int code;            /* exit status of this file */
@@ -69,7 +79,7 @@ typedef struct job {
     int steps;
     double worst_residual, us_per_step;
     const char *golden;  /* "-", "match", "DIFFER", "missing", "error" */
-    char *messages;      /* diagnostics, printed at the end */
+    char *messages;      /* diagnostics, printed when the file is done */
     size_t msize;
 } job;
 
@@ -82,18 +92,24 @@ typedef struct batch {
     int forces;
     int skip_existing;
     cmd_progress progress;    /* files done, on standard error */
+    int quiet;
+    const manifest *mf;       /* --shard: the table's manifest, else NULL */
+    pthread_mutex_t lock;     /* one finished file at a time: its row, its messages */
+    FILE *partial;            /* -o TABLE: TABLE.partial, rows as files finish */
+    char *partial_path;       /* owned */
 } batch;
 
-static void base_name(const char *path, char *out, size_t size)
+static void base_name(const char *path, const char **name, int *len)
 {
     const char *b = strrchr(path, '/');
     b = b ? b + 1 : path;
-    snprintf(out, size, "%s", b);
-    size_t n = strlen(out);
-    if (n > 5 && strcmp(out + n - 5, ".yaml") == 0)
-        out[n - 5] = '\0';
-    else if (n > 4 && strcmp(out + n - 4, ".yml") == 0)
-        out[n - 4] = '\0';
+    size_t n = strlen(b);
+    if (n > 5 && strcmp(b + n - 5, ".yaml") == 0)
+        n -= 5;
+    else if (n > 4 && strcmp(b + n - 4, ".yml") == 0)
+        n -= 4;
+    *name = b;
+    *len = n > 65535 ? 65535 : (int)n;
 }
 
 static int exit_of(int rc)
@@ -181,8 +197,15 @@ static void run_job(const batch *b, job *jb)
 static int by_name(const void *a, const void *b)
 {
     const job *x = *(const job *const *)a, *y = *(const job *const *)b;
-    int c = strcmp(x->name, y->name);
+    int c = memcmp(x->name, y->name, (size_t)(x->name_len < y->name_len ? x->name_len : y->name_len));
+    if (!c)
+        c = (x->name_len > y->name_len) - (x->name_len < y->name_len);
     return c ? c : (x < y ? -1 : x > y);
+}
+
+static int same_name(const job *x, const job *y)
+{
+    return x->name_len == y->name_len && memcmp(x->name, y->name, (size_t)x->name_len) == 0;
 }
 
 /* Two files with the same NAME would both write DIR/NAME.csv. */
@@ -196,7 +219,7 @@ static int refuse_collisions(const batch *b)
     qsort(order, (size_t)b->njobs, sizeof *order, by_name);
     int code = -1;
     for (int i = 1; i < b->njobs; i++)
-        if (strcmp(order[i - 1]->name, order[i]->name) == 0) {
+        if (same_name(order[i - 1], order[i])) {
             fprintf(stderr, "mech batch: %s and %s would both be written to %s; nothing "
                     "solved (give files with distinct names)\n", order[i - 1]->path,
                     order[i]->path, order[i]->csv);
@@ -265,10 +288,10 @@ static int prepare_outputs(batch *b)
         for (int k = 0; k < 2; k++) {
             if (!dirs[k])
                 continue;
-            size_t len = strlen(dirs[k]) + strlen(jb->name) + 6;
+            size_t len = strlen(dirs[k]) + (size_t)jb->name_len + 6;
             if (!(*paths[k] = malloc(len)))
                 return fprintf(stderr, "mech batch: out of memory\n"), MECH_EXIT_INPUT;
-            snprintf(*paths[k], len, "%s/%s.csv", dirs[k], jb->name);
+            snprintf(*paths[k], len, "%s/%.*s.csv", dirs[k], jb->name_len, jb->name);
         }
     }
     if (!b->out_dir)
@@ -284,31 +307,105 @@ static int prepare_outputs(batch *b)
     return code;
 }
 
-static void batch_job(void *ctx, int i)
-{
-    batch *b = ctx;
-    run_job(b, &b->jobs[i]);
-    cmd_progress_update(&b->progress, atomic_fetch_add(&b->done, 1) + 1, b->njobs);
-}
-
 /* The summary table; a shard's (indexed) starts with its manifest line
  * and ends each row with its index in the whole list, for mech merge. */
-static void print_table(const batch *b, const manifest *mf, FILE *out)
+static void put_head(const manifest *mf, FILE *out)
 {
     if (mf)
         manifest_write(mf, out);
     fprintf(out, "%-28s %-6s %7s %12s %12s %-7s%s\n", "file", "status", "steps", "worst res m",
             "us/step", "golden", mf ? " index" : "");
+}
+
+static void put_row(const job *jb, const manifest *mf, FILE *out)
+{
     static const char *const words[] = {"ok", "FAILED", "INPUT", "IO"};
-    for (int i = 0; i < b->njobs; i++) {
-        const job *jb = &b->jobs[i];
-        fprintf(out, "%-28s %-6s %7d %12.3g %12.3g %s", jb->name, jb->kept ? "kept"
-                : jb->code >= 0 && jb->code <= 3 ? words[jb->code] : "?", jb->steps,
-                jb->worst_residual, jb->us_per_step, jb->golden ? jb->golden : "-");
-        if (mf)
-            fprintf(out, " %ld", jb->index);
-        fputc('\n', out);
+    fprintf(out, "%-28.*s %-6s %7d %12.3g %12.3g %s", jb->name_len, jb->name, jb->kept ? "kept"
+            : jb->code >= 0 && jb->code <= 3 ? words[jb->code] : "?", jb->steps,
+            jb->worst_residual, jb->us_per_step, jb->golden ? jb->golden : "-");
+    if (mf)
+        fprintf(out, " %ld", jb->index);
+    fputc('\n', out);
+}
+
+static int emit_table(FILE *out, const void *ctx)
+{
+    const batch *b = ctx;
+    put_head(b->mf, out);
+    for (int i = 0; i < b->njobs; i++)
+        put_row(&b->jobs[i], b->mf, out);
+    return ferror(out) ? -1 : 0;
+}
+
+/* -o TABLE, a regular file (or a new name): TABLE.partial created with the
+ * head, for the rows as they finish. An old one (a killed run's) is
+ * replaced: the table is made again from this run. -1, or the exit status. */
+static int open_partial(batch *b, const char *table)
+{
+    struct stat st;
+    if (!table || !strcmp(table, "-") || (stat(table, &st) == 0 && !S_ISREG(st.st_mode)))
+        return -1;  /* standard output, a device, a FIFO: the table at the end only */
+    size_t n = strlen(table) + 9;
+    if (!(b->partial_path = malloc(n)))
+        return fprintf(stderr, "mech batch: out of memory\n"), MECH_EXIT_IO;
+    snprintf(b->partial_path, n, "%s.partial", table);
+    if (lstat(b->partial_path, &st) == 0 && !S_ISREG(st.st_mode)) {
+        fprintf(stderr, "mech batch: %s exists and is not a regular file; not replacing it "
+                "(remove it or write another -o)\n", b->partial_path);
+        return MECH_EXIT_INPUT;
     }
+    if (lstat(b->partial_path, &st) == 0)
+        unlink(b->partial_path);
+    int fd = open(b->partial_path, O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
+    if (fd >= 0 && !(b->partial = fdopen(fd, "w")))
+        close(fd);
+    if (b->partial) {
+        put_head(b->mf, b->partial);
+        fflush(b->partial);
+    }
+    if (!b->partial || ferror(b->partial)) {
+        fprintf(stderr, "mech batch: cannot create %s: %s\n", b->partial_path, strerror(errno));
+        return MECH_EXIT_IO;
+    }
+    return -1;
+}
+
+/* The table written whole to TABLE (or standard output), then TABLE.partial
+ * removed; MECH_EXIT_OK or MECH_EXIT_IO. */
+static int write_table(batch *b, const char *table)
+{
+    int partial_bad = b->partial && (fflush(b->partial) != 0 || ferror(b->partial));
+    if (partial_bad)
+        fprintf(stderr, "mech batch: cannot write %s (the rows as they finished)\n",
+                b->partial_path);
+    mech_diag d;
+    mech_diag_init(&d);
+    int rc = write_file_whole(table ? table : "-", emit_table, b, &d);
+    mech_diag_print(&d, stderr);
+    mech_diag_free(&d);
+    if (rc == MECH_OK && b->partial_path)
+        unlink(b->partial_path);
+    return rc == MECH_OK && !partial_bad ? MECH_EXIT_OK : MECH_EXIT_IO;
+}
+
+/* A file solved; its row (to TABLE.partial) and its messages out at once,
+ * so memory holds no messages of finished files. */
+static void batch_job(void *ctx, int i)
+{
+    batch *b = ctx;
+    job *jb = &b->jobs[i];
+    run_job(b, jb);
+    pthread_mutex_lock(&b->lock);
+    if (b->partial) {
+        put_row(jb, b->mf, b->partial);
+        fflush(b->partial);  /* on disk now: a killed run keeps this row */
+    }
+    if (!b->quiet && jb->messages && jb->msize)
+        fputs(jb->messages, stderr);
+    pthread_mutex_unlock(&b->lock);
+    free(jb->messages);
+    jb->messages = NULL;
+    cmd_progress_update(&b->progress, atomic_fetch_add(&b->done, 1) + 1, b->njobs);
 }
 
 /* The command line of mech batch: the options into b and *opt, the file
@@ -318,6 +415,7 @@ typedef struct batch_opts {
     int nthreads, quiet, shard_k, shard_m;
     int sharded, unsolvable_ok;
     const char *files_from;   /* --files-from LIST */
+    const char *table;        /* -o TABLE */
 } batch_opts;
 
 static int batch_option(batch *b, batch_opts *bo, const char *a, const char *v)
@@ -343,6 +441,8 @@ static int batch_option(batch *b, batch_opts *bo, const char *a, const char *v)
             return cmd_usage_error("batch", "--shard needs K/M with 0 <= K < M, not '%s'", v);
     } else if (!strcmp(a, "--files-from")) {
         bo->files_from = v;
+    } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
+        bo->table = v;
     }
     return -1;
 }
@@ -350,7 +450,7 @@ static int batch_option(batch *b, batch_opts *bo, const char *a, const char *v)
 static int takes_value(const char *a)
 {
     static const char *const opts[] = {"-j", "--jobs", "--out-dir", "--golden", "--shard",
-                                       "--rtol", "--atol", "--files-from"};
+                                       "--rtol", "--atol", "--files-from", "-o", "--output"};
     for (size_t k = 0; k < sizeof opts / sizeof opts[0]; k++)
         if (!strcmp(a, opts[k]))
             return 1;
@@ -436,7 +536,27 @@ static int read_list(const char *list, char **text, const char ***files, int *nf
     return -1;
 }
 
-/* The manifest of a shard's table: the whole list (its paths, in order)
+/* The input hash of a shard's table: every file of the whole list, in
+ * order, its path and the hash of its bytes, so a file edited between two
+ * shards makes them two runs to mech merge. An unreadable file is hashed as
+ * such (its row says IO). */
+static uint64_t hash_inputs(const char **files, int nfiles)
+{
+    uint64_t h = MANIFEST_HASH0;
+    for (int i = 0; i < nfiles; i++) {
+        uint64_t content = MANIFEST_HASH0;
+        unsigned char bytes[8];
+        if (manifest_hash_file(&content, files[i]) != 0)
+            content = 0;  /* no file hashes to 0 in practice; "unreadable" */
+        for (int k = 0; k < 8; k++)
+            bytes[k] = (unsigned char)(content >> (8 * k));
+        h = manifest_hash(h, files[i], strlen(files[i]) + 1);
+        h = manifest_hash(h, bytes, sizeof bytes);
+    }
+    return h;
+}
+
+/* The manifest of a shard's table: the whole list (its paths and contents)
  * as the input hash, the options that change a row as the arguments. */
 static manifest *make_manifest(const batch *b, const batch_opts *bo, int argc, char **argv,
                                const char **files, int nfiles)
@@ -450,15 +570,15 @@ static manifest *make_manifest(const batch *b, const batch_opts *bo, int argc, c
     mf->shard_m = bo->shard_m;
     mf->rows = b->njobs;
     mf->total = nfiles;
-    mf->input = mf->grid = MANIFEST_HASH0;
-    for (int i = 0; i < nfiles; i++)
-        mf->input = manifest_hash(mf->input, files[i], strlen(files[i]) + 1);
+    mf->grid = MANIFEST_HASH0;
+    mf->input = hash_inputs(files, nfiles);
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         int leaves_rows_alone = !strcmp(a, "-j") || !strcmp(a, "--jobs") ||
                                 !strcmp(a, "--shard") || !strcmp(a, "--files-from") ||
                                 !strcmp(a, "-q") || !strcmp(a, "--quiet") ||
-                                !strcmp(a, "--skip-existing") || !strcmp(a, "--unsolvable-ok");
+                                !strcmp(a, "--skip-existing") || !strcmp(a, "--unsolvable-ok") ||
+                                !strcmp(a, "-o") || !strcmp(a, "--output");
         int option = a[0] == '-' && a[1], takes = takes_value(a) && i + 1 < argc;
         if (option && !leaves_rows_alone) {  /* a file is in the list's hash */
             manifest_add_arg(mf, a);
@@ -482,7 +602,7 @@ static int make_jobs(batch *b, const batch_opts *bo, const char **files, int nfi
         job *jb = &b->jobs[b->njobs++];
         jb->index = i;
         jb->path = files[i];
-        base_name(files[i], jb->name, sizeof jb->name);
+        base_name(files[i], &jb->name, &jb->name_len);
     }
     int code = prepare_outputs(b), kept = 0;
     for (int i = 0; i < b->njobs; i++)
@@ -496,18 +616,13 @@ static int make_jobs(batch *b, const batch_opts *bo, const char **files, int nfi
     return code;
 }
 
-/* Each job's messages, then the summary table; the worst outcome: a failed
- * solve or differing golden (1) outranks invalid input (2) and unreadable
- * files (3), then success. */
-static int report_jobs(batch *b, const batch_opts *bo, const manifest *mf)
+/* The summary table; the worst outcome: a failed solve or differing golden
+ * (1) outranks invalid input (2) and unreadable files (3), then success. */
+static int report_jobs(batch *b, const batch_opts *bo)
 {
-    int quiet = bo->quiet;
     int code = MECH_EXIT_OK;
     for (int i = 0; i < b->njobs; i++) {
         job *jb = &b->jobs[i];
-        if (!quiet && jb->messages && jb->msize)
-            fputs(jb->messages, stderr);
-        free(jb->messages);
         free(jb->csv);
         free(jb->golden_path);
         int unsolved = jb->code == MECH_EXIT_SOLVE && !strcmp(jb->golden ? jb->golden : "-", "-");
@@ -516,8 +631,8 @@ static int report_jobs(batch *b, const batch_opts *bo, const manifest *mf)
         if (jb->code == MECH_EXIT_SOLVE || (code == MECH_EXIT_OK && jb->code != MECH_EXIT_OK))
             code = jb->code;
     }
-    print_table(b, mf, stdout);
-    return code;
+    int written = write_table(b, bo->table);
+    return written != MECH_EXIT_OK && code == MECH_EXIT_OK ? written : code;
 }
 
 int cmd_batch(int argc, char **argv)
@@ -526,7 +641,8 @@ int cmd_batch(int argc, char **argv)
     memset(&b, 0, sizeof b);
     compare_options_default(&b.cmp);
     b.cmp.table = 0;
-    batch_opts bo = {cmd_default_jobs(), 0, 0, 1, 0, 0, NULL};
+    batch_opts bo = {cmd_default_jobs(), 0, 0, 1, 0, 0, NULL, NULL};
+    pthread_mutex_init(&b.lock, NULL);
     const char **files = calloc((size_t)argc + 1, sizeof *files);
     char *list = NULL;
     manifest *mf = NULL;
@@ -537,15 +653,27 @@ int cmd_batch(int argc, char **argv)
     if (code < 0 && bo.files_from)
         code = read_list(bo.files_from, &list, &files, &nfiles);
     if (code < 0)
+        code = cmd_refuse_input("batch", bo.table, files, nfiles);
+    if (code < 0 && bo.files_from)
+        code = cmd_refuse_input("batch", bo.table, &bo.files_from, 1);
+    if (code < 0)
         code = make_jobs(&b, &bo, files, nfiles);
     if (code < 0 && bo.sharded && !(mf = make_manifest(&b, &bo, argc, argv, files, nfiles)))
         code = (fprintf(stderr, "mech batch: out of memory\n"), MECH_EXIT_IO);
+    b.mf = mf;
+    b.quiet = bo.quiet;
+    if (code < 0)
+        code = open_partial(&b, bo.table);
     if (code < 0) {
         cmd_progress_init(&b.progress, "batch", "files", bo.quiet);
         cmd_run_parallel(b.njobs, bo.nthreads, batch_job, &b);
         cmd_progress_done(&b.progress);
-        code = report_jobs(&b, &bo, mf);
+        code = report_jobs(&b, &bo);
     }
+    if (b.partial)
+        fclose(b.partial);
+    free(b.partial_path);
+    pthread_mutex_destroy(&b.lock);
     free(mf);
     free(b.jobs);
     free(files);

@@ -19,14 +19,16 @@ const char cmd_merge_help[] =
     "usage: mech merge -o OUT SHARD...\n"
     "\n"
     "Join the outputs of the shards of one run (mech sweep --shard K/M -o CSV, or\n"
-    "mech batch --shard K/M > SUMMARY) into OUT, rows in index order. Each shard\n"
+    "mech batch --shard K/M -o TABLE) into OUT, rows in index order. Each shard\n"
     "starts with a '# mech-manifest' line; merge checks that all come from the same\n"
     "run (version, arguments, input file hash, grid hash), that every shard K/M of\n"
     "it is given exactly once and is complete, that every index 0..N-1 appears\n"
     "exactly once, and that the headers agree. Runs numbered with --index-offset\n"
     "merge into one index space. For batch summaries, every file solved must have\n"
     "its CSV (with that many rows) in the run's --out-dir. Anything wrong is an\n"
-    "error naming the shard (\"shard 2/4 missing\"), and nothing is written.\n"
+    "error naming the shard (\"shard 2/4 missing\", \"shard 2/4 unfinished: 37 of\n"
+    "500 rows\": fewer rows than its manifest, or a SHARD not there whose\n"
+    "SHARD.partial is, left by a killed run), and nothing is written.\n"
     "OUT has no manifest: it equals the output of the same run without --shard.\n"
     "\n"
     "options:\n"
@@ -37,7 +39,8 @@ const char cmd_merge_help[] =
     "messages say which), 3 a file cannot be read or written\n";
 
 typedef struct shard {
-    const char *path;
+    const char *path;   /* as given; or SHARD.partial, read when SHARD is not there */
+    char *partial;      /* SHARD.partial (owned) when that was read */
     char *buf;          /* the whole file */
     manifest man;
     char *header;       /* the header line, in buf */
@@ -111,11 +114,32 @@ static const char *name(const shard *s, char *buf, size_t size)
     return buf;
 }
 
+/* The file of shard s: SHARD, or when it is not there but SHARD.partial
+ * is (a run killed before its end), that one, so the shard is named as
+ * unfinished rather than unreadable. */
+static char *read_file_or_partial(shard *s)
+{
+    char *buf = slurp(s->path);
+    if (buf || errno != ENOENT)
+        return buf;
+    size_t n = strlen(s->path) + 9;
+    if (!(s->partial = malloc(n)))
+        return NULL;
+    snprintf(s->partial, n, "%s.partial", s->path);
+    if ((buf = slurp(s->partial))) {
+        s->path = s->partial;
+        return buf;
+    }
+    errno = ENOENT;  /* the message is about SHARD, which is not there */
+    return NULL;
+}
+
 /* Reads shard s: its manifest, header and rows (counted; NUL-terminated
- * lines). 0, or -1 with the problem printed (3 when unreadable). */
+ * lines; a last line without its end, cut by a kill, is not a row). 0, or
+ * -1 with the problem printed (3 when unreadable). */
 static int read_shard(merge *g, shard *s)
 {
-    if (!(s->buf = slurp(s->path))) {
+    if (!(s->buf = read_file_or_partial(s))) {
         fprintf(stderr, "mech merge: cannot read %s: %s\n", s->path, strerror(errno));
         return MECH_EXIT_IO;
     }
@@ -135,8 +159,8 @@ static int read_shard(merge *g, shard *s)
     *nl = '\0';
     for (char *p = nl + 1; *p; p = nl + 1) {
         if (!(nl = strchr(p, '\n'))) {
-            complain(g, "%s: the last row has no line end (cut off)", s->path);
-            return -1;
+            *p = '\0';  /* cut off: the row count says the shard is unfinished */
+            break;
         }
         *nl = '\0';
         s->nrows++;
@@ -201,9 +225,12 @@ static void place_rows(merge *g)
     for (int i = 0; i < g->n; i++) {
         const shard *s = &g->shards[i];
         long want = manifest_shard_rows(s->man.total, s->man.shard_k, s->man.shard_m);
-        if (s->nrows != s->man.rows || s->nrows != want)
-            complain(g, "%s: %ld rows, its manifest says %ld (cut off or edited)",
-                     name(s, a, sizeof a), s->nrows, want);
+        if (s->nrows < want || s->partial)  /* a run killed, or its file cut */
+            complain(g, "shard %d/%d unfinished: %ld of %ld rows (%s)", s->man.shard_k,
+                     s->man.shard_m, s->nrows, want, s->path);
+        else if (s->nrows != s->man.rows || s->nrows != want)
+            complain(g, "%s: %ld rows, its manifest says %ld (edited)", name(s, a, sizeof a),
+                     s->nrows, want);
         const char *p = s->header + strlen(s->header) + 1;
         int bad = 0;  /* the first few bad rows of a shard are named */
         for (long r = 0; r < s->nrows; r++, p += strlen(p) + 1) {
@@ -390,8 +417,10 @@ int cmd_merge(int argc, char **argv)
         code = cmd_refuse_input("merge", out, &g.shards[i].path, 1);
     if (code < 0)
         code = merge_shards(&g, out);
-    for (int i = 0; i < g.n; i++)
+    for (int i = 0; i < g.n; i++) {
         free(g.shards[i].buf);
+        free(g.shards[i].partial);
+    }
     free(g.shards);
     free(g.rows);
     return code;

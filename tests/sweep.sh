@@ -81,7 +81,14 @@ merge_refused() {  # LABEL PATTERN SHARD...
 merge_refused "a shard missing" '^mech merge: shard 1/3 missing$' "$tmp/shard.0.csv" "$tmp/shard.2.csv"
 merge_refused "a shard twice" '^mech merge: shard 2/3 given twice' "$tmp"/shard.*.csv "$tmp/shard.2.csv"
 head -n 5 "$tmp/shard.1.csv" >"$tmp/cut.csv"
-merge_refused "a shard cut off" 'shard 1/3 (.*cut.csv): 3 rows, its manifest says 10' "$tmp/shard.0.csv" "$tmp/cut.csv" "$tmp/shard.2.csv"
+merge_refused "a shard cut off" '^mech merge: shard 1/3 unfinished: 3 of 10 rows (.*cut.csv)$' "$tmp/shard.0.csv" "$tmp/cut.csv" "$tmp/shard.2.csv"
+printf '1,0.05' >>"$tmp/cut.csv"  # a row cut by a kill is no row
+merge_refused "a shard cut in a row" 'shard 1/3 unfinished: 3 of 10 rows' "$tmp/shard.0.csv" "$tmp/cut.csv" "$tmp/shard.2.csv"
+mv "$tmp/cut.csv" "$tmp/gone.csv.partial"  # only the partial file of a killed run
+merge_refused "only OUT.partial" 'shard 1/3 unfinished: 3 of 10 rows (.*gone.csv.partial)$' "$tmp/shard.0.csv" "$tmp/gone.csv" "$tmp/shard.2.csv"
+sed '$d' "$tmp/shard.1.csv" >"$tmp/short.csv"; sed -n '$p' "$tmp/shard.1.csv" >>"$tmp/short.csv"
+sed -n '$p' "$tmp/shard.1.csv" >>"$tmp/short.csv"
+merge_refused "a shard with a row too many" 'shard 1/3 (.*short.csv): 11 rows, its manifest says 10 (edited)' "$tmp/shard.0.csv" "$tmp/short.csv" "$tmp/shard.2.csv"
 "$MECH" sweep $file --vary l1=50mm:64mm:6 --vary l2=420mm:440mm:6 $metrics -j 1 --shard 1/3 -o "$tmp/grid.csv" 2>/dev/null
 merge_refused "another grid" 'shard 1/3 (.*grid.csv) is not from the same run as shard 0/3 (.*): its grid differs' "$tmp/shard.0.csv" "$tmp/grid.csv" "$tmp/shard.2.csv"
 "$MECH" sweep $file $sub $metrics -j 1 --shard 1/4 -o "$tmp/m4.csv" 2>/dev/null
@@ -194,6 +201,90 @@ if run "batch --skip-existing" 0 "$MECH" batch -j 1 --shard 0/3 --out-dir "$tmp/
     [ "$(cat "$tmp/b3/jansen.csv")" = marker ] && pass || fail "batch --skip-existing: the existing CSV was rewritten"
 fi
 run "batch --skip-existing without --out-dir" 2 "$MECH" batch --skip-existing mechanisms/fourbar.yaml && pass
+
+# batch -o TABLE: the same table as on standard output, written whole;
+# no TABLE.partial left; an input as TABLE refused
+if run "batch -o" 0 "$MECH" batch -q -j 1 --files-from "$tmp/list" -o "$tmp/osum.txt"; then
+    [ "$(untimed "$tmp/osum.txt")" = "$(untimed "$tmp/sum.txt")" ] && pass || fail "batch -o: another table than on standard output"
+    [ ! -s "$tmp/out" ] && pass || fail "batch -o: the table also on standard output"
+    [ ! -e "$tmp/osum.txt.partial" ] && pass || fail "batch -o: TABLE.partial stays"
+fi
+cp "$tmp/list" "$tmp/list.copy"
+run "batch -o the list" 2 "$MECH" batch -q --files-from "$tmp/list.copy" -o "$tmp/list.copy" &&
+    has_line "$tmp/err" 'the output .*list.copy is the input file' "batch -o the list: message"
+cmp -s "$tmp/list" "$tmp/list.copy" && pass || fail "batch -o the list: the list was overwritten"
+
+# a killed batch shard: its rows so far are in TABLE.partial; mech merge
+# names it (missing when its TABLE is not given, unfinished when it is);
+# rerun with --skip-existing it solves only the rest, and the merge is whole
+mkdir "$tmp/many"
+for i in $(seq 100 299); do cp $file "$tmp/many/c$i.yaml"; done
+ls "$tmp"/many/*.yaml >"$tmp/mlist"
+# (exec: the pid of the background job is mech's, which the kill must reach)
+kbatch() { exec "$MECH" batch -j 1 -q --shard "$1"/2 --files-from "$tmp/mlist" --out-dir "$tmp/mcsv" \
+    --skip-existing --unsolvable-ok -o "$tmp/msum.$1.txt"; }
+(kbatch 0 2>/dev/null)
+(kbatch 1 2>/dev/null) &
+pid=$!
+for i in $(seq 600); do  # until 3 rows are on disk (up to 30 s)
+    [ -f "$tmp/msum.1.txt.partial" ] && [ "$(wc -l <"$tmp/msum.1.txt.partial")" -ge 5 ] && break
+    sleep 0.05
+done
+kill -KILL $pid 2>/dev/null
+wait $pid 2>/dev/null
+if [ ! -e "$tmp/msum.1.txt" ]; then
+    kept=$(($(wc -l <"$tmp/msum.1.txt.partial") - 2))
+    merge_refused "a killed batch shard, not given" '^mech merge: shard 1/2 missing$' "$tmp"/msum.*.txt
+    merge_refused "a killed batch shard, given" "^mech merge: shard 1/2 unfinished: $kept of 100 rows (.*msum.1.txt.partial)\$" \
+        "$tmp/msum.0.txt" "$tmp/msum.1.txt"
+    ncsv=$(ls "$tmp/mcsv" | wc -l)
+    [ "$ncsv" -ge $((100 + kept)) ] && [ "$ncsv" -lt 200 ] && pass || fail "a killed batch shard: $ncsv CSVs, $kept rows"
+    (kbatch 1 2>"$tmp/err") || fail "the killed batch shard rerun: exit $? ($(head -n 1 "$tmp/err"))"
+    if [ -f "$tmp/msum.1.txt" ]; then
+        [ "$(grep -c ' kept ' "$tmp/msum.1.txt")" -ge "$kept" ] && pass || fail "the rerun shard solved again what was there"
+        [ ! -e "$tmp/msum.1.txt.partial" ] && pass || fail "the rerun shard left its TABLE.partial"
+        "$MECH" batch -q -j 1 --files-from "$tmp/mlist" -o "$tmp/mone.txt" 2>/dev/null
+        if run "merge after the rerun" 0 "$MECH" merge -o "$tmp/mmerged.txt" "$tmp"/msum.*.txt; then
+            # file and status (a kept file's row has no steps nor times)
+            [ "$(awk '{ print $1, $2 }' "$tmp/mmerged.txt" | sed 's/ kept$/ ok/')" = "$(awk '{ print $1, $2 }' "$tmp/mone.txt")" ] && pass ||
+                fail "merge after the rerun: another table than one batch's"
+        fi
+    fi
+else
+    echo "sweep.sh: the batch shard finished before it was killed, the kill test skipped"
+fi
+
+# a TABLE.partial that is a link is not written through
+ln -s "$tmp/list" "$tmp/linked.txt.partial"
+run "batch -o, TABLE.partial a link" 2 "$MECH" batch -q -j 1 mechanisms/fourbar.yaml -o "$tmp/linked.txt" &&
+    has_line "$tmp/err" 'linked.txt.partial exists and is not a regular file' "batch -o, TABLE.partial a link: message"
+cmp -s "$tmp/list" "$tmp/list.copy" && [ ! -e "$tmp/linked.txt" ] && pass || fail "batch -o, TABLE.partial a link: written"
+
+# a file edited between two shards: the input hash covers the contents
+cp "$tmp/many/c100.yaml" "$tmp/c100.orig"
+echo "# edited" >>"$tmp/many/c100.yaml"
+"$MECH" batch -q -j 1 --shard 1/2 --files-from "$tmp/mlist" --out-dir "$tmp/mcsv" --skip-existing -o "$tmp/edited.txt" 2>/dev/null
+merge_refused "a batch file edited between shards" 'shard 1/2 (.*edited.txt) is not from the same run as shard 0/2 .*: its input file (its contents) differs' \
+    "$tmp/msum.0.txt" "$tmp/edited.txt"
+cp "$tmp/c100.orig" "$tmp/many/c100.yaml"
+"$MECH" batch -q -j 1 --shard 1/2 --files-from "$tmp/mlist" -o "$tmp/same.txt" 2>/dev/null
+input_of() { head -n 1 "$1" | grep -o ' input=[0-9a-f]*'; }
+[ -n "$(input_of "$tmp/same.txt")" ] && [ "$(input_of "$tmp/same.txt")" = "$(input_of "$tmp/msum.0.txt")" ] && pass ||
+    fail "batch manifest: the same files, another input hash"
+
+# messages as each file finishes: the first file's (an invalid file) are
+# on standard error while the later files are still being solved
+sed 's/^links:/links: [/' $file >"$tmp/a-bad.yaml"
+first_message() {  # reads the batch's stderr: at its first line, the rows on disk
+    IFS= read -r line
+    rows=$(($(wc -l <"$tmp/stream.txt.partial" 2>/dev/null || echo 1) - 1))
+    echo "$rows ${line%%:*}" >"$tmp/stream.seen"
+    cat >/dev/null
+}
+{ "$MECH" batch -j 1 --unsolvable-ok "$tmp/a-bad.yaml" "$tmp"/many/*.yaml -o "$tmp/stream.txt" 2>&1 >/dev/null; } | first_message
+read -r rows who <"$tmp/stream.seen"
+[ "$who" = "$tmp/a-bad.yaml" ] && pass || fail "batch messages: the first line is not the bad file's: $who"
+[ "$rows" -ge 0 ] && [ "$rows" -lt 100 ] && pass || fail "batch messages: printed only after $rows of 201 files were done"
 
 # batch --unsolvable-ok: a mechanism that cannot be solved is a result
 run "batch, an unsolvable file" 1 "$MECH" batch -q mechanisms/fourbar.yaml tests/solve/non-grashof.yaml && pass

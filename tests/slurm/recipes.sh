@@ -119,6 +119,9 @@ if run "the Slurm batch recipe" 0 sh "$tmp/batch.sh"; then
     build/mech batch -q --files-from out/files.txt >"$tmp/one.txt" 2>/dev/null
     [ "$(untimed out/summary.txt)" = "$(untimed "$tmp/one.txt")" ] && pass ||
         fail "the merged batch table differs from one batch's"
+    # each shard wrote its table whole with -o (rows first to TABLE.partial)
+    [ "$(ls out/summary.*.txt | wc -l)" -eq 4 ] && [ -z "$(ls out/summary.*.partial 2>/dev/null)" ] && pass ||
+        fail "the batch recipe: tables $(ls out/summary.* | tr '\n' ' ')"
 fi
 cd "$repo" || exit 2
 summary
