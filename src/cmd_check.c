@@ -32,6 +32,34 @@ static const char *drive_text(const mech_model *m, char *buf, size_t size)
     return buf;
 }
 
+/* One line per spring or damper: where it acts and its coefficients (SI). */
+static void print_springs(const mech_model *m)
+{
+    if (m->nsprings > 0)
+        printf("  springs    %d\n", m->nsprings);
+    for (int i = 0; i < m->nsprings; i++) {
+        const mech_spring *s = &m->springs[i];
+        int tor = s->kind == MECH_SPRING_TORSION;
+        if (tor)
+            printf("    %s: torsional at %s (%s, %s)", s->name, m->joints[s->joint].name,
+                   m->links[s->link[0]].name, m->links[s->link[1]].name);
+        else
+            printf("    %s: linear %s-%s (%s, %s)", s->name,
+                   m->links[s->link[0]].points[s->point[0]].name,
+                   m->links[s->link[1]].points[s->point[1]].name, m->links[s->link[0]].name,
+                   m->links[s->link[1]].name);
+        if (s->stiffness > 0)
+            printf(", stiffness %g %s, free %s %g %s", s->stiffness, tor ? "N*m/rad" : "N/m",
+                   tor ? "angle" : "length", tor ? s->free * 57.29577951308232 : s->free,
+                   tor ? "deg" : "m");
+        if (s->preload != 0)
+            printf(", preload %g %s", s->preload, tor ? "N*m" : "N");
+        if (s->damping > 0)
+            printf(", damping %g %s", s->damping, tor ? "N*m*s/rad" : "N*s/m");
+        printf("\n");
+    }
+}
+
 static void print_summary(const mech_model *m, const mech_summary *s)
 {
     char buf[256];
@@ -49,6 +77,7 @@ static void print_summary(const mech_model *m, const mech_summary *s)
     printf("  driver     %s\n", drive_text(m, buf, sizeof buf));
     printf("  outputs    %d points, %d links, %d sliders%s\n", m->outputs.npoints,
            m->outputs.nlinks, m->outputs.nsliders, m->outputs.forces ? ", forces" : "");
+    print_springs(m);
 }
 
 int cmd_check(int argc, char **argv)
