@@ -31,6 +31,9 @@ for f in mechanisms/*.yaml tests/hard/redundant-parallelogram.yaml; do
 done
 check "mech batch" batch -j 2 -q mechanisms/*.yaml tests/solve/*.yaml
 check "mech sweep" sweep mechanisms/slider-crank.yaml --list l=45mm,140mm --metric range:x_B.s -j 2
+check "mech sweep flywheel" sweep mechanisms/spring-slider-crank.yaml --list r=30mm,40mm --forces --metric flywheel:0.02 -j 2
+check "mech solve --speed-fluctuation" solve mechanisms/spring-slider-crank.yaml --stats --speed-fluctuation 0.02 -o "$tmp/x.csv"
+check "mech check bad springs" check tests/bad/63-springs.yaml
 check "mech plot" plot mechanisms/fourbar.yaml --out "$tmp/plots"
 check "mech animate" animate mechanisms/fourbar.yaml -o "$tmp/a.svg"
 echo "valgrind: $passed passed, $failed failed"
