@@ -221,9 +221,10 @@ typedef struct mech_model {
     int nloops;
     mech_load *loads;     /* [nloads] */
     int nloads;
-    mech_spring *springs; /* [nsprings] springs and dampers */
-    int nsprings;
     mech_outputs outputs;
+    mech_spring *springs; /* [nsprings] springs and dampers (last: the fields before
+                             keep their places) */
+    int nsprings;
 } mech_model;
 
 /* Read and validate a mechanism file. On success *out is the model and the
