@@ -77,6 +77,13 @@ static void print_summary(const mech_model *m, const mech_summary *s)
     printf("  driver     %s\n", drive_text(m, buf, sizeof buf));
     printf("  outputs    %d points, %d links, %d sliders%s\n", m->outputs.npoints,
            m->outputs.nlinks, m->outputs.nsliders, m->outputs.forces ? ", forces" : "");
+    if (m->nloads > 0) {
+        int count[3] = {0, 0, 0};
+        for (int i = 0; i < m->nloads; i++)
+            count[m->loads[i].kind]++;
+        printf("  loads      %d (%d force%s, %d torque%s, %d distributed)\n", m->nloads, count[0],
+               count[0] == 1 ? "" : "s", count[1], count[1] == 1 ? "" : "s", count[2]);
+    }
     print_springs(m);
 }
 

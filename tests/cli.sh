@@ -293,6 +293,9 @@ if run "mech check springs" 0 "$MECH" check $ssc; then
     has_line "$tmp/out" 'return: linear S-B (ground, piston), stiffness 2000 N/m, free length 0.25 m' "check: a spring listed"
     has_line "$tmp/out" 'pivot: torsional at O (crank, ground)' "check: a torsional spring listed"
 fi
+if run "mech check loads" 0 "$MECH" check mechanisms/conveyor.yaml; then
+    has_line "$tmp/out" '^  loads      [1-9][0-9]* (' "check: loads counted"
+fi
 if run "mech solve springs --stats" 0 "$MECH" solve $ssc --stats -o "$tmp/ss.csv"; then
     has_line "$tmp/ss.csv" 'return\.length \[m\],return\.rate \[m/s\],return\.force \[N\],damper\.length \[m\],damper\.rate \[m/s\],damper\.force \[N\],pivot\.angle \[rad\],pivot\.rate \[rad/s\],pivot\.torque \[N\*m\]$' "spring columns"
     has_line "$tmp/err" 'flywheel           mean driver torque .* N\*m over 360 deg (one turn)' "--stats flywheel"
