@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "commands.h"
+#include "springs.h"
 
 const char cmd_check_help[] =
     "usage: mech check [-q] FILE...\n"
@@ -32,31 +33,14 @@ static const char *drive_text(const mech_model *m, char *buf, size_t size)
     return buf;
 }
 
-/* One line per spring or damper: where it acts and its coefficients (SI). */
+/* One line per spring or damper (springs_describe: mech report shows the
+ * same lines). */
 static void print_springs(const mech_model *m)
 {
-    if (m->nsprings > 0)
-        printf("  springs    %d\n", m->nsprings);
+    char buf[512];
     for (int i = 0; i < m->nsprings; i++) {
-        const mech_spring *s = &m->springs[i];
-        int tor = s->kind == MECH_SPRING_TORSION;
-        if (tor)
-            printf("    %s: torsional at %s (%s, %s)", s->name, m->joints[s->joint].name,
-                   m->links[s->link[0]].name, m->links[s->link[1]].name);
-        else
-            printf("    %s: linear %s-%s (%s, %s)", s->name,
-                   m->links[s->link[0]].points[s->point[0]].name,
-                   m->links[s->link[1]].points[s->point[1]].name, m->links[s->link[0]].name,
-                   m->links[s->link[1]].name);
-        if (s->stiffness > 0)
-            printf(", stiffness %g %s, free %s %g %s", s->stiffness, tor ? "N*m/rad" : "N/m",
-                   tor ? "angle" : "length", tor ? s->free * 57.29577951308232 : s->free,
-                   tor ? "deg" : "m");
-        if (s->preload != 0)
-            printf(", preload %g %s", s->preload, tor ? "N*m" : "N");
-        if (s->damping > 0)
-            printf(", damping %g %s", s->damping, tor ? "N*m*s/rad" : "N*s/m");
-        printf("\n");
+        springs_describe(m, i, buf, sizeof buf);
+        printf("  spring     %s\n", buf);
     }
 }
 
@@ -77,13 +61,6 @@ static void print_summary(const mech_model *m, const mech_summary *s)
     printf("  driver     %s\n", drive_text(m, buf, sizeof buf));
     printf("  outputs    %d points, %d links, %d sliders%s\n", m->outputs.npoints,
            m->outputs.nlinks, m->outputs.nsliders, m->outputs.forces ? ", forces" : "");
-    if (m->nloads > 0) {
-        int count[3] = {0, 0, 0};
-        for (int i = 0; i < m->nloads; i++)
-            count[m->loads[i].kind]++;
-        printf("  loads      %d (%d force%s, %d torque%s, %d distributed)\n", m->nloads, count[0],
-               count[0] == 1 ? "" : "s", count[1], count[1] == 1 ? "" : "s", count[2]);
-    }
     print_springs(m);
 }
 

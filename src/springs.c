@@ -9,6 +9,7 @@
  *   torque T = preload + k (phi - phi0) + c dphi/dt; -T on a, +T on b.
  * Either way the power delivered to the links is -F dL/dt (-T dphi/dt). */
 #include <math.h>
+#include <stdio.h>
 
 #include "springs.h"
 
@@ -95,4 +96,29 @@ double springs_power(const mech_model *m, const solver *sv, double *scale)
                   fabs(st.force) * (s->kind == MECH_SPRING_TORSION ? turning : linear);
     }
     return total;
+}
+
+void springs_describe(const mech_model *m, int i, char *buf, size_t size)
+{
+    const mech_spring *s = &m->springs[i];
+    int tor = s->kind == MECH_SPRING_TORSION;
+    size_t at;
+    if (tor)
+        at = (size_t)snprintf(buf, size, "%s: torsional at %s (%s, %s)", s->name,
+                              m->joints[s->joint].name, m->links[s->link[0]].name,
+                              m->links[s->link[1]].name);
+    else
+        at = (size_t)snprintf(buf, size, "%s: linear %s-%s (%s, %s)", s->name,
+                              m->links[s->link[0]].points[s->point[0]].name,
+                              m->links[s->link[1]].points[s->point[1]].name,
+                              m->links[s->link[0]].name, m->links[s->link[1]].name);
+    if (at < size && s->stiffness > 0)
+        at += (size_t)snprintf(buf + at, size - at, ", stiffness %g %s, free %s %g %s",
+                               s->stiffness, tor ? "N*m/rad" : "N/m", tor ? "angle" : "length",
+                               tor ? s->free * 180.0 / PI : s->free, tor ? "deg" : "m");
+    if (at < size && s->preload != 0)
+        at += (size_t)snprintf(buf + at, size - at, ", preload %g %s", s->preload,
+                               tor ? "N*m" : "N");
+    if (at < size && s->damping > 0)
+        snprintf(buf + at, size - at, ", damping %g %s", s->damping, tor ? "N*m*s/rad" : "N*s/m");
 }

@@ -28,4 +28,8 @@ void springs_add_loads(const mech_model *m, const solver *sv, const double *g, d
  * the absolute values. */
 double springs_power(const mech_model *m, const solver *sv, double *scale);
 
+/* Spring i in words, as mech check and mech report show it: its name,
+ * where it acts and its coefficients (SI; angles in deg). */
+void springs_describe(const mech_model *m, int i, char *buf, size_t size);
+
 #endif
