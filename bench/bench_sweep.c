@@ -77,7 +77,7 @@ int main(int argc, char **argv)
             mech_table tab = {0};
             int rc = way == 0 ? mech_analysis_solve(a[i], NULL, 0, &tab, NULL, &d)
                      : way == 1 ? old_way(file, &ov, &tab, &d)
-                                : sweep_variant_solve(file, &ov, 1, 0, &tab, &d);
+                                : sweep_variant_solve(file, &ov, 1, 0, &tab, NULL, &d);
             failed += rc != MECH_OK;
             mech_table_free(&tab);
         }

@@ -169,6 +169,28 @@ typedef struct mech_param {
     double tol;        /* tolerance: the value is value +- tol (same unit); 0 when none */
 } mech_param;
 
+/* A spring and/or viscous damper (docs/forces.md section 7). LINEAR: between
+ * point[0] of link[0] and point[1] of link[1], the force along the line
+ * joining them, tension positive: preload + stiffness (L - free) + damping
+ * dL/dt. TORSION: at the revolute joint `joint`, between its receiving link
+ * link[0] (the later in the file) and link[1]: the relative angle
+ * phi = th[link[0]] - th[link[1]], torque preload + stiffness (phi - free)
+ * + damping dphi/dt acting on link[1], its opposite on link[0]. */
+typedef enum { MECH_SPRING_LINEAR, MECH_SPRING_TORSION } mech_spring_kind;
+
+typedef struct mech_spring {
+    mech_spring_kind kind;
+    char *name;        /* owned; column base name */
+    int link[2];
+    int point[2];      /* LINEAR: point index in link[0], link[1]; TORSION: -1 */
+    int joint;         /* TORSION: revolute joint index; LINEAR: -1 */
+    double stiffness;  /* N/m or N*m/rad, >= 0 (0: a damper only) */
+    double free;       /* free length (m) or free angle (rad) */
+    double preload;    /* N or N*m at the free length or angle */
+    double damping;    /* N*s/m or N*m*s/rad, >= 0 */
+    mech_mark mark;
+} mech_spring;
+
 typedef struct mech_outputs {
     int *points;       /* [npoints] name ids */
     int npoints;
@@ -203,6 +225,9 @@ typedef struct mech_model {
     mech_load *loads;     /* [nloads] */
     int nloads;
     mech_outputs outputs;
+    mech_spring *springs; /* [nsprings] springs and dampers (last: the fields before
+                             keep their places) */
+    int nsprings;
 } mech_model;
 
 /* Read and validate a mechanism file. On success *out is the model and the

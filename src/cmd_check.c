@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "commands.h"
+#include "springs.h"
 
 const char cmd_check_help[] =
     "usage: mech check [-q] FILE...\n"
@@ -32,6 +33,17 @@ static const char *drive_text(const mech_model *m, char *buf, size_t size)
     return buf;
 }
 
+/* One line per spring or damper (springs_describe: mech report shows the
+ * same lines). */
+static void print_springs(const mech_model *m)
+{
+    char buf[512];
+    for (int i = 0; i < m->nsprings; i++) {
+        springs_describe(m, i, buf, sizeof buf);
+        printf("  spring     %s\n", buf);
+    }
+}
+
 static void print_summary(const mech_model *m, const mech_summary *s)
 {
     char buf[256];
@@ -49,6 +61,7 @@ static void print_summary(const mech_model *m, const mech_summary *s)
     printf("  driver     %s\n", drive_text(m, buf, sizeof buf));
     printf("  outputs    %d points, %d links, %d sliders%s\n", m->outputs.npoints,
            m->outputs.nlinks, m->outputs.nsliders, m->outputs.forces ? ", forces" : "");
+    print_springs(m);
 }
 
 int cmd_check(int argc, char **argv)

@@ -7,13 +7,15 @@
 #include <string.h>
 
 #include "commands.h"
+#include "flywheel.h"
 
 const char cmd_solve_help[] =
     "usage: mech solve FILE [-o OUT.csv] [--from A --to B --steps N] [--tol T]\n"
     "                  [--outputs NAME,...] [--level positions|velocities|accelerations]\n"
     "                  [--sensitivity NAME,...] [--tolerances]\n"
     "                  [--forces] [--friction on|off|both]\n"
-    "                  [--diagnostics] [--stats] [--verbose] [--all]\n"
+    "                  [--diagnostics] [--stats] [--speed-fluctuation CS]\n"
+    "                  [--verbose] [--all]\n"
     "                  [--within-assembly] [--range assembly]\n"
     "\n"
     "Solve positions, velocities and accelerations of the mechanism at every\n"
@@ -61,7 +63,14 @@ const char cmd_solve_help[] =
     "                      suffixed .nofriction\n"
     "  --diagnostics       add the columns iterations, residual [m], rcond, substeps\n"
     "  --stats             print iterations per step, worst residual, smallest\n"
-    "                      rcond and time per step to standard error\n"
+    "                      rcond and time per step to standard error; with\n"
+    "                      forces, the flywheel figures of the driver torque: its\n"
+    "                      mean, the largest energy fluctuation (over the rows:\n"
+    "                      sweep one full turn)\n"
+    "  --speed-fluctuation CS  the flywheel inertia I = dE / (CS w^2) for the\n"
+    "                      coefficient of speed fluctuation CS (0 < CS < 1, e.g.\n"
+    "                      0.02; w the driver speed) printed with the figures\n"
+    "                      above; implies --forces\n"
     "  --verbose           say which blocks of equations are solved and why\n"
     "  -q, --quiet         no progress report (long runs show one on standard error:\n"
     "                      a bar on a terminal, else a line every 5 s)\n"
@@ -89,6 +98,7 @@ typedef struct solve_args {
     int tolerances;              /* --tolerances */
     cmd_sets set;                /* --set NAME=VALUE: parameters replaced */
     int steps, stats, verbose, quiet;
+    double speed_fluctuation;    /* --speed-fluctuation: Cs, 0 when not given */
     int within;                  /* --within-assembly or --range assembly */
     mech_outputs selected;       /* --outputs, parsed (opt.outputs points here) */
     mech_solve_options opt;
@@ -105,7 +115,7 @@ static int parse_number(const char *text, double *v)
 static const char *const value_options[] = {"-o", "--output", "--from", "--to", "--outputs",
                                            "--steps", "--tol", "--max-iter", "--min-rcond",
                                            "--level", "--friction", "--set", "--linear-solver",
-                                           "--range", "--sensitivity"};
+                                           "--range", "--sensitivity", "--speed-fluctuation"};
 
 static int takes_value(const char *arg)
 {
@@ -194,6 +204,12 @@ static int parse_valued(solve_args *a, const char *arg, const char *val)
             return cmd_usage_error("solve", "--range needs 'assembly', not '%s'", val);
         a->within = 1;
         a->opt.limit_rows = 1;
+    } else if (strcmp(arg, "--speed-fluctuation") == 0) {
+        if (!parse_number(val, &num) || !(num > 0 && num < 1))
+            return cmd_usage_error("solve", "--speed-fluctuation needs a number between 0 and 1 "
+                                   "(e.g. 0.02), not '%s'", val);
+        a->speed_fluctuation = num;
+        a->opt.forces = 1;
     } else if (strcmp(arg, "--friction") == 0) {
         if (strcmp(val, "on") == 0)
             a->opt.friction = MECH_FRICTION_ON;
@@ -296,6 +312,17 @@ static void print_stats(const mech_model *m, const mech_solve_stats *st, FILE *o
                 "at most %d\n", st->worst_power_residual, st->max_friction_iterations);
     fprintf(out, "  time               %.3g us per step (sweep %.3g s, set-up %.3g s)\n",
             per * 1e6, st->seconds, st->setup_seconds);
+}
+
+/* The flywheel figures of the driver torque, when there is one. */
+static void print_flywheel(const solve_args *a, const mech_model *m, const mech_table *t)
+{
+    flywheel_figures f;
+    char why[200];
+    if (flywheel_compute(t, m, a->speed_fluctuation, &f, why, sizeof why) == 0)
+        flywheel_print(&f, a->speed_fluctuation, stderr);
+    else if (a->speed_fluctuation > 0.0 || mech_table_column(t, "driver.torque") >= 0)
+        fprintf(stderr, "  flywheel           none: %s\n", why);
 }
 
 /* One line per gap: the rows missing, why, and the limits found. */
@@ -420,6 +447,8 @@ static int solve_loaded(solve_args *pa, mech_model *m)
     }
     if (a.stats)
         print_stats(m, &st, stderr);
+    if (a.stats || a.speed_fluctuation > 0.0)
+        print_flywheel(&a, m, &t);
     code = cmd_exit_status(rc);
     if (rc == MECH_ESOLVE && a.within && only_assembly_gaps(&t))
         code = MECH_EXIT_OK;

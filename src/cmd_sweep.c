@@ -18,6 +18,7 @@
 #include "internal.h"
 #include "output.h"
 #include "sweep_variants.h"
+#include "flywheel.h"
 
 const char cmd_sweep_help[] =
     "usage: mech sweep FILE --vary NAME=FROM:TO:COUNT [--vary ...] [--list NAME=A,B,...]\n"
@@ -43,7 +44,10 @@ const char cmd_sweep_help[] =
     "                    max:COL, min:COL, maxabs:COL (e.g. maxabs:driver.torque,\n"
     "                    the peak torque), or transmission:LINK1,LINK2 (the\n"
     "                    smallest angle between the two links, 0..pi/2 rad, e.g. the\n"
-    "                    transmission angle of a four-bar: coupler,rocker)\n"
+    "                    transmission angle of a four-bar: coupler,rocker), or\n"
+    "                    flywheel:CS (the flywheel inertia, kg*m^2, for the\n"
+    "                    coefficient of speed fluctuation CS over the file's\n"
+    "                    driver range, one full turn; needs --forces)\n"
     "                    (default: the number of rows solved)\n"
     "  -o FILE           write the summary CSV to FILE (default: standard output)\n"
     "  -j, --jobs N      worker threads (default: the processors this process may\n"
@@ -75,13 +79,14 @@ typedef struct axis {
     int count;
 } axis;
 
-typedef enum { MET_RANGE, MET_MAX, MET_MIN, MET_MAXABS, MET_TRANSMISSION } metric_kind;
+typedef enum { MET_RANGE, MET_MAX, MET_MIN, MET_MAXABS, MET_TRANSMISSION, MET_FLYWHEEL } metric_kind;
 
 typedef struct metric {
     metric_kind kind;
     char col[128], col2[128];  /* column names (transmission: two link names) */
     char label[160];
     char unit[32];             /* of the column (transmission: rad) */
+    double cs;                 /* flywheel: coefficient of speed fluctuation */
 } metric;
 
 typedef struct variant {
@@ -263,7 +268,7 @@ static int parse_metric(sweep_run *r, const char *arg)
 {
     static const struct { const char *prefix; metric_kind kind; } kinds[] = {
         {"range:", MET_RANGE}, {"max:", MET_MAX}, {"min:", MET_MIN},
-        {"maxabs:", MET_MAXABS}, {"transmission:", MET_TRANSMISSION}};
+        {"maxabs:", MET_MAXABS}, {"transmission:", MET_TRANSMISSION}, {"flywheel:", MET_FLYWHEEL}};
     if (r->nmetrics == MAX_METRICS)
         return cmd_usage_error("sweep", "at most 32 metrics ('%s')", arg);
     metric *mt = &r->metrics[r->nmetrics];
@@ -283,13 +288,19 @@ static int parse_metric(sweep_run *r, const char *arg)
                 return cmd_usage_error("sweep", "transmission:LINK1,LINK2, not '%s'", arg);
             snprintf(mt->col, sizeof mt->col, "%.*s.angle", (int)(comma - arg - n), arg + n);
             snprintf(mt->col2, sizeof mt->col2, "%s.angle", comma + 1);
+        } else if (mt->kind == MET_FLYWHEEL) {
+            char *end;
+            mt->cs = strtod(arg + n, &end);
+            if (*end || !(mt->cs > 0 && mt->cs < 1))
+                return cmd_usage_error("sweep", "flywheel:CS needs 0 < CS < 1, not '%s'", arg);
+            snprintf(mt->col, sizeof mt->col, "driver.torque");
         } else {
             snprintf(mt->col, sizeof mt->col, "%s", arg + n);
         }
         r->nmetrics++;
         return -1;
     }
-    return cmd_usage_error("sweep", "unknown metric '%s' (range:, max:, min:, maxabs:, transmission:)", arg);
+    return cmd_usage_error("sweep", "unknown metric '%s' (range:, max:, min:, maxabs:, transmission:, flywheel:)", arg);
 }
 
 /* ---- the metrics' columns, checked before the grid --------------------- */
@@ -360,6 +371,7 @@ static int check_metrics(sweep_run *r, const mech_model *m)
         metric *mt = &r->metrics[k];
         int c = mech_table_column(&t, mt->col);
         snprintf(mt->unit, sizeof mt->unit, "%s", mt->kind == MET_TRANSMISSION ? "rad"
+                 : mt->kind == MET_FLYWHEEL ? "kg*m^2"
                  : c >= 0 && t.columns[c].unit ? t.columns[c].unit : "-");
     }
     mech_table_free(&t);
@@ -381,8 +393,14 @@ static void variant_overrides(const sweep_run *r, long v, mech_override *ov)
     }
 }
 
-static double metric_value(const metric *mt, const mech_table *t, FILE *msg)
+static double metric_value(const metric *mt, const mech_table *t, const mech_model *m, FILE *msg)
 {
+    flywheel_figures fw;
+    char why[200];
+    if (mt->kind == MET_FLYWHEEL && flywheel_compute(t, m, mt->cs, &fw, why, sizeof why) < 0)
+        return fprintf(msg, "metric %s: %s\n", mt->label, why), NAN;
+    if (mt->kind == MET_FLYWHEEL && !fw.full_cycle)
+        fprintf(msg, "metric %s: the rows are not one full turn\n", mt->label);
     int c = mech_table_column(t, mt->col), c2 = -1;
     if (mt->kind == MET_TRANSMISSION)
         c2 = mech_table_column(t, mt->col2);
@@ -408,6 +426,7 @@ static double metric_value(const metric *mt, const mech_table *t, FILE *msg)
     case MET_MIN: return lo;
     case MET_MAXABS: return big;
     case MET_TRANSMISSION: return tmin;  /* rad, as every angle of the CSVs */
+    case MET_FLYWHEEL: return fw.inertia;
     }
     return NAN;
 }
@@ -421,7 +440,8 @@ static void run_variant(const sweep_run *r, variant *var)
     mech_diag d;
     mech_diag_init(&d);
     mech_table t = {0};
-    int rc = sweep_variant_solve(r->file, ov, r->naxes, r->forces, &t, &d);
+    mech_model *m = NULL;
+    int rc = sweep_variant_solve(r->file, ov, r->naxes, r->forces, &t, &m, &d);
     int singular = 0, locking = 0;
     for (size_t i = 0; i < d.count; i++) {  /* the errors say what failed, not the notes */
         const char *msgtext = d.entries[i].message ? d.entries[i].message : "";
@@ -444,8 +464,9 @@ static void run_variant(const sweep_run *r, variant *var)
                   : rc == MECH_ESOLVE ? (locking ? "self-locking" : singular ? "singular" : "no-assembly")
                   : rc == MECH_EIO ? "error" : "invalid";
     for (int k = 0; k < r->nmetrics; k++)
-        var->value[k] = rc == MECH_OK ? metric_value(&r->metrics[k], &t, out) : NAN;
+        var->value[k] = rc == MECH_OK ? metric_value(&r->metrics[k], &t, m, out) : NAN;
     mech_table_free(&t);
+    mech_model_free(&m);
     if (msg)
         fclose(msg);
 }

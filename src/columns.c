@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "columns.h"
+#include "springs.h"
 
 void columns_free(column_layout *cl)
 {
@@ -133,6 +134,22 @@ static int force_columns(column_layout *cl, const mech_model *m, char **label, i
     return rc;
 }
 
+/* Each spring's length (or angle), its rate and its force (or torque). */
+static int spring_columns(column_layout *cl, const mech_model *m)
+{
+    static const char *const lin[] = {".length", ".rate", ".force"};
+    static const char *const lin_unit[] = {"m", "m/s", "N"};
+    static const char *const tor[] = {".angle", ".rate", ".torque"};
+    static const char *const tor_unit[] = {"rad", "rad/s", "N*m"};
+    int rc = 0;
+    for (int i = 0; i < m->nsprings; i++) {
+        int torsion = m->springs[i].kind == MECH_SPRING_TORSION;
+        rc |= add_levels(cl, MECH_WANT_ALL, SRC_SPRING, i, m->springs[i].name,
+                         torsion ? tor : lin, torsion ? tor_unit : lin_unit);
+    }
+    return rc;
+}
+
 static int dynamic_columns(column_layout *cl, const mech_model *m, const column_request *rq)
 {
     char **label = joint_labels(m);
@@ -144,6 +161,7 @@ static int dynamic_columns(column_layout *cl, const mech_model *m, const column_
               add(cl, SRC_FRICTION_ITERATIONS, 0, 0, "friction.iterations", "", "-");
     if (rq->friction == 2)
         rc |= force_columns(cl, m, label, 0);
+    rc |= spring_columns(cl, m);
     for (int j = 0; j < m->njoints; j++)
         free(label[j]);
     free(label);
@@ -161,7 +179,7 @@ static int source_width(column_source src)
 {
     switch (src) {
     case SRC_POINT: return 6;
-    case SRC_LINK: case SRC_SLIDER: return 3;
+    case SRC_LINK: case SRC_SLIDER: case SRC_SPRING: return 3;
     case SRC_REACTION: return 4;
     default: return 1;
     }
@@ -246,6 +264,15 @@ static void reaction_values(const row_sources *rs, int joint, int set, double *r
         r[2] = hypot(r[0], r[1]);
 }
 
+static void spring_values(const mech_spring *s, const solver *sv, double *v)
+{
+    spring_state st;
+    springs_eval(s, sv, &st);
+    v[0] = st.length;
+    v[1] = st.rate;
+    v[2] = st.force;
+}
+
 /* Every component of a group's source object into v[0 .. width - 1]. */
 static void source_values(const column_group *g, const row_sources *rs, double *v)
 {
@@ -269,6 +296,7 @@ static void source_values(const column_group *g, const row_sources *rs, double *
     case SRC_RESIDUAL: v[0] = sv->resid; break;
     case SRC_RCOND: v[0] = sv->rcond; break;
     case SRC_SUBSTEPS: v[0] = rs->substeps; break;
+    case SRC_SPRING: spring_values(&sv->p->m->springs[g->obj], sv, v); break;
     }
 }
 

@@ -25,7 +25,8 @@ typedef enum {
     SRC_ITERATIONS,      /* diagnostics: Newton iterations of the row */
     SRC_RESIDUAL,
     SRC_RCOND,
-    SRC_SUBSTEPS
+    SRC_SUBSTEPS,
+    SRC_SPRING           /* obj: spring; comp 0..2: length (angle), rate, force (torque) */
 } column_source;
 
 typedef struct column_desc {

@@ -22,6 +22,7 @@
 #include <string.h>
 
 #include "forces.h"
+#include "springs.h"
 
 enum { MAX_ENTRIES = 6, FRICTION_MAX_ITER = 100, ANDERSON_DEPTH = 3 };
 static const double FRICTION_TOL = 1e-12;
@@ -223,7 +224,7 @@ static int build_pattern(forces_plan *fp)
  * inertia and there are no loads (gravity acts on masses only). */
 static int nothing_loads(const mech_model *m)
 {
-    if (m->nloads > 0)
+    if (m->nloads > 0 || m->nsprings > 0)
         return 0;
     for (int i = 1; i < m->nlinks; i++)
         if (m->links[i].mass != 0.0 || m->links[i].inertia != 0.0)
@@ -384,6 +385,7 @@ static void known_loads(const forces *fc, const solver *sv, double *rhs)
         load_resultant(sv, ld, f, p, v);
         load_force(rhs, fc, ld->link, p, f);
     }
+    springs_add_loads(m, sv, fc->g, rhs);
 }
 
 /* ---- friction ---------------------------------------------------------- */
@@ -514,6 +516,7 @@ static double power_residual(const forces *fc, const solver *sv, double drive, d
         ext += pw;
         scale += fabs(pw);
     }
+    ext += springs_power(m, sv, &scale);
     double r = pd + ext - pfric - kin;
     return scale > 0.0 ? r / scale : 0.0;
 }

@@ -70,7 +70,8 @@ typedef struct dim {
 typedef enum {
     Q_NUMBER, Q_LENGTH, Q_ANGLE, Q_MASS, Q_TIME, Q_FORCE, Q_TORQUE, Q_INERTIA,
     Q_SPEED, Q_ACCELERATION, Q_ANGULAR_SPEED, Q_ANGULAR_ACCELERATION,
-    Q_FORCE_PER_LENGTH, NQUANTITIES /* ORDER Q: keep quantity_table in units.c in step */
+    Q_FORCE_PER_LENGTH, Q_DAMPING, Q_TORSION_STIFFNESS, Q_TORSION_DAMPING,
+    NQUANTITIES /* ORDER Q: keep quantity_table in units.c in step */
 } quantity;
 
 typedef struct quantity_info {

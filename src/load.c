@@ -17,6 +17,8 @@
  *   loops: [[A, B, C, A] | "A B C A"]
  *   loads: [{force: [fx, fy], link, at} | {torque, link}
  *         | {distributed, link, from, to, direction}]
+ *   springs: [{between: [P, Q], links, name, stiffness, free_length, preload, damping}
+ *           | {at: JOINT, name, stiffness, free_angle, preload, damping}]   (load_springs.c)
  *   outputs: {points: [...], links: [...], sliders: [...], forces: bool}
  *
  * Every problem is recorded with its file:line:column and loading goes on,
@@ -43,7 +45,7 @@ static void load_document(loader *ld, const ynode *root)
 {
     static const char *const keys[] = {"name", "description", "units", "parameters", "gravity",
                                        "ground", "links", "joints", "driver", "initial",
-                                       "branch", "loops", "loads", "outputs"};
+                                       "branch", "loops", "loads", "springs", "outputs"};
     mech_model *m = ld->m;
     if (!load_check_keys(ld, root, keys, COUNT(keys), "the mechanism"))
         return;
@@ -94,6 +96,8 @@ static void load_document(loader *ld, const ynode *root)
         load_loops(ld, v);
     if ((v = ymap_get(root, "loads")))
         load_loads(ld, v);
+    if ((v = ymap_get(root, "springs")))
+        load_springs(ld, v);
     if ((v = ymap_get(root, "outputs")))
         load_outputs(ld, v);
     else

@@ -129,4 +129,7 @@ void load_loads(loader *ld, const ynode *seq);
 void load_outputs(loader *ld, const ynode *map);
 void load_default_outputs(mech_model *m);
 
+/* ---- load_springs.c: springs and dampers. */
+void load_springs(loader *ld, const ynode *seq);
+
 #endif

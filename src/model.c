@@ -72,6 +72,9 @@ void mech_model_free(mech_model **pm)
     }
     free(m->loops);
     free(m->loads);
+    for (int i = 0; i < m->nsprings; i++)
+        free(m->springs[i].name);
+    free(m->springs);
     free(m->outputs.points);
     free(m->outputs.links);
     free(m->outputs.sliders);

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "report.h"
+#include "springs.h"
 
 #define RAD2DEG_R 57.295779513082321
 
@@ -120,6 +121,10 @@ static void put_summary(FILE *f, const mech_model *m, const mech_summary *s)
     snprintf(b, sizeof b, "%d points, %d links, %d sliders%s", m->outputs.npoints,
              m->outputs.nlinks, m->outputs.nsliders, m->outputs.forces ? ", forces" : "");
     row_text(f, "outputs", b);
+    for (int i = 0; i < m->nsprings; i++) {
+        springs_describe(m, i, b, sizeof b);
+        row_text(f, "spring", b);
+    }
     fputs("</table>\n", f);
 }
 

@@ -52,7 +52,7 @@ static const load_doc *document_of(const char *path)
 }
 
 int sweep_variant_solve(const char *file, const mech_override *ov, int nov, int forces,
-                        mech_table *t, mech_diag *d)
+                        mech_table *t, mech_model **model, mech_diag *d)
 {
     const load_doc *doc = document_of(file);
     mech_model *m = NULL;
@@ -66,6 +66,9 @@ int sweep_variant_solve(const char *file, const mech_override *ov, int nov, int 
         o.forces = forces;
         rc = mech_solve(m, &o, t, NULL, d);
     }
-    mech_model_free(&m);
+    if (model)
+        *model = m;  /* the caller's now, also when NULL or not solved */
+    else
+        mech_model_free(&m);
     return rc;
 }

@@ -38,6 +38,9 @@ static const quantity_info quantity_table[NQUANTITIES] = {
     {"angular_speed", "an angular speed", {{0, 0, -1, 1}}, "rad/s"},
     {"angular_acceleration", "an angular acceleration", {{0, 0, -2, 1}}, "rad/s^2"},
     {"force_per_length", "a force per length", {{0, 1, -2, 0}}, "N/m"},
+    {"damping", "a damping coefficient", {{0, 1, -1, 0}}, "N*s/m"},
+    {"torsion_stiffness", "a torsional stiffness", {{2, 1, -2, -1}}, "N*m/rad"},
+    {"torsion_damping", "a torsional damping coefficient", {{2, 1, -1, -1}}, "N*m*s/rad"},
 };
 
 const quantity_info *quantity_get(quantity q) { return &quantity_table[q]; }

@@ -286,6 +286,37 @@ if run "mech solve --forces on a file without forces" 0 "$MECH" solve mechanisms
 fi
 run "mech solve --friction bogus" 2 "$MECH" solve mechanisms/conveyor.yaml --friction bogus && pass
 
+# springs and dampers (docs/forces.md section 7), flywheel figures (section 8)
+ssc=mechanisms/spring-slider-crank.yaml
+if run "mech check springs" 0 "$MECH" check $ssc; then
+    [ "$(grep -c '^  spring     ' "$tmp/out")" -eq 3 ] && pass || fail "check: 3 spring lines"
+    has_line "$tmp/out" '^  spring     return: linear S-B (ground, piston), stiffness 2000 N/m, free length 0.25 m, preload -5 N$' "check: a spring listed"
+    has_line "$tmp/out" '^  spring     pivot: torsional at O (crank, ground), stiffness 0.5 N\*m/rad, free angle 0 deg$' "check: a torsional spring listed"
+fi
+if run "mech solve springs --stats" 0 "$MECH" solve $ssc --stats -o "$tmp/ss.csv"; then
+    has_line "$tmp/ss.csv" 'return\.length \[m\],return\.rate \[m/s\],return\.force \[N\],damper\.length \[m\],damper\.rate \[m/s\],damper\.force \[N\],pivot\.angle \[rad\],pivot\.rate \[rad/s\],pivot\.torque \[N\*m\]$' "spring columns"
+    has_line "$tmp/err" 'flywheel           mean driver torque .* N\*m over 360 deg (one turn)' "--stats flywheel"
+    has_line "$tmp/err" 'energy fluctuation .* J (energy lowest at q = ' "--stats energy fluctuation"
+    has_line "$tmp/err" '(--speed-fluctuation CS gives the flywheel inertia)' "--stats flywheel hint"
+fi
+if run "mech solve --speed-fluctuation" 0 "$MECH" solve $ssc --speed-fluctuation 0.02 -o "$tmp/ss2.csv"; then
+    has_line "$tmp/err" 'inertia .* kg\*m^2 for a speed fluctuation of 0.02 at 62.8319 rad/s' "--speed-fluctuation inertia"
+fi
+if run "mech solve --stats half a turn" 0 "$MECH" solve $ssc --stats --from 0 --to 180 -o "$tmp/ss3.csv"; then
+    has_line "$tmp/err" 'over 180 deg: NOT one full turn' "--stats flywheel: not a cycle"
+fi
+if run "mech solve --speed-fluctuation implies forces" 0 "$MECH" solve mechanisms/slider-crank.yaml --speed-fluctuation 0.05 -o "$tmp/ss4.csv"; then
+    has_line "$tmp/ss4.csv" 'driver\.torque' "--speed-fluctuation: torque column"
+fi
+run "mech solve --speed-fluctuation 0" 2 "$MECH" solve $ssc --speed-fluctuation 0 && pass
+run "mech solve --speed-fluctuation 1" 2 "$MECH" solve $ssc --speed-fluctuation 1 && pass
+run "mech solve --speed-fluctuation x" 2 "$MECH" solve $ssc --speed-fluctuation x && pass
+if run "mech sweep flywheel metric" 0 "$MECH" sweep $ssc --vary r=30mm:40mm:2 --forces --metric flywheel:0.02 -q; then
+    has_line "$tmp/out" 'flywheel:0.02 \[kg\*m^2\]' "sweep: flywheel metric header"
+fi
+run "mech sweep flywheel:2" 2 "$MECH" sweep $ssc --vary r=30mm:40mm:2 --forces --metric flywheel:2 && pass
+run "mech sweep flywheel without --forces" 2 "$MECH" sweep mechanisms/slider-crank.yaml --vary r=30mm:40mm:2 --metric flywheel:0.02 && pass
+
 for f in mechanisms/*.yaml; do
     run "mech solve $f" 0 "$MECH" solve "$f" -o "$tmp/all.csv" && pass
 done

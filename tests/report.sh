@@ -179,6 +179,7 @@ page_of() {
 
 page_of fourbar $four
 page_of stirling mechanisms/stirling.yaml
+page_of springs mechanisms/spring-slider-crank.yaml
 page_of conveyor-forces mechanisms/conveyor.yaml --forces --steps 90
 PLOT_ALL=0 page_of slider-range mechanisms/offset-slider-crank.yaml --from 10 --to 100 --steps 9
 page_of outputs mechanisms/watt-six-bar.yaml --outputs B,bellcrank

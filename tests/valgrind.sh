@@ -37,6 +37,9 @@ check "mech solve --sensitivity" solve mechanisms/conveyor.yaml --sensitivity l1
 sed 's/^  r: 40 mm .*/  r: {value: 40 mm, tolerance: 0.05 mm}/' mechanisms/offset-slider-crank.yaml >"$tmp/tol.yaml"
 check "mech solve --tolerances" solve "$tmp/tol.yaml" --tolerances --sensitivity e -q -o "$tmp/t.csv"
 check "mech solve --sensitivity, unknown name" solve mechanisms/conveyor.yaml --sensitivity zz -q
+check "mech sweep flywheel" sweep mechanisms/spring-slider-crank.yaml --list r=30mm,40mm --forces --metric flywheel:0.02 -j 2
+check "mech solve --speed-fluctuation" solve mechanisms/spring-slider-crank.yaml --stats --speed-fluctuation 0.02 -o "$tmp/x.csv"
+check "mech check bad springs" check tests/bad/63-springs.yaml
 check "mech plot" plot mechanisms/fourbar.yaml --out "$tmp/plots"
 check "mech animate" animate mechanisms/fourbar.yaml -o "$tmp/a.svg"
 check "mech report --forces" report mechanisms/fourbar.yaml --forces -o "$tmp/r.html"

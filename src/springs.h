@@ -1,0 +1,35 @@
+/* src/springs.h: springs and dampers evaluated from the solved motion
+ * (docs/forces.md section 7): their length or angle, its rate, the force
+ * or torque, the loads they put on the links and the power they take. */
+#ifndef MECH_SPRINGS_H
+#define MECH_SPRINGS_H
+
+#include "solve.h"
+
+/* One spring at the published position of a solver. */
+typedef struct spring_state {
+    double length;     /* m (LINEAR) or rad (TORSION: the relative angle) */
+    double rate;       /* m/s or rad/s */
+    double force;      /* N, tension positive, or N*m */
+    double p[2][2];    /* LINEAR: the two ends, ground frame */
+    double v[2][2];    /* their velocities */
+    double u[2];       /* LINEAR: unit vector from end 0 to end 1 */
+} spring_state;
+
+void springs_eval(const mech_spring *s, const solver *sv, spring_state *st);
+
+/* Move every spring's loads on the moving links to the right-hand side of
+ * the Newton-Euler rows (3 per moving link: x, y, moment about the centre
+ * g[2 l], g[2 l + 1]). */
+void springs_add_loads(const mech_model *m, const solver *sv, const double *g, double *rhs);
+
+/* Power the springs' forces deliver to the links, W (-force * rate summed:
+ * negative while they store or dissipate energy); *scale gets the sum of
+ * the absolute values. */
+double springs_power(const mech_model *m, const solver *sv, double *scale);
+
+/* Spring i in words, as mech check and mech report show it: its name,
+ * where it acts and its coefficients (SI; angles in deg). */
+void springs_describe(const mech_model *m, int i, char *buf, size_t size);
+
+#endif
