@@ -30,13 +30,14 @@ shard_pid() {
     return 1
 }
 
-# The first shard K of M whose out/sweep.K.csv.partial holds rows: waits up
-# to $2 seconds; prints K, or nothing.
+# The first shard K of M whose out/sweep.K.csv.partial (or the file $3
+# names, %s for K) holds rows: waits up to $2 seconds; prints K, or nothing.
 running_shard() {
-    m=$1 limit=$2 waited=0
+    m=$1 limit=$2 waited=0 pattern=${3:-sweep.%s.csv.partial}
     while [ "$waited" -lt $((limit * 20)) ]; do
         for k in $(seq 0 $((m - 1))); do
-            f=$work/out/sweep.$k.csv.partial
+            # shellcheck disable=SC2059
+            f=$work/out/$(printf "$pattern" "$k")
             if [ -f "$f" ] && [ "$(wc -l <"$f")" -ge 4 ]; then
                 echo "$k"
                 return 0
