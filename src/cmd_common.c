@@ -305,3 +305,24 @@ void cmd_progress_callback(void *ctx, int done, int total)
 {
     cmd_progress_update(ctx, done, total);
 }
+
+/* Outputs of the animation: every point name and every moving link, no
+ * forces (*all, owned by the caller). */
+int cmd_select_everything(const mech_model *m, mech_outputs *all)
+{
+    memset(all, 0, sizeof *all);
+    all->points = malloc(((size_t)m->npoint_names + 1) * sizeof *all->points);
+    all->links = malloc(((size_t)m->nlinks + 1) * sizeof *all->links);
+    all->sliders = malloc(sizeof *all->sliders);
+    if (!all->points || !all->links || !all->sliders) {
+        mech_outputs_free(all);
+        return -1;
+    }
+    for (int p = 0; p < m->npoint_names; p++)
+        all->points[p] = p;
+    for (int i = 1; i < m->nlinks; i++)
+        all->links[i - 1] = i;
+    all->npoints = m->npoint_names;
+    all->nlinks = m->nlinks - 1;
+    return 0;
+}

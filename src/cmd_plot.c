@@ -330,27 +330,6 @@ int cmd_plot(int argc, char **argv)
     return code;
 }
 
-/* Outputs of the animation: every point name and every moving link, no
- * forces (*all, owned by the caller). */
-static int select_everything(const mech_model *m, mech_outputs *all)
-{
-    memset(all, 0, sizeof *all);
-    all->points = malloc(((size_t)m->npoint_names + 1) * sizeof *all->points);
-    all->links = malloc(((size_t)m->nlinks + 1) * sizeof *all->links);
-    all->sliders = malloc(sizeof *all->sliders);
-    if (!all->points || !all->links || !all->sliders) {
-        mech_outputs_free(all);
-        return -1;
-    }
-    for (int p = 0; p < m->npoint_names; p++)
-        all->points[p] = p;
-    for (int i = 1; i < m->nlinks; i++)
-        all->links[i - 1] = i;
-    all->npoints = m->npoint_names;
-    all->nlinks = m->nlinks - 1;
-    return 0;
-}
-
 /* --outputs of the animation: the points whose paths are drawn (*traced,
  * owned by the caller); links and sliders have no path and are refused.
  * Returns -1 to go on, else the exit status. */
@@ -393,7 +372,7 @@ int cmd_animate(int argc, char **argv)
         return code;
     }
     mech_model view = *m;
-    if (select_everything(m, &view.outputs) != 0) {
+    if (cmd_select_everything(m, &view.outputs) != 0) {
         fprintf(stderr, "mech animate: out of memory\n");
         mech_outputs_free(&traced);
         mech_model_free(&m);

@@ -189,27 +189,6 @@ static int apply_range(const report_args *a, const mech_model *m, mech_solve_opt
     return -1;
 }
 
-/* Outputs of the animation: every point name and every moving link, no
- * forces (*all, freed by the caller with mech_outputs_free). */
-static int select_everything(const mech_model *m, mech_outputs *all)
-{
-    memset(all, 0, sizeof *all);
-    all->points = malloc(((size_t)m->npoint_names + 1) * sizeof *all->points);
-    all->links = malloc(((size_t)m->nlinks + 1) * sizeof *all->links);
-    all->sliders = malloc(sizeof *all->sliders);
-    if (!all->points || !all->links || !all->sliders) {
-        mech_outputs_free(all);
-        return -1;
-    }
-    for (int p = 0; p < m->npoint_names; p++)
-        all->points[p] = p;
-    for (int i = 1; i < m->nlinks; i++)
-        all->links[i - 1] = i;
-    all->npoints = m->npoint_names;
-    all->nlinks = m->nlinks - 1;
-    return 0;
-}
-
 /* Everything one run holds (freed by run_free). */
 typedef struct report_run {
     report_args a;
@@ -278,7 +257,7 @@ static int solve_both(report_run *r)
         r->view.outputs = r->selected;
     }
     r->view_all = *m;
-    if (select_everything(m, &r->all) != 0)
+    if (cmd_select_everything(m, &r->all) != 0)
         return fprintf(stderr, "mech report: out of memory\n"), MECH_EXIT_IO;
     r->view_all.outputs = r->all;
     r->o.forces = r->a.forces;

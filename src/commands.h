@@ -95,6 +95,11 @@ int cmd_codegen(int argc, char **argv);
 extern const char cmd_merge_help[];
 int cmd_merge(int argc, char **argv);
 
+/* Outputs of the animation (mech animate, mech report): every point name and
+ * every moving link, no forces; *all is freed with mech_outputs_free.
+ * Returns 0, or -1 when out of memory. */
+int cmd_select_everything(const mech_model *m, mech_outputs *all);
+
 /* Gap i of a partial sweep t, as `mech solve` and `mech report` print it
  * ("rows 3 to 9 of 361 (driver at ...) not solved: why; limits found: ...");
  * o are the options the sweep was solved with (cmd_gaps.c). */

@@ -77,6 +77,10 @@ double plot_nice_step(double span, int target);
  * buf must hold 32 bytes; returns buf. */
 char *plot_fmt(char *buf, double v, int decimals);
 
+/* Write text with &, <, >, " escaped: safe in XML and HTML text and
+ * attributes (src/plot_svg.c; the report uses it too). */
+void plot_put_text(FILE *f, const char *s);
+
 /* Options of the animation. */
 typedef struct plot_anim_options {
     double duration;       /* seconds for one pass through the driver range (default 4) */

@@ -16,8 +16,6 @@
  * top and bottom edges. */
 enum { FIG_W = 780, FIG_H = 450, AX_L = 86, AX_R = 590, AX_T = 62, AX_B = 384 };
 
-/* Write text with &, <, >, " escaped. */
-void plot_put_text(FILE *f, const char *s);
 
 /* sep, then "x,y" with `dec` decimals. */
 void plot_put_xy(FILE *f, const char *sep, double x, double y, int dec);

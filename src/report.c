@@ -271,16 +271,16 @@ static void put_header(FILE *f, const report_input *in)
     const char *name = m->name ? m->name : m->file;
     fputs(page_head, f);
     fputs("<title>", f);
-    report_put_text(f, name);
+    plot_put_text(f, name);
     fputs(" - mech report</title>\n", f);
     fputs(page_style, f);
     fputs("</head>\n<body>\n<header>\n<h1>", f);
-    report_put_text(f, name);
+    plot_put_text(f, name);
     fputs("</h1>\n<p>", f);
-    report_put_text(f, m->file);
+    plot_put_text(f, m->file);
     if (m->description) {
         fputs(": ", f);
-        report_put_text(f, m->description);
+        plot_put_text(f, m->description);
     }
     fprintf(f, " (mech %s)</p>\n<nav><a href=\"#animation\">Animation</a>"
                "<a href=\"#structure\">Structure</a><a href=\"#diagnostics\">Diagnostics</a>"
@@ -305,13 +305,13 @@ static void put_animation(FILE *f, const report_input *in)
           "<th>unit</th><th>shown as</th></tr></thead>\n<tbody>\n", f);
     for (int c = 0; c < t->ncolumns; c++) {
         fputs("<tr><td>", f);
-        report_put_text(f, t->columns[c].name);
+        plot_put_text(f, t->columns[c].name);
         double v = in->nframes > 0 ? mech_table_get(t, in->frame_rows[0], c) : NAN;
         if (isfinite(v))
             fprintf(f, "</td><td class=\"num\" id=\"v%d\">%.17g</td><td>", c, v);
         else
             fprintf(f, "</td><td class=\"num\" id=\"v%d\">n/a</td><td>", c);
-        report_put_text(f, t->columns[c].unit);
+        plot_put_text(f, t->columns[c].unit);
         fprintf(f, "</td><td class=\"num\" id=\"d%d\"></td></tr>\n", c);
     }
     fputs("</tbody></table>\n</div>\n</section>\n", f);
@@ -339,7 +339,7 @@ static void put_equations(FILE *f, const report_input *in)
           "<p>As <code>mech equations</code> prints them: the unknowns, the loops, the "
           "position equations f(x, q) = 0, the nonzeros of the Jacobian df/dx, and the "
           "right-hand sides of the velocity and acceleration equations.</p>\n<pre>", f);
-    report_put_text(f, in->equations ? in->equations : "");
+    plot_put_text(f, in->equations ? in->equations : "");
     fputs("</pre>\n</section>\n", f);
 }
 

@@ -51,8 +51,6 @@ void report_free_strings(char **s, int n);
 
 /* ---- src/report_parts.c: the sections, written to f. ---- */
 
-/* Text with & < > " escaped (XML and HTML). */
-void report_put_text(FILE *f, const char *s);
 /* An SVG document inline: its XML declaration dropped, every id, url(#..)
  * and href="#.." prefixed with `prefix` (the figures' ids would clash). */
 void report_put_svg(FILE *f, const char *svg, const char *prefix);

@@ -13,19 +13,6 @@
 
 #define RAD2DEG_R 57.295779513082321
 
-void report_put_text(FILE *f, const char *s)
-{
-    for (; *s; s++) {
-        switch (*s) {
-        case '&': fputs("&amp;", f); break;
-        case '<': fputs("&lt;", f); break;
-        case '>': fputs("&gt;", f); break;
-        case '"': fputs("&quot;", f); break;
-        default: fputc(*s, f);
-        }
-    }
-}
-
 /* ------------------------------------------------------------------ */
 /* Inline SVG.                                                         */
 
@@ -67,7 +54,7 @@ void report_put_svg(FILE *f, const char *svg, const char *prefix)
 static void row_text(FILE *f, const char *key, const char *value)
 {
     fprintf(f, "<tr><th>%s</th><td>", key);
-    report_put_text(f, value);
+    plot_put_text(f, value);
     fputs("</td></tr>\n", f);
 }
 
@@ -135,11 +122,11 @@ static void put_links(FILE *f, const mech_model *m)
     for (int i = 0; i < m->nlinks; i++) {
         const mech_link *l = &m->links[i];
         fputs("<tr><td>", f);
-        report_put_text(f, l->name);
+        plot_put_text(f, l->name);
         fputs("</td><td>", f);
         for (int k = 0; k < l->npoints; k++) {
             fputs(k ? ", " : "", f);
-            report_put_text(f, l->points[k].name);
+            plot_put_text(f, l->points[k].name);
             fprintf(f, " (%.6g, %.6g)", l->points[k].x * 1e3, l->points[k].y * 1e3);
         }
         if (l->has_mass)
@@ -158,16 +145,16 @@ static void put_joints(FILE *f, const mech_model *m)
     for (int j = 0; j < m->njoints; j++) {
         const mech_joint *jt = &m->joints[j];
         fputs("<tr><td>", f);
-        report_put_text(f, jt->name);
+        plot_put_text(f, jt->name);
         if (jt->kind == MECH_JOINT_REVOLUTE)
             fputs("</td><td>revolute", f);
         else
             fprintf(f, "</td><td>%s slider, guide at %.6g deg", jt->locked ? "prismatic"
                     : "pin-in-slot", jt->angle * RAD2DEG_R);
         fputs("</td><td>", f);
-        report_put_text(f, m->links[jt->link[0]].name);
+        plot_put_text(f, m->links[jt->link[0]].name);
         fputs(jt->kind == MECH_JOINT_SLIDER ? " on " : ", ", f);
-        report_put_text(f, m->links[jt->link[1]].name);
+        plot_put_text(f, m->links[jt->link[1]].name);
         if (jt->friction > 0)
             fprintf(f, "</td><td>%.6g</td></tr>\n", jt->friction);
         else
@@ -185,7 +172,7 @@ static void put_lists(FILE *f, const mech_model *m)
             fputs("<li>", f);
             for (int k = 0; k < m->loops[i].npoints; k++) {
                 fputs(k ? " - " : "", f);
-                report_put_text(f, m->point_names[m->loops[i].points[k]]);
+                plot_put_text(f, m->point_names[m->loops[i].points[k]]);
             }
             fputs("</li>\n", f);
         }
@@ -195,7 +182,7 @@ static void put_lists(FILE *f, const mech_model *m)
         fputs("<h3>Parameters (SI units)</h3>\n<table><tbody>\n", f);
         for (int i = 0; i < m->nparams; i++) {
             fputs("<tr><td>", f);
-            report_put_text(f, m->params[i].name);
+            plot_put_text(f, m->params[i].name);
             fprintf(f, "</td><td class=\"num\">%.9g</td></tr>\n", m->params[i].value);
         }
         fputs("</tbody></table>\n", f);
@@ -259,7 +246,7 @@ void report_put_diagnostics(FILE *f, const report_input *in)
         fprintf(f, "<h3>Gaps (%d)</h3>\n<ul id=\"gaps\">\n", in->ngaps);
         for (int i = 0; i < in->ngaps; i++) {
             fputs("<li class=\"error\">gap: ", f);
-            report_put_text(f, in->gaps[i]);
+            plot_put_text(f, in->gaps[i]);
             fputs("</li>\n", f);
         }
         fputs("</ul>\n", f);
@@ -274,11 +261,11 @@ void report_put_diagnostics(FILE *f, const report_input *in)
     for (size_t i = 0; i < d->count; i++) {
         const mech_diag_entry *e = &d->entries[i];
         fprintf(f, "<li class=\"%s\">", sev[e->severity]);
-        report_put_text(f, e->file);
+        plot_put_text(f, e->file);
         if (e->mark.line > 0)
             fprintf(f, ":%d:%d", e->mark.line, e->mark.col);
         fprintf(f, ": %s: ", sev[e->severity]);
-        report_put_text(f, e->message);
+        plot_put_text(f, e->message);
         fputs("</li>\n", f);
     }
     fputs("</ul>\n</section>\n", f);
