@@ -7,7 +7,9 @@
 # it runs: the submission fails and `mech merge` says "shard 3/8 missing";
 # the repair recipe (sbatch --array=3) reruns just that task, which
 # continues its partial file, and the merge equals the unsharded run. The
-# batch array's merged table equals one batch's. Needs root and the Debian
+# batch array's task 1 is cancelled too and repaired (sbatch --array=1, which
+# solves only the files with no CSV yet); its merged table equals one batch's.
+# Needs root and the Debian
 # packages slurm-wlm and munge.
 # Run from the repository root:  MECH=build/mech sh tests/slurm/recipes.sh
 NAME=slurm . tests/lib.sh
@@ -112,13 +114,45 @@ fi
 # each task used one worker: Slurm's allocation, through the affinity mask
 grep -q . out/sweep.0.log 2>/dev/null && fail "task 0 said: $(head -n 2 out/sweep.0.log)" || pass
 
-# ---- the batch array ----------------------------------------------------------
+# ---- the batch array, task 1 cancelled, repaired ------------------------------
+# (mechanisms/ here: the repository's files and 300 conveyor copies, so that
+# a task is still running when it is cancelled)
+rm mechanisms  # the link to the repository's directory, not the files
+mkdir mechanisms
+cp "$repo"/mechanisms/*.yaml mechanisms/
+for i in $(seq 100 399); do cp "$repo/mechanisms/conveyor.yaml" "mechanisms/c$i.yaml"; done
 recipe slurm-batch.sbatch >batch.sbatch
 recipe slurm-batch >"$tmp/batch.sh"
-if run "the Slurm batch recipe" 0 sh "$tmp/batch.sh"; then
+[ -s batch.sbatch ] && [ -s "$tmp/batch.sh" ] && pass || fail "no Slurm batch recipe in docs/batch.md"
+sh "$tmp/batch.sh" >"$tmp/out" 2>"$tmp/err" &
+pid=$!
+cancelled=
+for i in $(seq 1200); do  # until task 1 has written rows (up to 60 s)
+    if [ -f out/summary.1.txt.partial ] && [ "$(wc -l <out/summary.1.txt.partial)" -ge 4 ]; then
+        job=$(squeue -h -n mech-batch -o %F | head -n 1)
+        scancel "${job}_1" && cancelled=1
+        break
+    fi
+    [ -f out/summary.1.txt ] && break
+    sleep 0.05
+done
+wait $pid
+status=$?
+if [ -n "$cancelled" ]; then
+    [ "$status" -ne 0 ] && pass || fail "the batch submission with task 1 cancelled exits 0"
+    has_line "$tmp/err" '^mech merge: shard 1/4 missing' "batch merge after task 1 was cancelled"
+    [ ! -e out/summary.txt ] && pass || fail "merge wrote out/summary.txt with shard 1 missing"
+else
+    fail "batch task 1 was not seen running, so not cancelled (status $status: $(head -n 3 "$tmp/err"))"
+fi
+recipe slurm-batch-repair >"$tmp/brepair.sh"
+if run "the batch repair recipe (sbatch --array=1)" 0 sh "$tmp/brepair.sh"; then
     build/mech batch -q --files-from out/files.txt >"$tmp/one.txt" 2>/dev/null
-    [ "$(untimed out/summary.txt)" = "$(untimed "$tmp/one.txt")" ] && pass ||
-        fail "the merged batch table differs from one batch's"
+    # file and status (a row kept by --skip-existing has no steps nor times)
+    [ "$(awk '{ print $1, $2 }' out/summary.txt | sed 's/ kept$/ ok/')" = "$(awk '{ print $1, $2 }' "$tmp/one.txt")" ] && pass ||
+        fail "the repaired batch table differs from one batch's"
+    [ "$(ls out/csv/*.csv | wc -l)" -eq "$(wc -l <out/files.txt)" ] && pass ||
+        fail "the repaired batch: $(ls out/csv/*.csv | wc -l) CSVs for $(wc -l <out/files.txt) files"
     # each shard wrote its table whole with -o (rows first to TABLE.partial)
     [ "$(ls out/summary.*.txt | wc -l)" -eq 4 ] && [ -z "$(ls out/summary.*.partial 2>/dev/null)" ] && pass ||
         fail "the batch recipe: tables $(ls out/summary.* | tr '\n' ' ')"
