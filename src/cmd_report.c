@@ -298,9 +298,9 @@ static int equations(report_run *r)
     return MECH_EXIT_OK;
 }
 
-/* The rows behind the slider: at most --frames evenly spread, as the
- * animation's frames (src/plot_anim.c, choose_frames); the animation
- * drawn with exactly those frames. */
+/* The rows behind the slider: the animation's frames (plot_anim_frame_rows,
+ * at most --frames evenly spread); the animation drawn with exactly those
+ * frames. */
 static int animation(report_run *r)
 {
     int n = r->t.nrows, same = n >= 1 && r->t_all.nrows == n;
@@ -312,13 +312,10 @@ static int animation(report_run *r)
                 "rows); nothing written\n", r->t_all.nrows, n);
         return MECH_EXIT_SOLVE;
     }
-    int nf = n < r->a.anim.max_frames ? n : r->a.anim.max_frames;
-    r->frame_rows = malloc((size_t)nf * sizeof *r->frame_rows);
+    r->frame_rows = malloc((size_t)n * sizeof *r->frame_rows);
     if (!r->frame_rows)
         return fprintf(stderr, "mech report: out of memory\n"), MECH_EXIT_IO;
-    for (int k = 0; k < nf; k++)
-        r->frame_rows[k] = nf > 1 ? (int)((long long)k * (n - 1) / (nf - 1)) : 0;
-    r->nframes = nf;
+    r->nframes = plot_anim_frame_rows(n, r->a.anim.max_frames, r->frame_rows);
     /* the traced paths, unless a gap lies in the sweep: the animation's
        polyline would bridge it (the page says so) */
     r->a.anim.trace = r->view.outputs.points;

@@ -95,6 +95,12 @@ typedef struct plot_anim_options {
 
 void plot_anim_options_default(plot_anim_options *o);
 
+/* The rows an animation of nrows rows shows as frames: at most max_frames
+ * (when > 1) evenly spread, first and last included, into rows[] (room for
+ * min(nrows, max_frames)); returns their count. mech report's slider uses
+ * the same rows. */
+int plot_anim_frame_rows(int nrows, int max_frames, int *rows);
+
 /* Write the animated (or still) SVG of the mechanism. The table must hold the
  * positions ("P.x", "P.y") of every point name and the angle ("L.angle") of
  * every moving link, one row per driver position.

@@ -285,14 +285,19 @@ static int choose_frames(anim_ctx *c, mech_diag *d)
         c->rows[0] = c->o->frame;
         c->nframes = 1;
     } else {
-        int nf = c->nrows;
-        if (c->o->max_frames > 1 && nf > c->o->max_frames)
-            nf = c->o->max_frames;
-        for (int k = 0; k < nf; k++)
-            c->rows[k] = nf > 1 ? (int)((long long)k * (c->nrows - 1) / (nf - 1)) : 0;
-        c->nframes = nf;
+        c->nframes = plot_anim_frame_rows(c->nrows, c->o->max_frames, c->rows);
     }
     return MECH_OK;
+}
+
+int plot_anim_frame_rows(int nrows, int max_frames, int *rows)
+{
+    int nf = nrows;
+    if (max_frames > 1 && nf > max_frames)
+        nf = max_frames;
+    for (int k = 0; k < nf; k++)
+        rows[k] = nf > 1 ? (int)((long long)k * (nrows - 1) / (nf - 1)) : 0;
+    return nf;
 }
 
 /* Outlines of the links in their own frames. */
