@@ -142,11 +142,12 @@ static double cell(const mech_table *t, int row, int col)
     return col < 0 ? 0.0 : mech_table_get(t, row, col);
 }
 
-/* The table t widened by nnames * nc columns, filled from vals[row][k][c]. */
-static int widen(mech_table *t, const mech_model *m, const int *which, int nnames,
-                 const sens_col *cols, int nc, const double *vals)
+/* t widened by `extra` columns after its own: the old columns and values
+ * kept, the new ones zero with no name yet (the caller names them). Returns
+ * the old width, or -1 with t unchanged when out of memory. */
+static int table_add_columns(mech_table *t, int extra)
 {
-    int old = t->ncolumns, wide = old + nnames * nc;
+    int old = t->ncolumns, wide = old + extra;
     mech_column *cn = xcalloc((size_t)wide, sizeof *cn);
     double *v = xcalloc((size_t)t->nrows * (size_t)wide + 1, sizeof *v);
     if (!cn || !v) {
@@ -155,12 +156,29 @@ static int widen(mech_table *t, const mech_model *m, const int *which, int nname
         return -1;
     }
     memcpy(cn, t->columns, (size_t)old * sizeof *cn);
+    for (int r = 0; r < t->nrows; r++)
+        memcpy(v + (size_t)r * wide, t->values + (size_t)r * old, (size_t)old * sizeof *v);
+    free(t->columns);
+    free(t->values);
+    t->columns = cn;
+    t->values = v;
+    t->ncolumns = wide;
+    return old;
+}
+
+/* The table t widened by nnames * nc columns, filled from vals[row][k][c]. */
+static int widen(mech_table *t, const mech_model *m, const int *which, int nnames,
+                 const sens_col *cols, int nc, const double *vals)
+{
+    int old = table_add_columns(t, nnames * nc), wide = t->ncolumns;
+    if (old < 0)
+        return -1;
     int failed = 0;
     for (int k = 0; k < nnames; k++)
         for (int c = 0; c < nc; c++) {
             const mech_column *col = &t->columns[cols[c].col];
             const mech_param *p = &m->params[which[k]];
-            mech_column *out = &cn[old + k * nc + c];
+            mech_column *out = &t->columns[old + k * nc + c];
             size_t ln = strlen(col->name) + strlen(p->name) + 16;
             size_t lu = strlen(col->unit) + strlen(p->unit) + 8;
             out->name = malloc(ln);
@@ -175,16 +193,9 @@ static int widen(mech_table *t, const mech_model *m, const int *which, int nname
             else
                 snprintf(out->unit, lu, "%s", col->unit);  /* per 1 of a bare number */
         }
-    for (int r = 0; r < t->nrows; r++) {
-        memcpy(v + (size_t)r * wide, t->values + (size_t)r * old, (size_t)old * sizeof *v);
-        memcpy(v + (size_t)r * wide + old, vals + (size_t)r * nnames * nc,
-               (size_t)(nnames * nc) * sizeof *v);
-    }
-    free(t->columns);
-    free(t->values);
-    t->columns = cn;
-    t->values = v;
-    t->ncolumns = wide;
+    for (int r = 0; r < t->nrows; r++)
+        memcpy(t->values + (size_t)r * wide + old, vals + (size_t)r * nnames * nc,
+               (size_t)(nnames * nc) * sizeof *t->values);
     return failed ? -1 : 0;
 }
 
@@ -316,21 +327,15 @@ int mech_sensitivity(const mech_model *m, const mech_override *ov, int nov,
 static int add_stackup(mech_table *t, const mech_model *m, const int *which, int np,
                        const sens_col *cols, int nc, const double *vals)
 {
-    int old = t->ncolumns, wide = old + 2 * nc;
-    mech_column *cn = xcalloc((size_t)wide, sizeof *cn);
-    double *v = xcalloc((size_t)t->nrows * (size_t)wide + 1, sizeof *v);
-    if (!cn || !v) {
-        free(cn);
-        free(v);
+    int old = table_add_columns(t, 2 * nc), wide = t->ncolumns;
+    if (old < 0)
         return -1;
-    }
-    memcpy(cn, t->columns, (size_t)old * sizeof *cn);
     int failed = 0;
     for (int c = 0; c < nc; c++)
         for (int k = 0; k < 2; k++) {
             const mech_column *col = &t->columns[cols[c].col];
             size_t ln = strlen(col->name) + 8;
-            mech_column *out = &cn[old + 2 * c + k];
+            mech_column *out = &t->columns[old + 2 * c + k];
             out->name = malloc(ln);
             out->unit = xstrdup(col->unit);
             if (!out->name || !out->unit)
@@ -339,8 +344,7 @@ static int add_stackup(mech_table *t, const mech_model *m, const int *which, int
                 snprintf(out->name, ln, "%s(%s)", k ? "rss" : "worst", col->name);
         }
     for (int r = 0; r < t->nrows; r++) {
-        double *row = v + (size_t)r * wide;
-        memcpy(row, t->values + (size_t)r * old, (size_t)old * sizeof *v);
+        double *row = t->values + (size_t)r * wide;
         for (int c = 0; c < nc; c++) {
             double worst = 0, sq = 0;
             for (int k = 0; k < np; k++) {
@@ -352,11 +356,6 @@ static int add_stackup(mech_table *t, const mech_model *m, const int *which, int
             row[old + 2 * c + 1] = sqrt(sq);  /* root-sum-square */
         }
     }
-    free(t->columns);
-    free(t->values);
-    t->columns = cn;
-    t->values = v;
-    t->ncolumns = wide;
     return failed ? -1 : 0;
 }
 

@@ -78,6 +78,34 @@ done
 [ "$(sinfo -h -o %t 2>/dev/null)" = idle ] && pass ||
     { fail "the node is not idle: $(sinfo 2>&1; tail -n 5 "$sl/log/slurmctld.log")"; exit 1; }
 
+# Cancel task $3 of the array job named $2 once its partial output $1
+# holds rows (waits up to 60 s; gives up when the task finished first, its
+# output without .partial existing). Sets cancelled to 1 when it did.
+cancel_when_running() {
+    cancelled=
+    for i in $(seq 1200); do
+        if [ -f "$1" ] && [ "$(wc -l <"$1")" -ge 4 ]; then
+            job=$(squeue -h -n "$2" -o %F | head -n 1)
+            scancel "${job}_$3" && cancelled=1
+            return
+        fi
+        [ -f "${1%.partial}" ] && return
+        sleep 0.05
+    done
+}
+
+# After the submission whose merge step exited $1 with shard $2 (K/M)
+# cancelled: non-zero exit, the shard named missing, $3 not written.
+merge_refused() {
+    if [ -n "$cancelled" ]; then
+        [ "$1" -ne 0 ] && pass || fail "the submission with shard $2 cancelled exits 0"
+        has_line "$tmp/err" "^mech merge: shard $2 missing" "merge after shard $2 was cancelled"
+        [ ! -e "$3" ] && pass || fail "merge wrote $3 with shard $2 missing"
+    else
+        fail "shard $2 was not seen running, so not cancelled (status $1: $(head -n 3 "$tmp/err"))"
+    fi
+}
+
 # ---- the sweep array, task 3 cancelled, repaired ----------------------------
 scratch
 cd "$work" || exit 2
@@ -88,25 +116,9 @@ recipe slurm-sweep >"$tmp/sweep.sh"
 [ -s sweep.sbatch ] && [ -s "$tmp/sweep.sh" ] && pass || fail "no Slurm sweep recipe in docs/batch.md"
 sh "$tmp/sweep.sh" >"$tmp/out" 2>"$tmp/err" &
 pid=$!
-cancelled=
-for i in $(seq 1200); do  # until task 3 has written rows (up to 60 s)
-    if [ -f out/sweep.3.csv.partial ] && [ "$(wc -l <out/sweep.3.csv.partial)" -ge 4 ]; then
-        job=$(squeue -h -n mech-sweep -o %F | head -n 1)
-        scancel "${job}_3" && cancelled=1
-        break
-    fi
-    [ -f out/sweep.3.csv ] && break
-    sleep 0.05
-done
+cancel_when_running out/sweep.3.csv.partial mech-sweep 3
 wait $pid
-status=$?
-if [ -n "$cancelled" ]; then
-    [ "$status" -ne 0 ] && pass || fail "the submission with task 3 cancelled exits 0"
-    has_line "$tmp/err" '^mech merge: shard 3/8 missing' "merge after task 3 was cancelled"
-    [ ! -e out/sweep.csv ] && pass || fail "merge wrote out/sweep.csv with shard 3 missing"
-else
-    fail "task 3 was not seen running, so not cancelled (status $status: $(head -n 3 "$tmp/err"))"
-fi
+merge_refused $? 3/8 out/sweep.csv
 recipe slurm-sweep-repair >"$tmp/repair.sh"
 if run "the repair recipe (sbatch --array=3)" 0 sh "$tmp/repair.sh"; then
     cmp -s out/sweep.csv "$tmp/ref.csv" && pass || fail "the repaired merge differs from the unsharded run"
@@ -126,25 +138,9 @@ recipe slurm-batch >"$tmp/batch.sh"
 [ -s batch.sbatch ] && [ -s "$tmp/batch.sh" ] && pass || fail "no Slurm batch recipe in docs/batch.md"
 sh "$tmp/batch.sh" >"$tmp/out" 2>"$tmp/err" &
 pid=$!
-cancelled=
-for i in $(seq 1200); do  # until task 1 has written rows (up to 60 s)
-    if [ -f out/summary.1.txt.partial ] && [ "$(wc -l <out/summary.1.txt.partial)" -ge 4 ]; then
-        job=$(squeue -h -n mech-batch -o %F | head -n 1)
-        scancel "${job}_1" && cancelled=1
-        break
-    fi
-    [ -f out/summary.1.txt ] && break
-    sleep 0.05
-done
+cancel_when_running out/summary.1.txt.partial mech-batch 1
 wait $pid
-status=$?
-if [ -n "$cancelled" ]; then
-    [ "$status" -ne 0 ] && pass || fail "the batch submission with task 1 cancelled exits 0"
-    has_line "$tmp/err" '^mech merge: shard 1/4 missing' "batch merge after task 1 was cancelled"
-    [ ! -e out/summary.txt ] && pass || fail "merge wrote out/summary.txt with shard 1 missing"
-else
-    fail "batch task 1 was not seen running, so not cancelled (status $status: $(head -n 3 "$tmp/err"))"
-fi
+merge_refused $? 1/4 out/summary.txt
 recipe slurm-batch-repair >"$tmp/brepair.sh"
 if run "the batch repair recipe (sbatch --array=1)" 0 sh "$tmp/brepair.sh"; then
     build/mech batch -q --files-from out/files.txt >"$tmp/one.txt" 2>/dev/null
