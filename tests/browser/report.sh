@@ -31,33 +31,7 @@ MECH=${MECH:-build/mech}
 OUT=${OUT:-build/browser-report}
 CHROMIUM=${CHROMIUM:-chromium}
 CHECK="python3 tests/browser/report_check.py"
-fails=0
-
-for tool in "$CHROMIUM" xmllint python3; do
-    if ! command -v "$tool" >/dev/null 2>&1; then
-        echo "tests/browser/report.sh: '$tool' not found"
-        echo "  (Debian: apt-get install chromium libxml2-utils python3 fonts-dejavu-core)"
-        exit 1
-    fi
-done
-rm -rf "$OUT"
-mkdir -p "$OUT"
-OUT=$(cd "$OUT" && pwd)
-
-fail() {
-    echo "FAIL: $*"
-    fails=$((fails + 1))
-}
-
-# browse URL WIDTH,HEIGHT SCALE ARGS...: headless chromium, no network
-browse() {
-    url=$1 size=$2 scale=$3
-    shift 3
-    timeout 120 "$CHROMIUM" --headless --no-sandbox --disable-gpu --no-proxy-server \
-        --host-resolver-rules="MAP * ~NOTFOUND" --no-first-run --disable-extensions \
-        --user-data-dir="$OUT/chromium-profile" --hide-scrollbars \
-        --force-device-scale-factor="$scale" --window-size="$size" "$@" "$url"
-}
+. tests/browser/lib.sh
 
 # page_height DOM.html: the page's height in CSS px, from the test report
 page_height() {

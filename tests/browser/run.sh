@@ -31,23 +31,7 @@ MECH=${MECH:-build/mech}
 OUT=${OUT:-build/browser}
 CHROMIUM=${CHROMIUM:-chromium}
 CHECK="python3 tests/browser/pngcheck.py"
-fails=0
-
-for tool in "$CHROMIUM" xmllint python3; do
-    if ! command -v "$tool" >/dev/null 2>&1; then
-        echo "tests/browser: '$tool' not found"
-        echo "  (Debian: apt-get install chromium libxml2-utils python3 fonts-dejavu-core)"
-        exit 1
-    fi
-done
-rm -rf "$OUT"
-mkdir -p "$OUT"
-OUT=$(cd "$OUT" && pwd)
-
-fail() {
-    echo "FAIL: $*"
-    fails=$((fails + 1))
-}
+. tests/browser/lib.sh
 
 # svg_size FILE -> "W,H" from the root element's width and height
 svg_size() {
@@ -59,11 +43,7 @@ shot() {
     size=$(svg_size "$1")
     budget=""
     [ $# -ge 3 ] && budget="--virtual-time-budget=$3"
-    timeout 120 "$CHROMIUM" --headless --no-sandbox --disable-gpu --no-proxy-server \
-        --host-resolver-rules="MAP * ~NOTFOUND" --no-first-run --disable-extensions \
-        --user-data-dir="$OUT/chromium-profile" --hide-scrollbars \
-        --force-device-scale-factor=1 --window-size="$size" $budget \
-        --screenshot="$2" "file://$1" >"$OUT/chromium.log" 2>&1
+    browse "file://$1" "$size" 1 $budget --screenshot="$2" >"$OUT/chromium.log" 2>&1
     [ -s "$2" ] || { cat "$OUT/chromium.log"; return 1; }
 }
 
