@@ -814,6 +814,12 @@ static int run_variants(sweep_run *r, const sweep_opts *so, long total)
     cmd_progress_init(&r->progress, "sweep", "variants", r->quiet);
     cmd_run_parallel((int)r->nvars, (int)so->nthreads, sweep_job, r);
     cmd_progress_done(&r->progress);
+    long shared, alone;
+    sweep_variant_counts(&shared, &alone);
+    if (!r->quiet && shared + alone > 0)  /* docs/batch.md, "One analysis per sweep" */
+        fprintf(stderr, "mech sweep: %ld variant%s solved through the sweep's one analysis, "
+                "%ld analysed on %s own\n", shared, shared == 1 ? "" : "s", alone,
+                alone == 1 ? "its" : "their");
     long nok = 0;
     code = rows_finish(&r->rows, so->out, so->sharded, 1 + r->naxes, &nok);
     if (code == MECH_EXIT_OK && r->nvars > 0 && nok == 0) {

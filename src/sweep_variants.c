@@ -84,8 +84,11 @@ static const variant_base *base_of(const char *path, const mech_override *ov, in
         mech_summary sum;
         const char *names[MAX_BASE_NAMES];
         int ok = 1;
-        for (int i = 0; i < nov && ok; i++)
-            ok = (names[i] = fast.names[i] = xstrdup(ov[i].name)) != NULL && ++fast.nnames;
+        for (int i = 0; i < nov && ok; i++) {
+            names[i] = fast.names[i] = xstrdup(ov[i].name);
+            ok = names[i] != NULL;
+            fast.nnames += ok;
+        }
         fast.forces = forces;
         if (ok && load_doc_model(doc, NULL, 0, &m, &quiet) == MECH_OK &&
             mech_check(m, &sum, &quiet) == MECH_OK &&
