@@ -1,6 +1,8 @@
-/* src/cmd_sweep.c: `mech sweep`, a grid of variants of one mechanism
- * (docs/batch.md). Each variant re-loads the file with some `parameters:`
- * replaced, solves it, and reduces the table to the metrics asked for.
+/* src/cmd_sweep.c: `mech sweep`, a grid of variants of one mechanism, or
+ * --random N samples within the parameters' tolerances (docs/batch.md).
+ * Each variant builds its model with some `parameters:` replaced, solves it
+ * (through the sweep's one analysis: sweep_variants.c, variant_regs.c), and
+ * reduces the table to the metrics asked for.
  * Variants run on worker threads; rows come out in variant order, so the
  * result does not depend on the workers, and --shard K/M splits the grid
  * over machines (variant index i % M == K) with the index as first column
