@@ -142,6 +142,7 @@ test: deps
 	MECH=$(BUILD)/mech sh tests/files.sh
 	MECH=$(BUILD)/mech sh tests/golden.sh
 	MECH=$(BUILD)/mech MECH_SANITIZE=$(if $(SAN),1,) sh tests/sweep.sh
+	MECH=$(BUILD)/mech MECH_SANITIZE=$(if $(SAN),1,) sh tests/sweep_random.sh
 	MECH=$(BUILD)/mech MECH_SANITIZE=$(if $(SAN),1,) sh tests/codegen.sh
 	MECH=$(BUILD)/mech sh tests/report.sh
 	MECH=$(BUILD)/mech sh tests/parallel/recipes.sh

@@ -1,12 +1,15 @@
 /* bench/bench_sweep.c: what a variant of `mech sweep` costs beyond its crank
  * sweep, for the conveyor with l1 varied (CPU time of one thread; not a
- * test). Three ways, each over the same variants:
+ * test). Four ways, each over the same variants:
  *   sweep only  mech_analysis_solve of each variant's analysis, built
  *               beforehand and not timed (the crank sweeps themselves);
- *   before      mech_load_file_with + mech_check + mech_solve per variant (the
+ *   read each   mech_load_file_with + mech_check + mech_solve per variant (the
  *               file read and its YAML parsed each time);
- *   after       sweep_variant_solve (sweep_variants.c: the YAML parsed once).
- * The three are interleaved and each timed as the best of 3 rounds (the
+ *   parsed once sweep_variant_solve with MECH_SWEEP_REANALYSE set (the YAML
+ *               parsed once, each variant loaded, checked, analysed, solved);
+ *   one analysis sweep_variant_solve (variant_regs.c: each variant loaded,
+ *               checked and solved through the sweep's one analysis).
+ * The four are interleaved and each timed as the best of 3 rounds (the
  * machine is shared). Usage: bench-sweep [FILE [PARAM [FROM_MM TO_MM]]] */
 #include <stdio.h>
 #include <stdlib.h>
@@ -15,7 +18,7 @@
 #include "mech.h"
 #include "sweep_variants.h"
 
-enum { NVAR = 200, ROUNDS = 3 };
+enum { NVAR = 200, ROUNDS = 3, WAYS = 4 };
 
 static double cpu(void)
 {
@@ -67,10 +70,14 @@ int main(int argc, char **argv)
             return 1;
         }
     }
-    double t[3] = {1e300, 1e300, 1e300};
+    double t[WAYS] = {1e300, 1e300, 1e300, 1e300};
     int failed = 0;
-    for (int round = 0; round < 3 * ROUNDS; round++) {  /* interleaved; best of ROUNDS */
-        int way = round % 3;
+    for (int round = 0; round < WAYS * ROUNDS; round++) {  /* interleaved; best of ROUNDS */
+        int way = round % WAYS;
+        if (way == 2)
+            setenv("MECH_SWEEP_REANALYSE", "1", 1);
+        else
+            unsetenv("MECH_SWEEP_REANALYSE");
         double t0 = cpu();
         for (int i = 0; i < NVAR; i++) {
             mech_override ov = {param, text[i]};
@@ -88,10 +95,15 @@ int main(int argc, char **argv)
            "(best of %d)\n", file, param, from, to, NVAR, ROUNDS);
     printf("%-34s %10s %14s %12s\n", "", "us/variant", "variants/CPU-s", "beyond sweep");
     static const char *const what[] = {"crank sweep only (analysed before)",
-                                       "before: load, check, solve", "after: YAML parsed once"};
-    for (int way = 0; way < 3; way++)
+                                       "file read, load, check, analyse", "YAML parsed once, analysed each",
+                                       "one analysis per sweep"};
+    for (int way = 0; way < WAYS; way++)
         printf("%-34s %10.1f %14.1f %11.1f%%\n", what[way], t[way] * 1e6, 1 / t[way],
                100 * (t[way] - t[0]) / t[0]);
+    long shared, alone;
+    sweep_variant_counts(&shared, &alone);
+    printf("(sweep_variant_solve: %ld variant runs through the one analysis, %ld analysed alone)\n",
+           shared, alone);
     if (failed)
         printf("(%d variant runs failed)\n", failed);
     for (int i = 0; i < NVAR; i++) {

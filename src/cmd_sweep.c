@@ -1,6 +1,8 @@
-/* src/cmd_sweep.c: `mech sweep`, a grid of variants of one mechanism
- * (docs/batch.md). Each variant re-loads the file with some `parameters:`
- * replaced, solves it, and reduces the table to the metrics asked for.
+/* src/cmd_sweep.c: `mech sweep`, a grid of variants of one mechanism, or
+ * --random N samples within the parameters' tolerances (docs/batch.md).
+ * Each variant builds its model with some `parameters:` replaced, solves it
+ * (through the sweep's one analysis: sweep_variants.c, variant_regs.c), and
+ * reduces the table to the metrics asked for.
  * Variants run on worker threads; rows come out in variant order, so the
  * result does not depend on the workers, and --shard K/M splits the grid
  * over machines (variant index i % M == K) with the index as first column
@@ -8,6 +10,7 @@
 #include <errno.h>
 #include <math.h>
 #include <stdatomic.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -17,12 +20,14 @@
 #include "commands.h"
 #include "internal.h"
 #include "output.h"
+#include "sweep_random.h"
 #include "sweep_variants.h"
 #include "flywheel.h"
 
 const char cmd_sweep_help[] =
     "usage: mech sweep FILE --vary NAME=FROM:TO:COUNT [--vary ...] [--list NAME=A,B,...]\n"
     "                  [--metric M ...] [-o OUT.csv] [-j N] [--shard K/M] [--forces]\n"
+    "       mech sweep FILE --random N [--seed S] [--metric M ...] [options as above]\n"
     "                  [--index-offset N] [--resume] [--unsolvable-ok]\n"
     "\n"
     "Solve a grid of variants of one mechanism, changing its named parameters\n"
@@ -39,6 +44,12 @@ const char cmd_sweep_help[] =
     "                    may follow the numbers, the same on both: l=130mm:150mm:5\n"
     "  --list NAME=A,B,...        the given values (each may carry a unit)\n"
     "                    several --vary/--list make a grid (every combination)\n"
+    "  --random N        N variants with every parameter that has a tolerance\n"
+    "                    (r: {value: 40 mm, tolerance: 0.05 mm}) drawn uniformly\n"
+    "                    within value +- tolerance, independently (a Monte Carlo\n"
+    "                    check of 'mech solve --tolerances'); not with --vary/--list\n"
+    "  --seed S          the samples' seed, 0 to 2^64-1 (default 1): the same seed\n"
+    "                    gives the same rows, whatever -j and --shard\n"
     "  --metric M        a summary of one output column over the sweep; M is\n"
     "                    range:COL (max - min, e.g. range:x_B.s, the stroke),\n"
     "                    max:COL, min:COL, maxabs:COL (e.g. maxabs:driver.torque,\n"
@@ -69,7 +80,7 @@ const char cmd_sweep_help[] =
     "could be solved (the rows are still written), 2 bad usage or an invalid file,\n"
     "parameter or metric column, 3 a file cannot be read or written, or out of memory\n";
 
-enum { MAX_VARY = 8, MAX_METRICS = 32 };
+enum { MAX_VARY = 32, MAX_GRID = 8, MAX_METRICS = 32 };
 
 typedef struct axis {
     char name[64];
@@ -77,6 +88,7 @@ typedef struct axis {
     double *si;      /* [count] their values in SI (or the bare number) */
     char unit[32];   /* the SI unit of the values, "-" for bare numbers */
     int count;
+    double nominal, tol;  /* --random: the file's value and tolerance (SI) */
 } axis;
 
 typedef enum { MET_RANGE, MET_MAX, MET_MIN, MET_MAXABS, MET_TRANSMISSION, MET_FLYWHEEL } metric_kind;
@@ -107,6 +119,8 @@ typedef struct sweep_run {
     metric metrics[MAX_METRICS];
     int nmetrics;
     int forces;
+    long nrandom;         /* --random N (0: a grid) */
+    uint64_t seed;        /* --seed S */
     long nvars;           /* variants in this shard */
     int quiet;            /* -q: no progress report */
     atomic_long done;     /* variants finished */
@@ -202,7 +216,7 @@ static int parse_vary(sweep_run *r, const char *arg, int is_list)
                  "parameter values are text on one line", opt, (unsigned)cc);
         return cmd_usage_error("sweep", "%s", msg);
     }
-    if (r->naxes == MAX_VARY)
+    if (r->naxes == MAX_GRID)
         return cmd_usage_error("sweep", "at most 8 --vary/--list options ('%s')", arg);
     const char *eq = strchr(arg, '=');
     if (!eq || eq == arg || (size_t)(eq - arg) >= sizeof r->axes[0].name)
@@ -380,10 +394,29 @@ static int check_metrics(sweep_run *r, const mech_model *m)
 
 /* ---- one variant ------------------------------------------------------ */
 
-/* The parameter texts of variant v (offset included): axis k's index is a
- * mixed-radix digit. */
-static void variant_overrides(const sweep_run *r, long v, mech_override *ov)
+/* --random: parameter k of variant v (offset included), SI. */
+static double random_value(const sweep_run *r, long v, int k)
 {
+    const axis *a = &r->axes[k];
+    return a->nominal + a->tol * sweep_random_unit(r->seed, v, k);
+}
+
+typedef char override_text[64];
+
+/* The parameter texts of variant v (offset included): axis k's index is a
+ * mixed-radix digit; --random: the sample in SI with its unit, in text[k]. */
+static void variant_overrides(const sweep_run *r, long v, mech_override *ov, override_text *text)
+{
+    if (r->nrandom > 0) {
+        for (int k = 0; k < r->naxes; k++) {
+            const axis *a = &r->axes[k];
+            snprintf(text[k], sizeof text[k], "%.17g%s%s", random_value(r, v, k),
+                     strcmp(a->unit, "-") ? " " : "", strcmp(a->unit, "-") ? a->unit : "");
+            ov[k].name = a->name;
+            ov[k].text = text[k];
+        }
+        return;
+    }
     v -= r->offset;
     for (int k = r->naxes - 1; k >= 0; k--) {
         const axis *a = &r->axes[k];
@@ -436,7 +469,8 @@ static void run_variant(const sweep_run *r, variant *var)
     FILE *msg = open_memstream(&var->messages, &var->msize);
     FILE *out = msg ? msg : stderr;
     mech_override ov[MAX_VARY];
-    variant_overrides(r, var->index, ov);
+    override_text text[MAX_VARY];
+    variant_overrides(r, var->index, ov, text);
     mech_diag d;
     mech_diag_init(&d);
     mech_table t = {0};
@@ -538,7 +572,9 @@ static void format_row(const sweep_run *r, const variant *v, char *row)
     size_t n = (size_t)snprintf(row, ROW_SIZE, "%ld", v->index);
     for (int k = 0; k < r->naxes; k++)
         n += (size_t)snprintf(row + n, ROW_SIZE - n, ",%s",
-                              shortest(r->axes[k].si[axis_index(r, v->index, k)], cell, sizeof cell));
+                              shortest(r->nrandom > 0 ? random_value(r, v->index, k)
+                                       : r->axes[k].si[axis_index(r, v->index, k)],
+                                       cell, sizeof cell));
     n += (size_t)snprintf(row + n, ROW_SIZE - n, ",%s,%d", v->status, v->rows);
     for (int k = 0; k < r->nmetrics; k++)
         n += (size_t)snprintf(row + n, ROW_SIZE - n, ",%.17g", v->value[k]);
@@ -591,7 +627,7 @@ typedef struct sweep_opts {
 static int takes_value(const char *a)
 {
     static const char *const opts[] = {"--vary", "--list", "--metric", "-o", "-j", "--jobs",
-                                       "--shard", "--index-offset"};
+                                       "--shard", "--index-offset", "--random", "--seed"};
     for (size_t k = 0; k < sizeof opts / sizeof opts[0]; k++)
         if (!strcmp(a, opts[k]))
             return 1;
@@ -615,6 +651,22 @@ static int sweep_option(sweep_run *r, sweep_opts *so, const char *a, const char 
         return parse_vary(r, v, a[2] == 'l');
     if (!strcmp(a, "--metric"))
         return parse_metric(r, v);
+    if (!strcmp(a, "--random")) {
+        r->nrandom = strtol(v, &end, 10);
+        if (end == v || *end || r->nrandom < 1 || r->nrandom > 10000000)
+            return cmd_usage_error("sweep", "--random needs a number of variants from 1 to 10^7, "
+                                   "not '%s'", v);
+        return -1;
+    }
+    if (!strcmp(a, "--seed")) {
+        errno = 0;
+        unsigned long long sd = strtoull(v, &end, 10);
+        if (end == v || *end || errno || v[0] == '-')
+            return cmd_usage_error("sweep", "--seed needs a whole number from 0 to 2^64-1, "
+                                   "not '%s'", v);
+        r->seed = (uint64_t)sd;
+        return -1;
+    }
     if (!strcmp(a, "-o")) {
         so->out = v;
     } else if (!strcmp(a, "-j") || !strcmp(a, "--jobs")) {
@@ -670,8 +722,12 @@ static int parse_sweep_args(int argc, char **argv, sweep_run *r, sweep_opts *so)
     }
     if (code < 0 && !r->file)
         code = cmd_usage_error("sweep", "%s", "no file given (usage: mech sweep FILE --vary NAME=FROM:TO:COUNT)");
-    if (code < 0 && r->naxes == 0)
-        code = cmd_usage_error("sweep", "%s", "nothing to vary: give --vary NAME=FROM:TO:COUNT or --list");
+    if (code < 0 && r->nrandom > 0 && r->naxes > 0)
+        code = cmd_usage_error("sweep", "%s", "--random samples the parameters that have a "
+                               "tolerance; it does not combine with --vary or --list");
+    if (code < 0 && r->naxes == 0 && r->nrandom == 0)
+        code = cmd_usage_error("sweep", "%s", "nothing to vary: give --vary NAME=FROM:TO:COUNT, "
+                               "--list or --random N");
     if (code < 0 && so->resume && (!so->out || !strcmp(so->out, "-")))
         code = cmd_usage_error("sweep", "%s", "--resume needs -o FILE (it continues FILE.partial)");
     if (code < 0)
@@ -684,7 +740,8 @@ static int parse_sweep_args(int argc, char **argv, sweep_run *r, sweep_opts *so)
 static int check_base(sweep_run *r)
 {
     mech_override ov[MAX_VARY];
-    variant_overrides(r, r->offset, ov);
+    override_text text[MAX_VARY];
+    variant_overrides(r, r->offset, ov, text);
     mech_diag d;
     mech_diag_init(&d);
     mech_model *m = NULL;
@@ -722,6 +779,12 @@ static int make_head(const sweep_run *r, const sweep_opts *so, long total, char 
         for (int i = 0; i < a->count; i++)
             mf->grid = manifest_hash(mf->grid, a->texts[i], strlen(a->texts[i]) + 1);
     }
+    if (r->nrandom > 0) {  /* the samples: N and the seed (the file's bytes are hashed) */
+        char text[64];
+        snprintf(text, sizeof text, "random %ld seed %llu", r->nrandom,
+                 (unsigned long long)r->seed);
+        mf->grid = manifest_hash(mf->grid, text, strlen(text) + 1);
+    }
     for (int i = 1; i < so->argc; i++)  /* the file by its contents, not its path */
         if (leaves_rows_alone(so->argv[i]))
             i += takes_value(so->argv[i]);
@@ -753,6 +816,12 @@ static int run_variants(sweep_run *r, const sweep_opts *so, long total)
     cmd_progress_init(&r->progress, "sweep", "variants", r->quiet);
     cmd_run_parallel((int)r->nvars, (int)so->nthreads, sweep_job, r);
     cmd_progress_done(&r->progress);
+    long shared, alone;
+    sweep_variant_counts(&shared, &alone);
+    if (!r->quiet && shared + alone > 0)  /* docs/batch.md, "One analysis per sweep" */
+        fprintf(stderr, "mech sweep: %ld variant%s solved through the sweep's one analysis, "
+                "%ld analysed on %s own\n", shared, shared == 1 ? "" : "s", alone,
+                alone == 1 ? "its" : "their");
     long nok = 0;
     code = rows_finish(&r->rows, so->out, so->sharded, 1 + r->naxes, &nok);
     if (code == MECH_EXIT_OK && r->nvars > 0 && nok == 0) {
@@ -762,15 +831,54 @@ static int run_variants(sweep_run *r, const sweep_opts *so, long total)
     return code;
 }
 
+/* --random: the axes are the file's parameters that have a tolerance. -1
+ * when there is one at least, else the exit status (the problem printed). */
+static int random_axes(sweep_run *r)
+{
+    mech_diag d;
+    mech_diag_init(&d);
+    mech_model *m = NULL;
+    int rc = mech_load_file(r->file, &m, &d);
+    mech_diag_print(&d, stderr);
+    mech_diag_free(&d);
+    if (rc != MECH_OK)
+        return cmd_exit_status(rc);
+    int code = -1;
+    for (int k = 0; k < m->nparams && code < 0; k++) {
+        const mech_param *p = &m->params[k];
+        if (!(p->tol > 0.0))
+            continue;
+        if (r->naxes == MAX_VARY) {
+            code = cmd_usage_error("sweep", "%s", "--random: more than 32 parameters with a "
+                                   "tolerance");
+            break;
+        }
+        axis *a = &r->axes[r->naxes++];
+        memset(a, 0, sizeof *a);
+        snprintf(a->name, sizeof a->name, "%s", p->name);
+        snprintf(a->unit, sizeof a->unit, "%s", p->unit[0] ? p->unit : "-");
+        a->nominal = p->value;
+        a->tol = p->tol;
+    }
+    if (code < 0 && r->naxes == 0)
+        code = cmd_usage_error("sweep", "--random: no parameter of '%s' has a tolerance (give "
+                               "one as r: {value: 40 mm, tolerance: 0.05 mm})", r->file);
+    mech_model_free(&m);
+    return code;
+}
+
 int cmd_sweep(int argc, char **argv)
 {
     sweep_run r;
     memset(&r, 0, sizeof r);
     r.shard_m = 1;
+    r.seed = 1;
     sweep_opts so = {NULL, cmd_default_jobs(), 0, 0, 0, argc, argv};
     int code = parse_sweep_args(argc, argv, &r, &so);
-    long total = 1;
-    for (int k = 0; code < 0 && k < r.naxes; k++)
+    if (code < 0 && r.nrandom > 0)
+        code = random_axes(&r);
+    long total = r.nrandom > 0 ? r.nrandom : 1;
+    for (int k = 0; code < 0 && r.nrandom == 0 && k < r.naxes; k++)
         if ((total *= r.axes[k].count) > 10000000)
             code = cmd_usage_error("sweep", "%s", "more than 10^7 variants");
     if (code < 0)

@@ -29,7 +29,7 @@ static const double MAX_STEP = 1.0;
  * between two points of one link (or of the ground). A link with many
  * points (a ground with 10^4 pivots) uses its bounding box's diagonal
  * instead, at most sqrt(2) larger, to stay linear in the size. */
-static double largest_length(const mech_model *m)
+double solver_largest_length(const mech_model *m)
 {
     double L = 0.0;
     for (int l = 0; l < m->nlinks; l++) {
@@ -293,14 +293,16 @@ static int compile_tape(solver_plan *sp)
     /* dx/dq and d2x/dq2 feed the predictor even for positions only: all three
        phases (two solves with factors already there cost less than the
        Newton iteration a second-order predictor needs) */
-    if (tape_compile(&sp->tp, &sp->sys->ex, SYS_NVARS(n), NPHASES, roots, nroots) < 0)
+    int nv = sp->sys->nvars;  /* SYS_NVARS(n), and a SYS_REGISTERS system's coefficients */
+    if (tape_compile(&sp->tp, &sp->sys->ex, nv, NPHASES, roots, nroots) < 0)
         return -1;
     /* what depends on the driver alone (its sines and cosines, the crank's
        terms) is computed once per position, not per Newton iteration */
-    unsigned char *invariant = xcalloc((size_t)SYS_NVARS(n), 1);
+    unsigned char *invariant = xcalloc((size_t)nv, 1);
     if (!invariant)
         return -1;
     invariant[SYS_VAR_Q(n)] = 1;
+    memset(invariant + SYS_NVARS(n), 1, (size_t)(nv - SYS_NVARS(n)));  /* fixed per sweep */
     tape_hoist(&sp->tp, PHASE_POSITION, invariant);
     free(invariant);
     if (tape_fuse(&sp->tp, roots, nroots) < 0)
@@ -399,15 +401,22 @@ static int level_of(int want)
 int solver_plan_init(solver_plan *sp, const mech_model *m, const mech_solve_options *o,
                      mech_diag *d)
 {
+    return solver_plan_init_with(sp, m, o, NULL, d);
+}
+
+int solver_plan_init_with(solver_plan *sp, const mech_model *m, const mech_solve_options *o,
+                          mech_system *sys, mech_diag *d)
+{
     memset(sp, 0, sizeof *sp);
     sp->m = m;
     sp->opt = *o;
     sp->level = level_of(o->want ? o->want : MECH_WANT_ALL);
-    int rc = mech_system_new(m, &sp->sys, d);
+    sp->sys = sys;
+    int rc = sys ? MECH_OK : mech_system_new(m, &sp->sys, d);
     if (rc != MECH_OK)
         return rc;
     sp->n = sp->sys->n;
-    sp->lref = largest_length(m);
+    sp->lref = solver_largest_length(m);
     if (!(sp->opt.tol > 0.0))
         sp->opt.tol = 1e-12;
     if (!(sp->opt.min_rcond > 0.0))

@@ -86,6 +86,12 @@ typedef struct solver {
 int solver_plan_init(solver_plan *sp, const mech_model *m, const mech_solve_options *o,
                      mech_diag *d);
 void solver_plan_free(solver_plan *sp);
+/* The same with a system built beforehand (SYS_NUMERIC or SYS_REGISTERS, of
+ * m), owned by the plan from here on, also when this fails; NULL: built
+ * here. The length scale lref of m (tolerances, slide steps). */
+int solver_plan_init_with(solver_plan *sp, const mech_model *m, const mech_solve_options *o,
+                          mech_system *sys, mech_diag *d);
+double solver_largest_length(const mech_model *m);
 
 /* A numeric state for the plan (allocates everything a step needs). */
 int solver_init(solver *sv, const solver_plan *sp);

@@ -18,6 +18,7 @@
 
 #include "columns.h"
 #include "diagnose.h"
+#include "variant_regs.h"
 
 struct mech_analysis {
     const mech_model *m;       /* borrowed: must outlive the analysis */
@@ -114,10 +115,10 @@ static int copy_outputs(mech_outputs *to, const mech_outputs *from)
     return 0;
 }
 
-static int build_plans(mech_analysis *a, mech_diag *d)
+static int build_plans(mech_analysis *a, mech_system *sys, mech_diag *d)
 {
     const mech_model *m = a->m;
-    int rc = solver_plan_init(&a->sp, m, &a->opt, d);
+    int rc = solver_plan_init_with(&a->sp, m, &a->opt, sys, d);
     if (rc == MECH_OK && a->want_forces)
         rc = forces_plan_init(&a->fp, &a->sp, a->opt.friction, d);
     if (rc == MECH_OK && a->want_forces && a->opt.log) {
@@ -139,17 +140,28 @@ static int build_plans(mech_analysis *a, mech_diag *d)
 int mech_analysis_new(const mech_model *m, const mech_solve_options *o, mech_analysis **out,
                       mech_diag *d)
 {
+    return analysis_new_with(m, o, NULL, out, d);
+}
+
+int analysis_new_with(const mech_model *m, const mech_solve_options *o, mech_system *sys,
+                      mech_analysis **out, mech_diag *d)
+{
     *out = NULL;
-    if (!m->has_driver)
+    if (!m->has_driver) {
+        mech_system_free(&sys);
         return diag_error(d, m->file, (mech_mark){0, 0}, "the mechanism has no driver");
+    }
     double t0 = now_seconds();
     mech_analysis *a = xcalloc(1, sizeof *a);
-    if (!a)
+    if (!a) {
+        mech_system_free(&sys);
         return no_memory(m, d);
+    }
     a->m = m;
     a->opt = *o;
     if (copy_outputs(&a->outputs, o->outputs ? o->outputs : &m->outputs) != 0) {
         free(a);
+        mech_system_free(&sys);
         return no_memory(m, d);
     }
     a->opt.outputs = &a->outputs;
@@ -158,7 +170,7 @@ int mech_analysis_new(const mech_model *m, const mech_solve_options *o, mech_ana
         a->opt.all_blocks = 1;
         a->opt.want = MECH_WANT_ALL;
     }
-    int rc = build_plans(a, d);
+    int rc = build_plans(a, sys, d);
     if (rc != MECH_OK) {
         mech_analysis_free(&a);
         return rc;
@@ -181,6 +193,73 @@ void mech_analysis_free(mech_analysis **pa)
     free(a);
     *pa = NULL;
 }
+
+/* ---- a variant's view of an analysis (variant_regs.h) --------------------- */
+
+/* What a view owns beside its copy of the analysis: the numbers the plans
+ * took from the model (the tape's register image with the coefficients,
+ * the slide step units, the link frames' attachment points). */
+typedef struct analysis_view {
+    mech_analysis a;           /* first: the view is used as an analysis */
+    mech_system sys;           /* the system's fields, its model the variant's */
+} analysis_view;
+
+mech_analysis *analysis_view_new(const mech_analysis *base, const mech_model *mv)
+{
+    analysis_view *v = xcalloc(1, sizeof *v);
+    if (!v)
+        return NULL;
+    mech_analysis *a = &v->a;
+    *a = *base;
+    v->sys = *base->sp.sys;
+    v->sys.model = mv;
+    a->m = mv;
+    solver_plan *sp = &a->sp;
+    sp->m = mv;
+    sp->sys = &v->sys;
+    sp->lref = solver_largest_length(mv);
+    sp->ftol = sp->opt.tol * sp->lref;
+    sp->tp.reg0 = xcalloc((size_t)sp->tp.nreg + 1, sizeof *sp->tp.reg0);
+    sp->unit = xcalloc((size_t)sp->ns + 1, sizeof *sp->unit);
+    int ok = sp->tp.reg0 && sp->unit && kin_tree_build(&sp->tree, &v->sys) == MECH_OK;
+    if (!ok) {  /* what is not the view's own is the base's: not freed */
+        free(sp->tp.reg0);
+        free(sp->unit);
+        free(v);
+        return NULL;
+    }
+    memcpy(sp->tp.reg0, base->sp.tp.reg0, (size_t)sp->tp.nreg * sizeof *sp->tp.reg0);
+    memcpy(sp->tree.active, base->sp.tree.active, (size_t)mv->nlinks);
+    for (int i = 0; i < sp->ns; i++)  /* as root_registers (solve.c) */
+        sp->unit[i] = v->sys.unk_kind[sp->col[i]] == UNK_SLIDE ? sp->lref : 1.0;
+    if (a->want_forces) {
+        a->fp.m = mv;  /* as forces_plan_init */
+        double qd = fabs(mv->driver.speed);
+        if (mv->driver.kind == MECH_DRIVE_SLIDER)
+            qd /= sp->lref;
+        a->fp.speed_eps = 1e-6 * (qd > 0.0 ? qd : 1.0);
+    }
+    return a;
+}
+
+void analysis_view_set(mech_analysis *view, int var, double value)
+{
+    tape_set_var(&view->sp.tp, view->sp.tp.reg0, var, value);
+}
+
+void analysis_view_free(mech_analysis **pv)
+{
+    if (!pv || !*pv)
+        return;
+    analysis_view *v = (analysis_view *)*pv;
+    free(v->a.sp.tp.reg0);
+    free(v->a.sp.unit);
+    kin_tree_free(&v->a.sp.tree);
+    free(v);
+    *pv = NULL;
+}
+
+const mech_system *analysis_system(const mech_analysis *a) { return a->sp.sys; }
 
 int mech_analysis_columns(const mech_analysis *a) { return a->cols.ncols; }
 

@@ -14,4 +14,8 @@
 int sweep_variant_solve(const char *file, const mech_override *ov, int nov, int forces,
                         mech_table *t, mech_model **model, mech_diag *d);
 
+/* How many variants were solved through the sweep's one analysis and how
+ * many were analysed on their own (re-analysed), since the process began. */
+void sweep_variant_counts(long *shared, long *alone);
+
 #endif

@@ -249,6 +249,10 @@ static void term_vector(mech_system *s, const loop_term *t, ex *x, ex *y)
         sys_cartesian_body(s, t, x, y);
         return;
     }
+    if (t->kind == TERM_BODY && s->mode == SYS_REGISTERS) {
+        sys_register_body(s, t, x, y);
+        return;
+    }
     if (t->kind == TERM_BODY && s->mode == SYS_NAMED) {
         sys_named_body(s, t, x, y);
         return;
@@ -473,6 +477,7 @@ void mech_system_free(mech_system **ps)
         for (int k = 0; k < s->nvars - SYS_NVARS(s->n); k++)
             free(s->coef_desc[k]);
     free(s->coef_desc);
+    free(s->coef);
     free(s->point_base);
     if (s->grad)
         pgrad_free(s->grad);

@@ -31,9 +31,20 @@ typedef enum {
     SYS_NAMED,     /* the lengths and angles of body vectors that depend on parameters
                       are named leaves: the parameter itself (`r`), or |AB| and <AB
                       defined in coef_desc (mech equations); not compiled */
-    SYS_CARTESIAN  /* each body vector written R(theta) (P1 - P0) with the points'
+    SYS_CARTESIAN, /* each body vector written R(theta) (P1 - P0) with the points'
                       coordinates as variables (sensitivity.c); not compiled */
+    SYS_REGISTERS  /* as SYS_NUMERIC, but the length and angle of a body vector that
+                      depend on a parameter are variables (sys_coef), set per variant
+                      in the registers (mech sweep: variant_regs.c); not compiled here,
+                      the solver plan compiles it */
 } sys_mode;
+
+/* SYS_REGISTERS: coefficient variable SYS_NVARS(n) + k is the length
+ * (is_angle 0) or the angle of the vector p0 -> p1 of link `link`. */
+typedef struct sys_coef {
+    int link, p0, p1;
+    int is_angle;
+} sys_coef;
 
 /* The parameters and d(point coordinates)/d(parameter), from seeded loads
  * (load_file_seeded): what SYS_NAMED needs to see which numbers depend on
@@ -95,6 +106,7 @@ struct mech_system {
                                   ("length of E - B in link 'tray' = 564.97 mm"), or NULL
                                   for a parameter */
     struct param_grad *grad;   /* owned by mech_system_new_named, or NULL */
+    sys_coef *coef;            /* [nvars - SYS_NVARS(n)] SYS_REGISTERS: the coefficients */
     tape tp;                   /* compiled evaluator of every row */
     double *reg;               /* [tp.nreg] its registers, for sys_eval_* (so those
                                   are not for threads sharing the system; the solver
@@ -110,6 +122,7 @@ int sys_new_with(const mech_model *m, sys_mode mode, const sys_params *params,
 int sys_coefficients_init(mech_system *s);
 void sys_named_body(mech_system *s, const loop_term *t, ex *x, ex *y);
 void sys_cartesian_body(mech_system *s, const loop_term *t, ex *x, ex *y);
+void sys_register_body(mech_system *s, const loop_term *t, ex *x, ex *y);
 
 /* Evaluation through the tape (no allocation). The velocity and
  * acceleration phases reuse the position phase's registers, so they must

@@ -296,3 +296,68 @@ int mech_system_new_named(const mech_model *m, mech_system **out, mech_diag *d)
     (*out)->grad = g;
     return MECH_OK;
 }
+
+/* ---- SYS_REGISTERS: the varied coefficients as register leaves ---------- */
+
+/* The variable of the length or angle of t's vector: one per vector and
+ * kind (a loop crossing the vector again finds it). */
+static ex register_leaf(mech_system *s, const loop_term *t, int is_angle)
+{
+    int k0 = SYS_NVARS(s->n), nc = s->nvars - k0;
+    for (int k = 0; k < nc; k++) {
+        const sys_coef *c = &s->coef[k];
+        if (c->link == t->link && c->p0 == t->p0 && c->p1 == t->p1 && c->is_angle == is_angle)
+            return expr_var(&s->ex, k0 + k);
+    }
+    sys_coef *grown = xrealloc_array(s->coef, (size_t)nc + 1, sizeof *grown);
+    if (!grown) {
+        s->ex.failed = 1;  /* the system build then fails: out of memory */
+        return s->ex.zero;
+    }
+    s->coef = grown;
+    s->coef[nc] = (sys_coef){t->link, t->p0, t->p1, is_angle};
+    return expr_var(&s->ex, s->nvars++);
+}
+
+/* As the numeric system's body vector r (cos, sin)(theta + a), with r
+ * and a leaves when they depend on one of the parameters (a nonzero
+ * derivative at the model's values; variant_regs.c checks every variant's
+ * other numbers against these and re-analyses a variant where they moved). */
+void sys_register_body(mech_system *s, const loop_term *t, ex *x, ex *y)
+{
+    expr_ctx *c = &s->ex;
+    const mech_link *l = &s->model->links[t->link];
+    double dx = l->points[t->p1].x - l->points[t->p0].x;
+    double dy = l->points[t->p1].y - l->points[t->p0].y;
+    double r = hypot(dx, dy), a = atan2(dy, dx);
+    int np = s->params->nparams;
+    double *dr = xcalloc((size_t)np + 1, sizeof *dr), *da = xcalloc((size_t)np + 1, sizeof *da);
+    if (!dr || !da) {
+        free(dr);
+        free(da);
+        c->failed = 1;
+        *x = *y = c->zero;
+        return;
+    }
+    body_gradient(s, t, dx, dy, dr, da);
+    int r_varies = 0, a_varies = 0;
+    for (int k = 0; k < np; k++) {
+        r_varies |= dr[k] != 0.0;
+        a_varies |= da[k] != 0.0;
+    }
+    free(dr);
+    free(da);
+    ex len = r_varies ? register_leaf(s, t, 0) : expr_const(c, r);
+    ex ang;
+    if (a_varies) {
+        ang = expr_add(c, s->link_angle[t->link], register_leaf(s, t, 1));
+    } else {
+        if (a == PI_ || a == -PI_) {  /* as the numeric system: -r (cos, sin)(theta) */
+            len = expr_neg(c, len);
+            a = 0.0;
+        }
+        ang = expr_add(c, s->link_angle[t->link], expr_const(c, a));
+    }
+    *x = expr_mul(c, len, expr_cos(c, ang));
+    *y = expr_mul(c, len, expr_sin(c, ang));
+}

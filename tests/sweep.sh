@@ -1,7 +1,8 @@
 #!/bin/sh
 # tests/sweep.sh: a sweep of 10 000 conveyor variants (100 under a sanitizer,
 # MECH_SANITIZE=1) completes, and its summary rows agree with solving a few
-# variants alone (`mech solve --set`); then the distributed recipe: shards
+# variants alone (`mech solve --set`), as every variant of a four-bar's
+# sweep does (one analysis per sweep: variant_regs.c); then the distributed recipe: shards
 # run as separate local processes in parallel (xargs -P, and GNU Parallel
 # when installed) and merged, equal to the unsharded run.
 # Run from the repository root:  MECH=build/mech sh tests/sweep.sh
@@ -50,6 +51,42 @@ for v in 0 $((total / 3)) $((total * 2 / 3 + 7)) $((total - 1)); do
         fail "variant $v (l1=$l1, l2=$l2): sweep says $swept, solving it alone gives $alone"
     fi
 done
+
+# a four-bar (the double crank, its dimensions as parameters): every variant
+# of a 3 x 3 sweep, solved through the sweep's one analysis, against solving
+# it alone with --set (range and largest of a position, a velocity and an
+# acceleration), to 1e-12 relative
+fb=mechanisms/double-crank.yaml
+fbm="--metric range:B.x --metric max:B.vy --metric maxabs:P.ax"
+if "$MECH" sweep $fb --vary l1=58mm:62mm:3 --vary l3=69mm:71mm:3 $fbm -o "$tmp/fb.csv" 2>"$tmp/err"; then
+    has_line "$tmp/err" "^mech sweep: 9 variants solved through the sweep's one analysis, 0 analysed on their own$" \
+        "double crank: every variant through the one analysis"
+    for v in 0 1 2 3 4 5 6 7 8; do
+        row=$(grep "^$v," "$tmp/fb.csv")
+        l1=$(echo "$row" | cut -d, -f2)
+        l3=$(echo "$row" | cut -d, -f3)
+        if ! "$MECH" solve $fb --set "l1=${l1}m" --set "l3=${l3}m" -o "$tmp/one.csv" 2>"$tmp/err"; then
+            fail "double crank, mech solve --set l1=${l1}m --set l3=${l3}m: $(head -n 1 "$tmp/err")"
+            continue
+        fi
+        bx=$(column "$tmp/one.csv" B.x)
+        bvy=$(column "$tmp/one.csv" B.vy)
+        pax=$(column "$tmp/one.csv" P.ax)
+        alone=$(awk -F, -v e="$bx" -v w="$bvy" -v a="$pax" 'NR > 1 {
+                if (NR == 2 || $e < lo) lo = $e; if (NR == 2 || $e > hi) hi = $e
+                if (NR == 2 || $w > wmax) wmax = $w
+                x = $a < 0 ? -$a : $a; if (x > big) big = x }
+            END { printf "%.17g %.17g %.17g", hi - lo, wmax, big }' "$tmp/one.csv")
+        swept=$(echo "$row" | awk -F, '{ printf "%.17g %.17g %.17g", $6, $7, $8 }')
+        if echo "$alone $swept" | awk '{ exit !(($1 - $4)^2 <= (1e-12 * $1)^2 && ($2 - $5)^2 <= (1e-12 * $2)^2 && ($3 - $6)^2 <= (1e-12 * $3)^2) }'; then
+            pass
+        else
+            fail "double crank variant $v (l1=$l1, l3=$l3): sweep says $swept, solving it alone gives $alone"
+        fi
+    done
+else
+    fail "mech sweep of 9 double-crank variants: $(head -n 3 "$tmp/err")"
+fi
 
 # the distributed recipe with local workers: M shards as separate
 # processes, joined by mech merge (which checks their manifests)

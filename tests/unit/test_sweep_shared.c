@@ -1,0 +1,288 @@
+/* tests/unit/test_sweep_shared.c: one analysis per sweep (variant_regs.c).
+ * Every variant solved through the sweep's shared analysis
+ * (sweep_variant_solve) against the same parameters loaded and solved on
+ * their own (mech_load_file_with + mech_check + mech_solve, i.e. `mech
+ * solve --set`): every column of every row to 1e-12 of the column's size;
+ * and that the variants did go through the shared analysis (or were
+ * re-analysed when their structure changes); every parameter of every file
+ * in mechanisms/ likewise. */
+#include <criterion/criterion.h>
+#include <math.h>
+#include <stdarg.h>
+#include <glob.h>
+#include <sys/wait.h>
+#include <unistd.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "helpers.h"
+#include "sweep_variants.h"
+
+static void note_hard(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+static void note_hard(const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    note_tagged("sweep_shared", fmt, ap);
+    va_end(ap);
+}
+
+/* A four-bar with its dimensions as parameters, masses and a polar coupler
+ * point (its angle stays 30 deg when p changes: a folded number that must
+ * stay equal), and a slider guide angle as a parameter (alpha: folded). */
+static const char FOURBAR[] =
+    "name: parametric four-bar\n"
+    "units: {length: mm, angle: deg}\n"
+    "parameters:\n"
+    "  a: 20 mm\n  b: 60 mm\n  c: 50 mm\n  d: 70 mm\n  p: 40 mm\n  m2: 0.1 kg\n"
+    "ground: {O: [0, 0], C: [d, 0]}\n"
+    "links:\n"
+    "  crank: {points: {O: [0, 0], A: [a, 0]}, mass: 0.05 kg, center: [10, 0],"
+    " inertia: 2e-6 kg*m^2}\n"
+    "  coupler:\n"
+    "    points: {A: [0, 0], B: [b, 0], P: {length: p, angle: 30}}\n"
+    "    mass: m2\n    center: [b/2, 5]\n    inertia: 3e-5 kg*m^2\n"
+    "  rocker: {points: {C: [0, 0], B: [c, 0]}, mass: 0.08 kg, center: [c/2, 0],"
+    " inertia: 2e-5 kg*m^2}\n"
+    "driver: {link: crank, angle: {from: 0, to: 360, steps: 72}, speed: 10 rad/s}\n"
+    "initial: {coupler: 40, rocker: 100}\n"
+    "branch:\n  - {points: [A, B, C], turn: cw}\n"
+    "outputs: {points: [A, B, P], links: [crank, coupler, rocker], forces: true}\n";
+
+static const char *write_temp(const char *text)
+{
+    static char path[64];
+    snprintf(path, sizeof path, "/tmp/mech-test-shared-%d.yaml", (int)getpid());
+    FILE *f = fopen(path, "w");
+    cr_assert_not_null(f);
+    fputs(text, f);
+    fclose(f);
+    return path;
+}
+
+/* The largest difference of the two tables, relative to each column's
+ * largest magnitude (the columns of the reference); rows must match. The
+ * power balance's residual (already relative, rounding noise of 1e-14) is
+ * compared absolutely. */
+static double table_difference(const mech_table *got, const mech_table *want)
+{
+    cr_assert_eq(got->nrows, want->nrows, "rows %d, alone %d", got->nrows, want->nrows);
+    cr_assert_eq(got->ncolumns, want->ncolumns);
+    double worst = 0.0;
+    for (int c = 0; c < want->ncolumns; c++) {
+        double scale = 0.0;
+        for (int i = 0; i < want->nrows; i++)
+            scale = fmax(scale, fabs(mech_table_get(want, i, c)));
+        if (ends_with(want->columns[c].name, ".residual"))
+            scale = 1.0;
+        for (int i = 0; i < want->nrows; i++) {
+            double e = fabs(mech_table_get(got, i, c) - mech_table_get(want, i, c));
+            double rel = scale > 0.0 ? e / scale : e;
+            if (rel > worst) {
+                worst = rel;
+                if (rel > 1e-12 && getenv("MECH_HARD_VERBOSE"))
+                    fprintf(stderr, "column %s row %d: %.17g, alone %.17g\n",
+                            want->columns[c].name, i, mech_table_get(got, i, c),
+                            mech_table_get(want, i, c));
+            }
+        }
+    }
+    return worst;
+}
+
+/* Each variant (texts[k][i] for parameter names[k], nvar variants) solved
+ * both ways; returns the largest relative difference over all variants. */
+static double compare_variants(const char *file, const char *const *names, int nnames,
+                               const char *const *texts, int nvar, int forces)
+{
+    double worst = 0.0;
+    for (int v = 0; v < nvar; v++) {
+        mech_override ov[8];
+        for (int k = 0; k < nnames; k++)
+            ov[k] = (mech_override){names[k], texts[v * nnames + k]};
+        mech_diag d;
+        mech_diag_init(&d);
+        mech_table shared = {0}, alone = {0};
+        int rc1 = sweep_variant_solve(file, ov, nnames, forces, &shared, NULL, &d);
+        mech_model *m = NULL;
+        mech_summary s;
+        int rc2 = mech_load_file_with(file, ov, nnames, &m, &d);
+        if (rc2 == MECH_OK)
+            rc2 = mech_check(m, &s, &d);
+        if (rc2 == MECH_OK) {
+            mech_solve_options o;
+            mech_solve_options_default(&o);
+            o.forces = forces;
+            rc2 = mech_solve(m, &o, &alone, NULL, &d);
+        }
+        if (rc1 != rc2)
+            mech_diag_print(&d, stderr);
+        cr_assert_eq(rc1, rc2, "variant %d: status %d through the shared analysis, %d alone",
+                     v, rc1, rc2);
+        double e = table_difference(&shared, &alone);
+        worst = fmax(worst, e);
+        cr_expect_leq(e, 1e-12, "variant %d (%s=%s): relative difference %.3g", v, names[0],
+                      texts[v * nnames], e);
+        mech_table_free(&shared);
+        mech_table_free(&alone);
+        mech_model_free(&m);
+        mech_diag_free(&d);
+    }
+    return worst;
+}
+
+Test(sweep_shared, conveyor_every_variant_as_solved_alone)
+{
+    static const char *const names[] = {"l1", "l2", "a"};
+    enum { NV = 24 };
+    static char buf[NV][3][32];
+    const char *texts[NV * 3];
+    for (int v = 0; v < NV; v++) {
+        snprintf(buf[v][0], 32, "%.10g mm", 50.0 + 14.0 * (v % 6) / 5.0);
+        snprintf(buf[v][1], 32, "%.10g mm", 420.0 + 5.0 * (v / 6));
+        snprintf(buf[v][2], 32, "%.10g mm", 45.0 + v % 4);
+        for (int k = 0; k < 3; k++)
+            texts[v * 3 + k] = buf[v][k];
+    }
+    double e = compare_variants("mechanisms/conveyor.yaml", names, 3, texts, NV, 1);
+    long shared, alone;
+    sweep_variant_counts(&shared, &alone);
+    cr_assert_eq(shared, NV, "%ld of %d variants through the shared analysis (%ld alone)",
+                 shared, NV, alone);
+    note_hard("conveyor: %d variants, largest relative difference %.3g", NV, e);
+}
+
+Test(sweep_shared, offset_slider_crank_every_variant)
+{
+    static const char *const names[] = {"r", "l", "e"};
+    static const char *const texts[] = {"40 mm", "120 mm", "30 mm", "35 mm", "110 mm", "0 mm",
+                                        "45 mm", "150 mm", "-20 mm", "30.5 mm", "99 mm", "12 mm"};
+    double e = compare_variants("mechanisms/offset-slider-crank.yaml", names, 3, texts, 4, 0);
+    long shared, alone;
+    sweep_variant_counts(&shared, &alone);
+    /* e = 0 makes the ground vector O -> G of length 0 (its terms vanish from
+       the numeric system), e = -20 mm turns its angle from +90 to -90 deg (a
+       folded number: its derivative by e is 0): both are analysed alone */
+    cr_assert_eq(shared, 2, "%ld through the shared analysis, %ld alone", shared, alone);
+    cr_assert_eq(alone, 2, "%ld through the shared analysis, %ld alone", shared, alone);
+    note_hard("offset slider-crank: largest relative difference %.3g", e);
+}
+
+Test(sweep_shared, fourbar_every_variant_with_forces)
+{
+    const char *file = write_temp(FOURBAR);
+    static const char *const names[] = {"a", "b", "c", "d", "p", "m2"};
+    enum { NV = 16 };
+    static char buf[NV][6][32];
+    const char *texts[NV * 6];
+    for (int v = 0; v < NV; v++) {
+        snprintf(buf[v][0], 32, "%g mm", 18.0 + (v % 4));
+        snprintf(buf[v][1], 32, "%g mm", 58.0 + 2.0 * (v / 4));
+        snprintf(buf[v][2], 32, "%g mm", 50.0 + 0.5 * v);
+        snprintf(buf[v][3], 32, "%g mm", 70.0 - 0.25 * v);
+        snprintf(buf[v][4], 32, "%g mm", 30.0 + 1.5 * v);
+        snprintf(buf[v][5], 32, "%g kg", 0.1 + 0.01 * v);
+        for (int k = 0; k < 6; k++)
+            texts[v * 6 + k] = buf[v][k];
+    }
+    double e = compare_variants(file, names, 6, texts, NV, 1);
+    long shared, alone;
+    sweep_variant_counts(&shared, &alone);
+    remove(file);
+    cr_assert_eq(shared, NV, "%ld through the shared analysis, %ld alone", shared, alone);
+    note_hard("four-bar: largest relative difference %.3g", e);
+}
+
+/* A variant whose structure differs from the base (here: a mass of 0, so
+ * "nothing loads" may change; a crank too long to assemble everywhere) is
+ * analysed on its own, with the same result as solving it alone. */
+Test(sweep_shared, structure_changes_are_reanalysed)
+{
+    const char *file = write_temp(FOURBAR);
+    static const char *const names[] = {"m2", "a"};
+    static const char *const texts[] = {"0 kg", "20 mm", "0.2 kg", "20 mm", "0.2 kg", "45 mm"};
+    compare_variants(file, names, 2, texts, 3, 1);
+    long shared, alone;
+    sweep_variant_counts(&shared, &alone);
+    remove(file);
+    cr_assert_eq(shared, 1, "%ld through the shared analysis, %ld alone", shared, alone);
+    cr_assert_eq(alone, 2, "%ld through the shared analysis, %ld alone", shared, alone);
+}
+
+/* Every parameter of every mechanism in mechanisms/, at 0.97, 1.01 and 1.03
+ * times its value, with forces: the same status and every column to 1e-12.
+ * One child process per parameter (a process keeps one sweep's analysis);
+ * its exit status is the number of variants solved through the shared
+ * analysis, or 100 for a difference. */
+static int parameter_child(const char *file, const mech_param *p)
+{
+    static const double factor[] = {0.97, 1.01, 1.03};
+    for (int k = 0; k < 3; k++) {
+        char text[64];
+        snprintf(text, sizeof text, "%.17g %s", p->value * factor[k], p->unit);
+        mech_override ov = {p->name, text};
+        mech_diag d;
+        mech_diag_init(&d);
+        mech_table shared = {0}, alone = {0};
+        int rc1 = sweep_variant_solve(file, &ov, 1, 1, &shared, NULL, &d);
+        mech_model *m = NULL;
+        mech_summary s;
+        int rc2 = mech_load_file_with(file, &ov, 1, &m, &d);
+        if (rc2 == MECH_OK)
+            rc2 = mech_check(m, &s, &d);
+        if (rc2 == MECH_OK) {
+            mech_solve_options o;
+            mech_solve_options_default(&o);
+            o.forces = 1;
+            rc2 = mech_solve(m, &o, &alone, NULL, &d);
+        }
+        int same = rc1 == rc2 && shared.nrows == alone.nrows &&
+                   shared.ncolumns == alone.ncolumns;
+        double e = same ? table_difference(&shared, &alone) : INFINITY;
+        if (!(e <= 1e-12))
+            fprintf(stderr, "%s, %s = %s: status %d and %d, difference %.3g\n", file, p->name,
+                    text, rc1, rc2, e);
+        mech_table_free(&shared);
+        mech_table_free(&alone);
+        mech_model_free(&m);
+        mech_diag_free(&d);
+        if (!(e <= 1e-12))
+            return 100;
+    }
+    long shared, alone;
+    sweep_variant_counts(&shared, &alone);
+    return (int)shared;
+}
+
+Test(sweep_shared, every_parameter_of_every_mechanism)
+{
+    glob_t g;
+    cr_assert_eq(glob("mechanisms/*.yaml", 0, NULL, &g), 0);
+    int variants = 0, through = 0;
+    for (size_t i = 0; i < g.gl_pathc; i++) {
+        mech_model *m = load_path(g.gl_pathv[i]);
+        for (int k = 0; k < m->nparams; k++) {
+            fflush(NULL);
+            pid_t pid = fork();
+            cr_assert_geq(pid, 0);
+            if (pid == 0)
+                _exit(parameter_child(g.gl_pathv[i], &m->params[k]));
+            int status = 0;
+            waitpid(pid, &status, 0);
+            cr_assert(WIFEXITED(status) && WEXITSTATUS(status) <= 3,
+                      "%s, parameter %s: a variant differs from solving it alone",
+                      g.gl_pathv[i], m->params[k].name);
+            variants += 3;
+            through += WEXITSTATUS(status);
+        }
+        mech_model_free(&m);
+    }
+    globfree(&g);
+    /* the others: a variant that does not assemble, a slider's angle, a
+       point moved off its line (docs/batch.md, "One analysis per sweep") */
+    cr_assert_geq(through, variants * 8 / 10, "%d of %d variants through the shared analysis",
+                  through, variants);
+    note_hard("%d variants of every parameter of every mechanism, %d through the shared "
+              "analysis", variants, through);
+}
