@@ -239,14 +239,8 @@ static sval dotted(sparser *sp, const char *at, size_t n, const char *mem, size_
         }
         return input(sp, lm->kind, li, lm->q);
     }
-    if (jm && jt >= 0) {
-        if (m->joints[jt].kind != MECH_JOINT_SLIDER) {
-            sfail(sp, at, "'%s' is a revolute joint: only a slider has '%.*s' (a point has x, y, "
-                          "vx, vy, ax, ay)", name, (int)mlen, mem);
-            return fail_val();
-        }
+    if (jm && jt >= 0 && m->joints[jt].kind == MECH_JOINT_SLIDER)
         return input(sp, jm->kind, jt, jm->q);
-    }
     /* the name is something, but not with that member */
     const member *ms = pt >= 0 ? point_members : li >= 0 ? link_members : jt >= 0 ? slider_members
                                                                               : NULL;
