@@ -16,6 +16,7 @@
 #include <string.h>
 
 #include "helpers.h"
+#include "state_loads.h"
 
 static const double PI = 3.14159265358979323846;
 
@@ -351,4 +352,35 @@ Test(state_loads, driver_members)
     }
     mech_table_free(&t);
     mech_model_free(&m);
+}
+
+/* ---- mechanisms/shaper.yaml: the cut by virtual work -------------------- */
+
+/* The same file without its cutting load has the same motion; the driver
+ * torque differs by the cut's power over the crank speed, -F . vT / w, with
+ * F = (Fc, Ft) while the tool cuts (ram moving -x over 0 < x_C < 100 mm). */
+Test(state_loads, shaper_cut_by_virtual_work)
+{
+    mech_model *m = load_path("mechanisms/shaper.yaml");
+    mech_model *bare = load_path("mechanisms/shaper.yaml");
+    cr_assert_not_null(bare->state_loads);
+    state_loads_free(bare->state_loads);
+    bare->state_loads = NULL;
+    mech_table t = solve_forces(m, 0), u = solve_forces(bare, 0);
+    double w = m->driver.speed;
+    int cutting = 0;
+    for (int i = 0; i < t.nrows; i++) {
+        double s = table_at(&t, i, "x_C.s"), v = table_at(&t, i, "x_C.v");
+        double c = (v < 0 && s > 0 && s < 0.1) ? 1.0 : 0.0;
+        double p = 400.0 * c * table_at(&t, i, "T.vx") + 100.0 * c * table_at(&t, i, "T.vy");
+        double dT = table_at(&t, i, "driver.torque") - table_at(&u, i, "driver.torque");
+        cr_assert(fabs(dT + p / w) < 1e-11, "row %d: torque difference %.17g, -P/w %.17g", i, dT,
+                  -p / w);
+        cutting += c > 0;
+    }
+    cr_assert_eq(cutting, 162, "the tool cuts on rows 9 .. 170 deg");
+    mech_table_free(&t);
+    mech_table_free(&u);
+    mech_model_free(&m);
+    mech_model_free(&bare);
 }
