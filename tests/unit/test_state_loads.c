@@ -384,3 +384,52 @@ Test(state_loads, shaper_cut_by_virtual_work)
     mech_model_free(&m);
     mech_model_free(&bare);
 }
+
+/* ---- mechanisms/stirling-gas.yaml: the Schmidt gas forces ---------------- */
+
+/* The pressure of the file's Schmidt model, computed here from the two
+ * slides (docs/stirling-gas.md): bore 40 mm, rod 8 mm, H = 13 cm, hp = 4 cm,
+ * Te 600, Tc 300, Tr 432.81, dead volumes 10, 5 and 20 cm^3, m R = 1 bar *
+ * 100 cm^3 / 300. *vol gets the working volume. */
+static double schmidt(double r3, double r9, double *vol)
+{
+    double A = PI / 4 * 0.04 * 0.04, Ar = PI / 4 * 0.008 * 0.008, mR = 1e5 * 100e-6 / 300;
+    double vc = (A - Ar) * (0.13 - 0.04 - r9 - r3) + 5e-6, ve = A * r9 + 10e-6, vr = 20e-6;
+    *vol = vc + ve + vr;
+    return mR / (vc / 300 + vr / 432.81 + ve / 600);
+}
+
+/* Without its gas loads the engine has the same motion; the driver torque
+ * differs by -(F . v)/w at the piston D and the displacer L. Over the turn
+ * the driver takes out the gas's cycle work, the integral of p dV. */
+Test(state_loads, stirling_gas_by_virtual_work_and_cycle_work)
+{
+    mech_model *m = load_path("mechanisms/stirling-gas.yaml");
+    mech_model *bare = load_path("mechanisms/stirling-gas.yaml");
+    state_loads_free(bare->state_loads);
+    bare->state_loads = NULL;
+    mech_table t = solve_forces(m, 0), u = solve_forces(bare, 0);
+    double w = m->driver.speed, A = PI / 4 * 0.04 * 0.04, Ar = PI / 4 * 0.008 * 0.008;
+    double work = 0, drive = 0, pv = 0, vv = 0;
+    for (int i = 0; i < t.nrows; i++) {
+        double v, p = schmidt(table_at(&t, i, "r3.s"), table_at(&t, i, "r9.s"), &v);
+        double fd = -(p - 1e5) * (A - Ar), fl = -(p - 1e5) * Ar;
+        double pw = fd * table_at(&t, i, "D.vy") + fl * table_at(&t, i, "L.vy");
+        double dT = table_at(&t, i, "driver.torque") - table_at(&u, i, "driver.torque");
+        cr_assert(fabs(dT + pw / w) < 1e-10, "row %d: torque difference %.17g, -P/w %.17g", i, dT,
+                  -pw / w);
+        if (i > 0) {  /* trapezoids over the turn */
+            double h = table_at(&t, i, "q") - table_at(&t, i - 1, "q");
+            work += 0.5 * (p + pv) * (v - vv);
+            drive += 0.5 * h * (table_at(&t, i, "driver.torque") + table_at(&t, i - 1, "driver.torque"));
+        }
+        pv = p, vv = v;
+    }
+    /* 2.0437 J a turn; the two trapezoid sums agree to O(h^2) */
+    cr_assert(work > 2.0 && work < 2.1, "cycle work %g J", work);
+    cr_assert(fabs(drive + work) < 1e-3 * work, "driver %g J a turn, gas %g J", drive, work);
+    mech_table_free(&t);
+    mech_table_free(&u);
+    mech_model_free(&m);
+    mech_model_free(&bare);
+}
