@@ -3,6 +3,7 @@
  * made), running it once per step from the solved motion, and applying the
  * loads to the force rows and to the power balance. */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -245,4 +246,15 @@ double state_loads_power(const state_loads *s, const solver *sv, const double *r
         *scale += fabs(pw);
     }
     return total;
+}
+
+void state_loads_describe(const mech_model *m, int i, char *buf, size_t size)
+{
+    const sl_load *l = &m->state_loads->loads[i];
+    const mech_link *k = &m->links[l->link];
+    if (l->torque)
+        snprintf(buf, size, "torque on link '%s', depends on the motion", k->name);
+    else
+        snprintf(buf, size, "force at %s on link '%s', depends on the motion",
+                 k->points[l->point].name, k->name);
 }

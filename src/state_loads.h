@@ -86,6 +86,8 @@ void state_loads_add(const state_loads *s, const solver *sv, const double *reg, 
  * velocities); *scale gets the size terms for the relative residual. */
 double state_loads_power(const state_loads *s, const solver *sv, const double *reg,
                          double *scale);
+/* Load i in words, as mech check shows it: "force at T on link 'ram'". */
+void state_loads_describe(const mech_model *m, int i, char *buf, size_t size);
 /* The values of load i: fx, fy (or torque, 0). */
 void state_loads_value(const state_loads *s, const double *reg, int i, double *f0, double *f1);
 
