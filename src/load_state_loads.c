@@ -37,6 +37,7 @@ typedef struct sparser {
     int failed;
     int depth;
     int uses_state;  /* a dotted name or a function units.c does not know was seen */
+    int nomem;       /* an allocation failed */
 } sparser;
 
 static const dim NONE = {{0, 0, 0, 0}};
@@ -113,7 +114,7 @@ static int emit(sparser *sp, int op, int a, int b, int k)
         return -1;
     int r = sl_emit(sp->s, op, a, b, k);
     if (r < 0)
-        sfail(sp, sp->p, "out of memory");
+        sp->nomem = 1, sfail(sp, sp->p, "out of memory");
     return r;
 }
 
@@ -121,7 +122,7 @@ static int constant(sparser *sp, double v)
 {
     int r = sl_const(sp->s, v);
     if (r < 0)
-        sfail(sp, sp->p, "out of memory");
+        sp->nomem = 1, sfail(sp, sp->p, "out of memory");
     return r;
 }
 
@@ -193,7 +194,7 @@ static sval input(sparser *sp, int kind, int index, quantity q)
 {
     int r = sl_input_reg(sp->s, kind, index);
     if (r < 0)
-        sfail(sp, sp->p, "out of memory");
+        sp->nomem = 1, sfail(sp, sp->p, "out of memory");
     return (sval){r, quantity_get(q)->d, 0};
 }
 
@@ -581,9 +582,13 @@ static int component(loader *ld, const ynode *n, quantity q, const char *what)
     char msg[256];
     size_t pos;
     double v;
-    if (quantity_eval(n->text, q, &ld->env, &v, msg, sizeof msg, &pos) == 0)
-        return sl_const(s, v);
-    sparser sp = {ld, s, n->text, n->text, "", 0, 0, 0, 0};
+    if (quantity_eval(n->text, q, &ld->env, &v, msg, sizeof msg, &pos) == 0) {
+        int r = sl_const(s, v);
+        if (r < 0)
+            load_err(ld, n, "out of memory");
+        return r;
+    }
+    sparser sp = {ld, s, n->text, n->text, "", 0, 0, 0, 0, 0};
     sval r = parse_expr(&sp);
     sp.p = skip_space(sp.p);
     if (!sp.failed && *sp.p != '\0')
@@ -599,6 +604,8 @@ static int component(loader *ld, const ynode *n, quantity q, const char *what)
     }
     if (!sp.failed && r.reg >= 0)
         return r.reg;
+    if (sp.nomem)
+        return load_err(ld, n, "out of memory"), -1;
     if (!sp.uses_state) {  /* nothing of the motion: units.c's own message */
         load_get_quantity(ld, n, q, what, &v);
         return -1;

@@ -16,6 +16,7 @@
 #include <string.h>
 
 #include "helpers.h"
+#include "internal.h"
 #include "state_loads.h"
 
 static const double PI = 3.14159265358979323846;
@@ -432,4 +433,49 @@ Test(state_loads, stirling_gas_by_virtual_work_and_cycle_work)
     mech_table_free(&u);
     mech_model_free(&m);
     mech_model_free(&bare);
+}
+
+/* ---- out of memory ------------------------------------------------------ */
+
+/* Every allocation of loading a file with a motion-dependent force and
+ * torque made to fail in turn: the load either fails with "out of memory"
+ * or gives the whole model, its loads included (never a model without
+ * them), and never crashes (it did, before nearest_name skipped a name
+ * whose copy had failed: util.c). */
+Test(state_loads, out_of_memory_while_loading)
+{
+    static char text[4096];
+    snprintf(text, sizeof text, SC, "", "", "", "",
+             "loads:\n"
+             "  - {force: [\"-5 N * step(B.vx) + 1 N*s/m * abs(x_B.v)\", 2 N], at: B, link: piston}\n"
+             "  - {torque: -2 N*m*s/rad * crank.omega * tanh(rod.angle / 1 rad), link: crank}\n");
+    long failures = 0;
+    for (long k = 1; k < 1000000; k++) {
+        mech_diag d;
+        mech_diag_init(&d);
+        mech_model *m = NULL;
+        xalloc_fail_countdown = k;
+        int rc = mech_load_string(text, strlen(text), "s.yaml", &m, &d);
+        int failed = xalloc_fail_countdown == 0;
+        xalloc_fail_countdown = 0;
+        if (!failed) {
+            cr_assert_eq(rc, MECH_OK);
+            cr_assert(m->state_loads && m->state_loads->nloads == 2);
+            mech_model_free(&m);
+            mech_diag_free(&d);
+            break;
+        }
+        failures++;
+        if (rc == MECH_OK) {  /* a failure that was recovered from must not lose a load */
+            cr_assert(m->state_loads && m->state_loads->nloads == 2, "k = %ld", k);
+            mech_model_free(&m);
+        } else {
+            int oom = 0;
+            for (size_t i = 0; i < d.count; i++)
+                oom |= strstr(d.entries[i].message, "out of memory") != NULL;
+            cr_assert(oom, "k = %ld: failed without 'out of memory'", k);
+        }
+        mech_diag_free(&d);
+    }
+    cr_assert_gt(failures, 250);
 }
