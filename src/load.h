@@ -134,6 +134,8 @@ void load_default_outputs(mech_model *m);
  *      constant quantity; load_state_load compiles them into m->state_loads. */
 int load_state_wanted(loader *ld, const ynode *value);
 void load_state_load(loader *ld, const ynode *map, const ynode *value, int link, int point);
+/* {force: TENSION, between: [P, Q], links: [a, b]}: a force along a line. */
+void load_state_line(loader *ld, const ynode *map);
 
 /* ---- load_springs.c: springs and dampers. */
 void load_springs(loader *ld, const ynode *seq);

@@ -57,9 +57,11 @@ static int keys_apply(loader *ld, const ynode *map, int kind)
 static void load_one_load(loader *ld, const ynode *map, mech_load *l)
 {
     static const char *const keys[] = {"force", "torque", "distributed", "link", "at",
-                                       "from", "to", "direction"};
+                                       "from", "to", "direction", "between", "links"};
     if (!load_check_keys(ld, map, keys, COUNT(keys), "a load"))
         return;
+    if (ymap_get(map, "between") || ymap_get(map, "links"))
+        return load_state_line(ld, map);  /* a force along a line (load_state_loads.c) */
     const ynode *f = ymap_get(map, "force"), *t = ymap_get(map, "torque"),
                 *dl = ymap_get(map, "distributed");
     if ((f != NULL) + (t != NULL) + (dl != NULL) != 1)

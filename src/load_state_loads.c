@@ -662,3 +662,73 @@ void load_state_load(loader *ld, const ynode *map, const ynode *value, int link,
     if (sl_add_load(ld->m->state_loads, &l) < 0)
         load_err(ld, map, "out of memory");
 }
+
+/* ---- a force along a line ------------------------------------------ */
+
+/* The carriers of end k: links[k] when given (it must carry the point),
+ * else every link with the point, in file order. */
+static int line_end_links(loader *ld, const ynode *links, int k, int id, const ynode *pnode,
+                          int *cand, int max)
+{
+    if (links) {
+        int li = load_find_link_or_report(ld, links->items[k], "loaded link");
+        if (li < 0)
+            return -1;
+        if (load_point_in_link(ld, li, id) < 0)
+            return load_err(ld, pnode, "link '%s' has no point '%s'", ld->m->links[li].name,
+                            pnode->text), -1;
+        cand[0] = li;
+        return 1;
+    }
+    int first, end, n = 0;
+    load_carriers_of(ld, id, &first, &end);
+    for (int c = first; c < end && n < max; c++)
+        cand[n++] = ld->carrier_link[c];
+    return n;
+}
+
+void load_state_line(loader *ld, const ynode *map)
+{
+    static const char *const not_here[] = {"torque", "distributed", "link", "at", "from", "to",
+                                           "direction"};
+    for (size_t i = 0; i < COUNT(not_here); i++) {
+        const ynode *k = load_key_of(map, not_here[i]);
+        if (k)
+            return (void)load_err(ld, k, "'%s' does not apply to a force along a line "
+                                         "('between:')", not_here[i]);
+    }
+    const ynode *f = ymap_get(map, "force"), *btw = ymap_get(map, "between"),
+                *links = ymap_get(map, "links");
+    if (!btw)
+        return (void)load_err(ld, map, "'links' needs 'between: [P, Q]' (a force along a line)");
+    if (!f)
+        return (void)load_err(ld, map, "a load 'between' two points needs 'force: TENSION'");
+    if (!load_want_kind(ld, f, YNODE_SCALAR, "force along a line (one value, tension positive)") ||
+        !load_want_kind(ld, btw, YNODE_SEQ, "'between'"))
+        return;
+    if (btw->n != 2)
+        return (void)load_err(ld, btw, "'between' needs two points, [P, Q]");
+    if (links && !load_want_kind(ld, links, YNODE_SEQ, "'links'"))
+        return;
+    if (links && links->n != 2)
+        return (void)load_err(ld, links, "'links' needs two links, [a, b]");
+    int id[2], cand[2][8], n[2];
+    for (int k = 0; k < 2; k++) {
+        id[k] = load_find_point_or_report(ld, btw->items[k], "load end");
+        n[k] = id[k] < 0 ? -1 : line_end_links(ld, links, k, id[k], btw->items[k], cand[k], 8);
+    }
+    int reg = component(ld, f, Q_FORCE, "force");
+    if (n[0] <= 0 || n[1] <= 0 || reg < 0)
+        return;
+    for (int a = 0; a < n[0]; a++)
+        for (int b = 0; b < n[1]; b++)
+            if (cand[0][a] != cand[1][b]) {
+                sl_load l = {2, cand[0][a], load_point_in_link(ld, cand[0][a], id[0]), {reg, -1},
+                             map->mark, cand[1][b], load_point_in_link(ld, cand[1][b], id[1])};
+                if (sl_add_load(ld->m->state_loads, &l) < 0)
+                    load_err(ld, map, "out of memory");
+                return;
+            }
+    load_err(ld, btw, "both ends are on link '%s': a force between them does nothing; attach "
+                      "it between two links", ld->m->links[cand[0][0]].name);
+}

@@ -182,11 +182,31 @@ void state_loads_eval(const state_loads *s, const solver *sv, double *reg)
     }
 }
 
-void state_loads_value(const state_loads *s, const double *reg, int i, double *f0, double *f1)
+static void point_motion(const solver *sv, int l, int i, double *p, double *v);
+
+void state_loads_line(const sl_load *l, const solver *sv, double p[2][2], double v[2][2],
+                      double u[2], double *length, double *rate)
 {
-    const sl_load *l = &s->loads[i];
-    *f0 = reg[l->reg[0]];
-    *f1 = l->torque ? 0.0 : reg[l->reg[1]];
+    point_motion(sv, l->link, l->point, p[0], v[0]);
+    point_motion(sv, l->link2, l->point2, p[1], v[1]);
+    double d[2] = {p[1][0] - p[0][0], p[1][1] - p[0][1]};
+    *length = hypot(d[0], d[1]);
+    u[0] = *length > 0.0 ? d[0] / *length : 1.0;
+    u[1] = *length > 0.0 ? d[1] / *length : 0.0;
+    *rate = u[0] * (v[1][0] - v[0][0]) + u[1] * (v[1][1] - v[0][1]);
+}
+
+/* A known load (force f at p, moment t) on link l, on its three rows. */
+static void add_load(double *rhs, const double *g, int l, const double *p, const double *f,
+                     double t)
+{
+    if (l == 0)
+        return;
+    double r[2] = {p[0] - g[2 * l], p[1] - g[2 * l + 1]};
+    double *row = rhs + 3 * (l - 1);
+    row[0] -= f[0];
+    row[1] -= f[1];
+    row[2] -= r[0] * f[1] - r[1] * f[0] + t;
 }
 
 static void point_motion(const solver *sv, int l, int i, double *p, double *v)
@@ -201,19 +221,22 @@ void state_loads_add(const state_loads *s, const solver *sv, const double *reg, 
 {
     if (!s)
         return;
+    static const double none[2] = {0.0, 0.0};
     for (int i = 0; i < s->nloads; i++) {
         const sl_load *l = &s->loads[i];
-        double *row = rhs + 3 * (l->link - 1);
-        if (l->torque) {
-            row[2] -= reg[l->reg[0]];
-            continue;
+        if (l->torque == 1) {
+            add_load(rhs, g, l->link, none, none, reg[l->reg[0]]);
+        } else if (l->torque == 2) {
+            double p[2][2], v[2][2], u[2], len, rate, t = reg[l->reg[0]];
+            state_loads_line(l, sv, p, v, u, &len, &rate);
+            double f[2] = {t * u[0], t * u[1]}, fb[2] = {-f[0], -f[1]};
+            add_load(rhs, g, l->link, p[0], f, 0.0);
+            add_load(rhs, g, l->link2, p[1], fb, 0.0);
+        } else {
+            double f[2] = {reg[l->reg[0]], reg[l->reg[1]]}, p[2], v[2];
+            point_motion(sv, l->link, l->point, p, v);
+            add_load(rhs, g, l->link, p, f, 0.0);
         }
-        double f[2] = {reg[l->reg[0]], reg[l->reg[1]]}, p[2], v[2];
-        point_motion(sv, l->link, l->point, p, v);
-        double r[2] = {p[0] - g[2 * l->link], p[1] - g[2 * l->link + 1]};
-        row[0] -= f[0];
-        row[1] -= f[1];
-        row[2] -= r[0] * f[1] - r[1] * f[0];
     }
 }
 
@@ -232,10 +255,15 @@ double state_loads_power(const state_loads *s, const solver *sv, const double *r
     for (int i = 0; i < s->nloads; i++) {
         const sl_load *l = &s->loads[i];
         double pw;
-        if (l->torque) {
+        if (l->torque == 1) {
             double t = reg[l->reg[0]];
             pw = t * sv->ks.om[l->link];
             *scale += fabs(t) * turning;
+        } else if (l->torque == 2) {
+            double p[2][2], v[2][2], u[2], len, rate, t = reg[l->reg[0]];
+            state_loads_line(l, sv, p, v, u, &len, &rate);
+            pw = -t * rate;
+            *scale += fabs(t) * linear;
         } else {
             double f[2] = {reg[l->reg[0]], reg[l->reg[1]]}, p[2], v[2];
             point_motion(sv, l->link, l->point, p, v);
@@ -252,8 +280,12 @@ void state_loads_describe(const mech_model *m, int i, char *buf, size_t size)
 {
     const sl_load *l = &m->state_loads->loads[i];
     const mech_link *k = &m->links[l->link];
-    if (l->torque)
+    if (l->torque == 1)
         snprintf(buf, size, "torque on link '%s', depends on the motion", k->name);
+    else if (l->torque == 2)
+        snprintf(buf, size, "force along %s-%s (%s, %s), tension positive, depends on the motion",
+                 k->points[l->point].name, m->links[l->link2].points[l->point2].name, k->name,
+                 m->links[l->link2].name);
     else
         snprintf(buf, size, "force at %s on link '%s', depends on the motion",
                  k->points[l->point].name, k->name);

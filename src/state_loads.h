@@ -41,11 +41,14 @@ typedef struct sl_input {
 } sl_input;
 
 typedef struct sl_load {
-    int torque;      /* 0: force [fx, fy] at point `point` of `link`; 1: torque on `link` */
+    int torque;      /* 0: force [fx, fy] at point `point` of `link`; 1: torque on `link`;
+                        2: a force along the line from point of link to point2 of link2,
+                        tension positive (pulls the two ends together) */
     int link;
-    int point;       /* index of the point in the link (force) */
-    int reg[2];      /* registers of fx, fy (force) or of the torque ([0]) */
+    int point;       /* index of the point in the link (force, line) */
+    int reg[2];      /* registers of fx, fy (force), of the torque or the tension ([0]) */
     mech_mark mark;
+    int link2, point2; /* line: the other end */
 } sl_load;
 
 /* The compiled program of every motion-dependent load of a model (owned by
@@ -86,9 +89,11 @@ void state_loads_add(const state_loads *s, const solver *sv, const double *reg, 
  * velocities); *scale gets the size terms for the relative residual. */
 double state_loads_power(const state_loads *s, const solver *sv, const double *reg,
                          double *scale);
+/* A line load's ends, unit vector u from end 0 to end 1 (x when they
+ * coincide), length and its rate. */
+void state_loads_line(const sl_load *l, const solver *sv, double p[2][2], double v[2][2],
+                      double u[2], double *length, double *rate);
 /* Load i in words, as mech check shows it: "force at T on link 'ram'". */
 void state_loads_describe(const mech_model *m, int i, char *buf, size_t size);
-/* The values of load i: fx, fy (or torque, 0). */
-void state_loads_value(const state_loads *s, const double *reg, int i, double *f0, double *f1);
 
 #endif

@@ -109,6 +109,39 @@ Test(state_loads, spring_expression_equals_spring)
     mech_model_free(&b);
 }
 
+/* The same spring as a force along the line S-B ('between'), its length
+ * and rate written out: L = |B - S|, dL/dt = (B - S) . vB / L. */
+Test(state_loads, line_load_equals_spring)
+{
+    mech_model *a = sc_model("", 1, ", mass: 0.4 kg, center: [0, 0], inertia: 0 kg*m^2",
+                             "springs:\n"
+                             "  - {between: [S, B], links: [ground, piston], stiffness: 2000 N/m,\n"
+                             "     free_length: 250 mm, preload: -5 N, damping: 20 N*s/m}\n");
+    mech_model *b = sc_model("", 1, ", mass: 0.4 kg, center: [0, 0], inertia: 0 kg*m^2",
+                             "parameters: {L0: 250 mm}\n"
+                             "loads:\n"
+                             "  - force: \"-5 N + 2000 N/m * (sqrt((B.x - S.x)^2 + (B.y - S.y)^2) - L0)\n"
+                             "      + 20 N*s/m * ((B.x - S.x) * B.vx + (B.y - S.y) * B.vy)\n"
+                             "      / sqrt((B.x - S.x)^2 + (B.y - S.y)^2)\"\n"
+                             "    between: [S, B]\n"
+                             "    links: [ground, piston]\n");
+    cr_assert_eq(b->state_loads->loads[0].torque, 2);
+    mech_table ta = solve_forces(a, 720), tb = solve_forces(b, 720);
+    static const char *const cols[] = {"driver.torque", "O.Fx", "O.Fy", "A.Fx", "A.Fy",
+                                       "B.Fx", "B.Fy", "x_B.N"};
+    for (size_t c = 0; c < sizeof cols / sizeof *cols; c++) {
+        double size, d = max_diff(&ta, &tb, cols[c], &size);
+        cr_assert(d <= 1e-12 * size, "%s: differs by %g (size %g)", cols[c], d, size);
+    }
+    for (int i = 0; i < tb.nrows; i++)
+        cr_assert(fabs(table_at(&tb, i, "power.residual")) < 1e-13, "row %d: %g", i,
+                  table_at(&tb, i, "power.residual"));
+    mech_table_free(&ta);
+    mech_table_free(&tb);
+    mech_model_free(&a);
+    mech_model_free(&b);
+}
+
 /* ---- D'Alembert: -m a as a load is the mass ---------------------------- */
 
 Test(state_loads, inertia_load_equals_mass)
@@ -336,6 +369,10 @@ Test(state_loads, names_checked)
     expect_error("{torque: ground.omega * 1 N*m*s/rad, link: crank}", 14, 14, "ground does not move");
     expect_error("{torque: A.s * 1 N, link: crank}", 14, 16, "point 'A' has no 's'");
     expect_error("{torque: driver.rate * 1 N*m*s/rad, link: crank}", 14, 21, "the driver has no 'rate'");
+    expect_error("{force: [1 N, 0], between: [S, B]}", 14, 13, "one value, tension positive");
+    expect_error("{force: 1 N, between: [S, B], at: B}", 14, 35, "'at' does not apply");
+    expect_error("{force: 1 N, between: [O, S], links: [ground, ground]}", 14, 27, "both ends are on link 'ground'");
+    expect_error("{force: 1 N, between: [S, Q]}", 14, 31, "unknown point 'Q'");
 }
 
 /* The driver's value and speed: a torque -c (q - q0) - d w on the crank
