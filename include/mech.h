@@ -228,6 +228,8 @@ typedef struct mech_model {
     mech_spring *springs; /* [nsprings] springs and dampers (last: the fields before
                              keep their places) */
     int nsprings;
+    struct state_loads *state_loads; /* owned: the loads that depend on the motion
+                                        (src/state_loads.h), NULL when there are none */
 } mech_model;
 
 /* Read and validate a mechanism file. On success *out is the model and the

@@ -5,6 +5,7 @@
 
 #include "commands.h"
 #include "springs.h"
+#include "state_loads.h"
 
 const char cmd_check_help[] =
     "usage: mech check [-q] FILE...\n"
@@ -62,6 +63,10 @@ static void print_summary(const mech_model *m, const mech_summary *s)
     printf("  outputs    %d points, %d links, %d sliders%s\n", m->outputs.npoints,
            m->outputs.nlinks, m->outputs.nsliders, m->outputs.forces ? ", forces" : "");
     print_springs(m);
+    for (int i = 0; m->state_loads && i < m->state_loads->nloads; i++) {
+        state_loads_describe(m, i, buf, sizeof buf);
+        printf("  load       %s\n", buf);
+    }
 }
 
 int cmd_check(int argc, char **argv)

@@ -23,6 +23,7 @@
 
 #include "forces.h"
 #include "springs.h"
+#include "state_loads.h"
 
 enum { MAX_ENTRIES = 6, FRICTION_MAX_ITER = 100, ANDERSON_DEPTH = 3 };
 static const double FRICTION_TOL = 1e-12;
@@ -224,7 +225,7 @@ static int build_pattern(forces_plan *fp)
  * inertia and there are no loads (gravity acts on masses only). */
 static int nothing_loads(const mech_model *m)
 {
-    if (m->nloads > 0 || m->nsprings > 0)
+    if (m->nloads > 0 || m->nsprings > 0 || m->state_loads)
         return 0;
     for (int i = 1; i < m->nlinks; i++)
         if (m->links[i].mass != 0.0 || m->links[i].inertia != 0.0)
@@ -301,6 +302,8 @@ int forces_init(forces *fc, const forces_plan *fp)
                       nr, nr, depth * nr, depth * nr, nr, nl2, nl2, nl2};
     if (xcalloc_doubles(arrays, sizes, 0, COUNT_OF(arrays)) < 0)
         return -1;
+    if (fp->m->state_loads && !(fc->sl_reg = state_loads_registers(fp->m->state_loads)))
+        return -1;
     return linsys_init(&fc->ls, &fp->lp);
 }
 
@@ -310,6 +313,7 @@ void forces_free(forces *fc)
     void *blocks[] = {fc->Ax, fc->b, fc->y, fc->y0, fc->ynext, fc->fric, fc->cscale,
                       fc->g, fc->vg, fc->ag, fc->aa_g, fc->aa_r, fc->aa_dg, fc->aa_dr};
     free_all(blocks, COUNT_OF(blocks));
+    free(fc->sl_reg);
     memset(fc, 0, sizeof *fc);
 }
 
@@ -386,6 +390,7 @@ static void known_loads(const forces *fc, const solver *sv, double *rhs)
         load_force(rhs, fc, ld->link, p, f);
     }
     springs_add_loads(m, sv, fc->g, rhs);
+    state_loads_add(m->state_loads, sv, fc->sl_reg, fc->g, rhs);
 }
 
 /* ---- friction ---------------------------------------------------------- */
@@ -517,6 +522,7 @@ static double power_residual(const forces *fc, const solver *sv, double drive, d
         scale += fabs(pw);
     }
     ext += springs_power(m, sv, &scale);
+    ext += state_loads_power(m->state_loads, sv, fc->sl_reg, &scale);
     double r = pd + ext - pfric - kin;
     return scale > 0.0 ? r / scale : 0.0;
 }
@@ -642,6 +648,7 @@ int forces_solve(forces *fc, const solver *sv)
     const forces_plan *fp = fc->p;
     int n = fp->nrows, drive = fp->ncols - 1;
     update_centres(fc, sv);
+    state_loads_eval(fp->m->state_loads, sv, fc->sl_reg);
     known_loads(fc, sv, fc->b);
     if (factor(fc, sv) < 0)
         return -1;

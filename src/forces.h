@@ -41,6 +41,7 @@ typedef struct forces {
     double *g, *vg, *ag;    /* [2 nlinks] centres of mass and their rates, this step */
     double *fric;           /* [nrows] friction loads moved to the right-hand side */
     double *cscale;         /* [ncols] column equilibration */
+    double *sl_reg;         /* registers of the loads that depend on the motion, or NULL */
     linsys ls;              /* factors of the force system */
     /* per step results */
     int iterations;         /* friction fixed-point iterations */

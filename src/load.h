@@ -129,6 +129,14 @@ void load_loads(loader *ld, const ynode *seq);
 void load_outputs(loader *ld, const ynode *map);
 void load_default_outputs(mech_model *m);
 
+/* ---- load_state_loads.c: loads that depend on the motion (docs/format.md 10.2).
+ *      wanted: some component of a force [fx, fy] or torque does not read as a
+ *      constant quantity; load_state_load compiles them into m->state_loads. */
+int load_state_wanted(loader *ld, const ynode *value);
+void load_state_load(loader *ld, const ynode *map, const ynode *value, int link, int point);
+/* {force: TENSION, between: [P, Q], links: [a, b]}: a force along a line. */
+void load_state_line(loader *ld, const ynode *map);
+
 /* ---- load_springs.c: springs and dampers. */
 void load_springs(loader *ld, const ynode *seq);
 

@@ -435,8 +435,8 @@ void load_ground(loader *ld, const ynode *map)
     mech_link *g = &ld->m->links[0];
     g->name = xstrdup("ground");
     g->is_ground = 1;
-    if (g->name)
-        name_map_put(&ld->link_map, g->name, 0);
+    if (!g->name || name_map_put(&ld->link_map, g->name, 0) < 0)
+        load_err(ld, map, "out of memory");
     if (map) {
         g->mark = map->mark;
         if (!load_points(ld, g, map))

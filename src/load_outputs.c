@@ -57,9 +57,11 @@ static int keys_apply(loader *ld, const ynode *map, int kind)
 static void load_one_load(loader *ld, const ynode *map, mech_load *l)
 {
     static const char *const keys[] = {"force", "torque", "distributed", "link", "at",
-                                       "from", "to", "direction"};
+                                       "from", "to", "direction", "between", "links"};
     if (!load_check_keys(ld, map, keys, COUNT(keys), "a load"))
         return;
+    if (ymap_get(map, "between") || ymap_get(map, "links"))
+        return load_state_line(ld, map);  /* a force along a line (load_state_loads.c) */
     const ynode *f = ymap_get(map, "force"), *t = ymap_get(map, "torque"),
                 *dl = ymap_get(map, "distributed");
     if ((f != NULL) + (t != NULL) + (dl != NULL) != 1)
@@ -75,12 +77,17 @@ static void load_one_load(loader *ld, const ynode *map, mech_load *l)
             return (void)load_err(ld, map, "a force needs 'at: POINT'");
         int id = load_find_point_or_report(ld, at, "load point");
         l->link = load_target_link(ld, map, id, at);
+        if (load_state_wanted(ld, f))  /* an expression of the motion: not in m->loads */
+            return load_state_load(ld, map, f, l->link,
+                                   id >= 0 && l->link >= 0 ? load_point_in_link(ld, l->link, id) : -1);
         ok = load_get_vec2(ld, f, Q_FORCE, "force", l->force) && id >= 0 && l->link >= 0;
         if (ok)
             l->point[0] = load_point_in_link(ld, l->link, id);
     } else if (t) {
         l->kind = MECH_LOAD_TORQUE;
         l->link = load_target_link(ld, map, -1, NULL);
+        if (load_state_wanted(ld, t))
+            return load_state_load(ld, map, t, l->link, -1);
         ok = load_get_quantity(ld, t, Q_TORQUE, "torque", &l->torque) && l->link >= 0;
     } else {
         l->kind = MECH_LOAD_DISTRIBUTED;

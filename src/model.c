@@ -5,6 +5,7 @@
 #include <strings.h>
 
 #include "internal.h"
+#include "state_loads.h"
 
 int model_point_in_link(const mech_link *l, int name_id)
 {
@@ -75,6 +76,7 @@ void mech_model_free(mech_model **pm)
     for (int i = 0; i < m->nsprings; i++)
         free(m->springs[i].name);
     free(m->springs);
+    state_loads_free(m->state_loads);
     free(m->outputs.points);
     free(m->outputs.links);
     free(m->outputs.sliders);

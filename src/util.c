@@ -87,6 +87,8 @@ const char *nearest_name(const char *word, const char *const *names, size_t n)
     const char *best = NULL;
     int best_d = 99;
     for (size_t i = 0; i < n; i++) {
+        if (!names[i])  /* a name whose copy failed (out of memory, already reported) */
+            continue;
         int dist = edit_distance(word, names[i]);
         if (dist < best_d) {
             best_d = dist;

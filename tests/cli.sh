@@ -293,6 +293,11 @@ if run "mech check springs" 0 "$MECH" check $ssc; then
     has_line "$tmp/out" '^  spring     return: linear S-B (ground, piston), stiffness 2000 N/m, free length 0.25 m, preload -5 N$' "check: a spring listed"
     has_line "$tmp/out" '^  spring     pivot: torsional at O (crank, ground), stiffness 0.5 N\*m/rad, free angle 0 deg$' "check: a torsional spring listed"
 fi
+# loads that depend on the motion (docs/format.md 10.2)
+if run "mech check state loads" 0 "$MECH" check mechanisms/stirling-gas.yaml; then
+    [ "$(grep -c '^  load       ' "$tmp/out")" -eq 2 ] && pass || fail "check: 2 load lines"
+    has_line "$tmp/out" "^  load       force at D on link 'piston3', depends on the motion\$" "check: a state load listed"
+fi
 if run "mech solve springs --stats" 0 "$MECH" solve $ssc --stats -o "$tmp/ss.csv"; then
     has_line "$tmp/ss.csv" 'return\.length \[m\],return\.rate \[m/s\],return\.force \[N\],damper\.length \[m\],damper\.rate \[m/s\],damper\.force \[N\],pivot\.angle \[rad\],pivot\.rate \[rad/s\],pivot\.torque \[N\*m\]$' "spring columns"
     has_line "$tmp/err" 'flywheel           mean driver torque .* N\*m over 360 deg (one turn)' "--stats flywheel"
