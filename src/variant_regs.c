@@ -212,7 +212,8 @@ static int same_structure(const mech_model *a, const mech_model *v)
 {
     return SAME(nlinks) && SAME(njoints) && SAME(npoint_names) && SAME(has_driver) &&
            SAME(nguesses) && SAME(nbranches) && SAME(nloops) && SAME(nloads) &&
-           SAME(nsprings) && same_links(a, v) && same_lists(a, v);
+           SAME(nsprings) && same_links(a, v) && same_lists(a, v) &&
+           !a->state_loads && !v->state_loads;  /* see docs/batch.md */
 }
 
 /* ---- a variant ------------------------------------------------------------ */
