@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "diagnose.h"
+#include "gears.h"
 
 static const double PI = 3.14159265358979323846;
 
@@ -43,6 +44,8 @@ const char *diagnose_loop_label(const solver *sv, int k, char *buf, size_t size)
 {
     const mech_model *m = sv->p->m;
     const loop_set *ls = &sv->p->sys->loops;
+    if (k >= ls->nloops)  /* a gear pair's row (after the loops'; k is a row / 2) */
+        return gears_row_label(m, buf, size);
     size_t at = (size_t)snprintf(buf, size, "loop %d (", k + 1);
     if (ls->from_file && k < m->nloops) {
         for (int i = 0; i < m->loops[k].npoints && at < size; i++)

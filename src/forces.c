@@ -22,6 +22,7 @@
 #include <string.h>
 
 #include "forces.h"
+#include "gears.h"
 #include "springs.h"
 
 enum { MAX_ENTRIES = 6, FRICTION_MAX_ITER = 100, ANDERSON_DEPTH = 3 };
@@ -134,7 +135,7 @@ static void column_geometry(const solver *sv, const mech_joint *jt, fc_kind kind
     case FC_FY: dir[0] = 0.0; dir[1] = 1.0; break;
     case FC_NORMAL: dir[0] = -u[1]; dir[1] = u[0]; break;
     case FC_DRIVE: dir[0] = u[0]; dir[1] = u[1]; break;
-    case FC_MOMENT: dir[0] = dir[1] = 0.0; break;
+    case FC_MOMENT: case FC_GEAR: dir[0] = dir[1] = 0.0; break;
     }
 }
 
@@ -146,6 +147,13 @@ static int column_entries(const forces_plan *fp, const solver *sv, const double 
 {
     const mech_model *m = fp->m;
     int n = 0;
+    if (fp->kind[c] == FC_GEAR) {  /* the tooth force: on link[1], its opposite on link[0] */
+        const mech_gear *gr = &m->gears[fp->joint[c]];
+        double p[2], dir[2];
+        gears_contact(m, sv, fp->joint[c], p, dir);
+        n = push_force(e, n, g, gr->link[1], p, dir, 1.0);
+        return push_force(e, n, g, gr->link[0], p, dir, -1.0);
+    }
     if (fp->joint[c] < 0 && m->driver.kind == MECH_DRIVE_ANGLE) {
         n = push_moment(e, n, m->driver.index, 1.0);
     } else {
@@ -189,6 +197,9 @@ static void make_columns(forces_plan *fp)
         if (jt->friction > 0.0)
             fp->has_friction = 1;
     }
+    fp->gcol = fp->ncols;
+    for (int g = 0; g < m->ngears; g++)
+        add_column(fp, FC_GEAR, g);
     add_column(fp, FC_DRIVE, -1);
 }
 
@@ -243,7 +254,7 @@ int forces_plan_init(forces_plan *fp, const solver_plan *sp, int friction, mech_
     memset(fp, 0, sizeof *fp);
     fp->m = m;
     fp->nrows = 3 * (m->nlinks - 1);
-    size_t nc = 2 * (size_t)m->njoints + 2;
+    size_t nc = 2 * (size_t)m->njoints + (size_t)m->ngears + 2;
     fp->kind = xcalloc(nc, sizeof *fp->kind);
     fp->joint = xcalloc(nc, sizeof *fp->joint);
     fp->jcol = xcalloc((size_t)m->njoints + 1, sizeof *fp->jcol);
@@ -685,10 +696,10 @@ void forces_singular_joints(forces *fc, char *buf, size_t size)
         double big = vec_norm_inf(fc->ynext, ncols);
         for (int c = 0; c < ncols; c++)
             if (isfinite(big) && fabs(fc->ynext[c]) > 0.1 * big)
-                mark[fp->joint[c] >= 0 ? fp->joint[c] : m->njoints] = 1;
+                mark[fp->joint[c] >= 0 && fp->kind[c] != FC_GEAR ? fp->joint[c] : m->njoints] = 1;
     } else if (linsys_singular_col(&fc->ls) >= 0) {
         int c = linsys_singular_col(&fc->ls);
-        mark[fp->joint[c] >= 0 ? fp->joint[c] : m->njoints] = 1;
+        mark[fp->joint[c] >= 0 && fp->kind[c] != FC_GEAR ? fp->joint[c] : m->njoints] = 1;
     }
     for (int j = 0; j <= m->njoints && at < size; j++)
         if (mark[j])
@@ -723,4 +734,10 @@ double forces_drive(const forces *fc, int with_friction)
 {
     const forces_plan *fp = fc->p;
     return (with_friction ? fc->y : fc->y0)[fp->ncols - 1];
+}
+
+double forces_gear(const forces *fc, int i, int with_friction)
+{
+    const forces_plan *fp = fc->p;
+    return (with_friction ? fc->y : fc->y0)[fp->gcol + i];
 }

@@ -132,4 +132,7 @@ void load_default_outputs(mech_model *m);
 /* ---- load_springs.c: springs and dampers. */
 void load_springs(loader *ld, const ynode *seq);
 
+/* ---- load_gears.c: gear pairs and racks. */
+void load_gears(loader *ld, const ynode *seq);
+
 #endif

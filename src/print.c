@@ -86,7 +86,10 @@ static void print_text(const mech_system *s, FILE *out)
     for (int r = 0; r < s->m; r++) {
         fprintf(out, "  f%d = ", r + 1);
         expr_print(&s->ex, s->f[r], &nm, 0, out);
-        fprintf(out, "    [loop %d, %c]\n", r / 2 + 1, r % 2 ? 'y' : 'x');
+        if (r >= 2 * s->loops.nloops)  /* gears.c's rows */
+            fprintf(out, "    [gear pair '%s']\n", s->model->gears[r - 2 * s->loops.nloops].name);
+        else
+            fprintf(out, "    [loop %d, %c]\n", r / 2 + 1, r % 2 ? 'y' : 'x');
     }
     fprintf(out, "\njacobian df/dx (%d nonzeros):\n", s->nnz);
     for (int j = 0; j < n; j++)
