@@ -119,7 +119,7 @@ static int pair_radii(loader *ld, const ynode *map, mech_gear *g, double d)
     const ynode *radii = ymap_get(map, "radii"), *teeth = ymap_get(map, "teeth"),
                 *module = ymap_get(map, "module");
     if (!radii && !teeth)
-        return load_err(ld, map, "gear pair needs 'teeth: [z_gear, z_with]' (with an optional "
+        return load_err(ld, map, "a gear pair needs 'teeth: [z_gear, z_with]' (with an optional "
                         "'module') or 'radii: [r_gear, r_with]'"), 0;
     if (radii && (teeth || module))
         return load_err(ld, radii, "give either 'radii' or 'teeth' (and 'module'), not both"), 0;

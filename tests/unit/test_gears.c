@@ -1,0 +1,368 @@
+/* tests/unit/test_gears.c: gear pairs and racks (src/gears.c,
+ * src/load_gears.c) against independent truths: an external pair's exact
+ * ratio -r_a/r_b and an internal pair's +r_a/r_b for angles, speeds and
+ * accelerations (with the 'offset' phase); the planetary train of
+ * mechanisms/epicyclic.yaml and a sun-fixed variant against Willis' formula
+ * (w_ring - w_c)/(w_sun - w_c) = -z_sun/z_ring; a rack and pinion s = r th
+ * (pinion driven, and rack driven); the power balance of the planetary
+ * train with the rate of kinetic energy computed from the kinematic columns
+ * and the inertias alone, its tooth forces from the sun's moment balance by
+ * hand; a rack's driver torque T = (I + m r^2) alpha and tooth force
+ * W cos(phi) = m a; and the loader's errors with their line:column. */
+#include <criterion/criterion.h>
+#include <math.h>
+#include <string.h>
+
+#include "helpers.h"
+
+static const double PI = 3.14159265358979323846;
+#define DEG (PI / 180.0)
+
+static mech_table solve_all(const mech_model *m, int forces)
+{
+    mech_solve_options o;
+    mech_solve_options_default(&o);
+    o.forces = forces;
+    return must_solve(m, &o);
+}
+
+static void close_to(double got, double want, double tol, const char *what, int row)
+{
+    cr_assert(fabs(got - want) <= tol * fmax(1.0, fabs(want)),
+              "%s, row %d: %.17g, expected %.17g (difference %.3g)", what, row, got, want,
+              got - want);
+}
+
+/* ---- an external pair on the ground ------------------------------------ */
+
+/* g1 (30 mm) drives g2 (60 mm, 20:40 teeth of module 3 mm) with the phase
+ * offset [10 deg, 4 deg]: 30 (th1 - 10 deg) + 60 (th2 - 4 deg) = 0. The
+ * pivots are not on an axis, to check the centre distance in 2-D. */
+static const char EXTERNAL[] =
+    "name: external pair\n"
+    "units: {length: mm, angle: deg}\n"
+    "ground: {O1: [10, 20], O2: [64, 92]}\n"  /* |O2 - O1| = |(54, 72)| = 90 mm */
+    "links:\n"
+    "  g1: {points: {O1: [0, 0]}}\n"
+    "  g2: {points: {O2: [0, 0], M: [60, 0]}}\n"
+    "driver: {link: g1, angle: {from: -40, to: 320, steps: 36}, speed: 7 rad/s,\n"
+    "         acceleration: -3 rad/s^2}\n"
+    "gears:\n"
+    "  - {name: g12, gear: g1, with: g2, teeth: [20, 40], module: 3 mm, offset: [10, 4]}\n"
+    "outputs: {links: [g1, g2]}\n";
+
+static mech_model *external_pair(void) { return load_text(EXTERNAL); }
+
+Test(gears, external_pair_exact_ratio)
+{
+    mech_model *m = external_pair();
+    mech_table t = solve_all(m, 0);
+    cr_assert_eq(t.nrows, 37);
+    const double k = -30.0 / 60.0;
+    for (int i = 0; i < t.nrows; i++) {
+        double q = table_at(&t, i, "q");
+        close_to(table_at(&t, i, "g2.angle"), 4 * DEG + k * (q - 10 * DEG), 1e-14, "angle", i);
+        close_to(table_at(&t, i, "g2.omega"), k * 7.0, 1e-14, "omega", i);
+        close_to(table_at(&t, i, "g2.alpha"), k * -3.0, 1e-14, "alpha", i);
+    }
+    mech_table_free(&t);
+    mech_model_free(&m);
+}
+
+/* ---- an internal pair: a pinion inside a ring gear ----------------------- */
+
+/* Pinion p (radii given: 25 mm) turns about A = (0, 0); the ring (75 mm)
+ * about C = (50 mm, 0), its internal teeth meshing with the pinion's:
+ * 25 th_p - 75 th_ring = 0, the ring turns the same way, a third as fast. */
+static const char INTERNAL[] =
+    "name: internal pair\n"
+    "units: {length: mm, angle: deg}\n"
+    "ground: {A: [0, 0], C: [50, 0]}\n"
+    "links:\n"
+    "  pinion: {points: {A: [0, 0]}}\n"
+    "  ring: {points: {C: [0, 0], R: [75, 0]}}\n"
+    "driver: {link: pinion, angle: {from: 0, to: 720, steps: 48}, speed: -12 rad/s,\n"
+    "         acceleration: 2 rad/s^2}\n"
+    "gears:\n"
+    "  - {gear: pinion, with: ring, radii: [25, 75], internal: true}\n"
+    "outputs: {points: [R], links: [ring]}\n";
+
+Test(gears, internal_pair_exact_ratio)
+{
+    mech_model *m = load_text(INTERNAL);
+    cr_assert_str_eq(m->gears[0].name, "pinion_ring");
+    mech_table t = solve_all(m, 0);
+    const double k = 25.0 / 75.0;
+    for (int i = 0; i < t.nrows; i++) {
+        double q = table_at(&t, i, "q"), th = k * q;
+        close_to(table_at(&t, i, "ring.angle"), th, 1e-14, "angle", i);
+        close_to(table_at(&t, i, "ring.omega"), k * -12.0, 1e-14, "omega", i);
+        close_to(table_at(&t, i, "ring.alpha"), k * 2.0, 1e-14, "alpha", i);
+        /* the point R on the ring's pitch circle, by hand */
+        close_to(table_at(&t, i, "R.x"), 0.05 + 0.075 * cos(th), 1e-14, "R.x", i);
+        close_to(table_at(&t, i, "R.vy"), 0.075 * cos(th) * k * -12.0, 1e-13, "R.vy", i);
+    }
+    mech_table_free(&t);
+    mech_model_free(&m);
+}
+
+/* ---- the planetary train: Willis' formula --------------------------------- */
+
+static void check_willis(const mech_table *t, const char *sun, const char *ring, double zs,
+                         double zr)
+{
+    for (int i = 0; i < t->nrows; i++) {
+        /* ring, sun and carrier angles, speeds and accelerations: the relative
+           motion against the carrier is in the ratio -zs/zr */
+        static const char *const what[] = {".angle", ".omega", ".alpha"};
+        for (int k = 0; k < 3; k++) {
+            char cs[64], cr[64], cc[64];
+            snprintf(cs, sizeof cs, "%s%s", sun, what[k]);
+            snprintf(cr, sizeof cr, "%s%s", ring, what[k]);
+            snprintf(cc, sizeof cc, "carrier%s", what[k]);
+            double s = strcmp(sun, "ground") ? table_at(t, i, cs) : 0.0;
+            double r = strcmp(ring, "ground") ? table_at(t, i, cr) : 0.0;
+            double c = table_at(t, i, cc);
+            close_to(r - c, -zs / zr * (s - c), 1e-13, what[k], i);
+        }
+    }
+}
+
+Test(gears, planetary_train_willis)
+{
+    mech_model *m = load_path("mechanisms/epicyclic.yaml");
+    mech_table t = solve_all(m, 0);
+    cr_assert_eq(t.nrows, 145);
+    check_willis(&t, "sun", "ground", 20, 100);
+    /* and the figures the file's comments give */
+    close_to(table_at(&t, 7, "carrier.omega"), 50.0, 1e-14, "carrier omega", 7);
+    close_to(table_at(&t, 7, "planet.omega"), -75.0, 1e-14, "planet omega", 7);
+    mech_table_free(&t);
+    mech_model_free(&m);
+}
+
+/* The same train with the sun fixed (it is the ground) and the ring driven:
+ * w_c = w_ring z_ring / (z_ring + z_sun). The ring is a gear of the pair
+ * on its own pivot O, shared with the carrier. */
+static const char SUN_FIXED[] =
+    "name: sun fixed\n"
+    "units: {length: mm, angle: deg}\n"
+    "ground: {O: [0, 0]}\n"
+    "links:\n"
+    "  ring: {points: {O: [0, 0], Q: [100, 0]}}\n"
+    "  carrier: {points: {O: [0, 0], P: [0, 48]}}\n"
+    "  planet: {points: {P: [0, 0]}}\n"
+    "driver: {link: ring, angle: {from: 0, to: 360, steps: 24}, speed: 10 rad/s,\n"
+    "         acceleration: 4 rad/s^2}\n"
+    "gears:\n"
+    "  - {name: sp, gear: ground, with: planet, teeth: [18, 30], arm: carrier}\n"
+    "  - {name: pr, gear: planet, with: ring, teeth: [30, 78], internal: true, arm: carrier}\n"
+    "outputs: {links: [ring, carrier, planet]}\n";
+
+Test(gears, sun_fixed_willis)
+{
+    mech_model *m = load_text(SUN_FIXED);
+    /* 'teeth' without 'module': the module from the centre distance 48 mm */
+    cr_assert(fabs(m->gears[0].radius[0] - 0.018) < 1e-15, "%.17g", m->gears[0].radius[0]);
+    cr_assert(fabs(m->gears[1].radius[1] - 0.078) < 1e-15, "%.17g", m->gears[1].radius[1]);
+    mech_table t = solve_all(m, 0);
+    check_willis(&t, "ground", "ring", 18, 78);
+    close_to(table_at(&t, 3, "carrier.omega"), 10.0 * 78 / 96, 1e-14, "carrier omega", 3);
+    mech_table_free(&t);
+    mech_model_free(&m);
+}
+
+/* ---- rack and pinion --------------------------------------------------- */
+
+/* Pinion (r = 20 mm, or 16 teeth of module 2.5 mm) about O = (0, 20 mm);
+ * the rack a block sliding along the ground's x axis (through T), its pitch
+ * line; the pinion above it: s = r th; below it (O at y = -20 mm): s = -r th. */
+static const char RACK[] =
+    "name: rack and pinion\n"
+    "units: {length: mm, angle: deg}\n"
+    "ground: {O: [0, %s], T: [0, 0]}\n"
+    "links:\n"
+    "  pinion: {points: {O: [0, 0]}, mass: 0.5 kg, center: [0, 0], inertia: 1e-4 kg*m^2}\n"
+    "  rack: {points: {R: [0, 0]}, mass: 2 kg, center: [0, 0], inertia: 0 kg*m^2}\n"
+    "joints:\n"
+    "  - {slider: R, link: rack, on: ground, through: T, angle: 0, name: x_R}\n"
+    "driver: %s\n"
+    "gears:\n"
+    "  - {name: rp, pinion: pinion, rack: x_R, %s}\n"
+    "outputs: {points: [R], links: [pinion], sliders: [x_R], forces: true}\n";
+
+static mech_model *rack(const char *y, const char *driver, const char *size)
+{
+    char text[2048];
+    snprintf(text, sizeof text, RACK, y, driver, size);
+    return load_text(text);
+}
+
+static const char PINION_DRIVEN[] =
+    "{link: pinion, angle: {from: -90, to: 270, steps: 36}, speed: 5 rad/s,"
+    " acceleration: 30 rad/s^2}";
+
+Test(gears, rack_and_pinion_s_equals_r_theta)
+{
+    for (int below = 0; below < 2; below++) {
+        mech_model *m = rack(below ? "-20" : "20", PINION_DRIVEN,
+                             below ? "teeth: 16, module: 2.5 mm" : "radius: 20 mm");
+        double r = 0.02 * (below ? -1 : 1);
+        mech_table t = solve_all(m, 0);
+        for (int i = 0; i < t.nrows; i++) {
+            double q = table_at(&t, i, "q");
+            close_to(table_at(&t, i, "x_R.s"), r * q, 1e-14, "s", i);
+            close_to(table_at(&t, i, "x_R.v"), r * 5.0, 1e-14, "v", i);
+            close_to(table_at(&t, i, "x_R.a"), r * 30.0, 1e-14, "a", i);
+            close_to(table_at(&t, i, "R.x"), r * q, 1e-14, "R.x", i);
+        }
+        mech_table_free(&t);
+        mech_model_free(&m);
+    }
+    /* the rack driven: the pinion follows, th = s / r */
+    mech_model *m = rack("20", "{slider: x_R, displacement: {from: -30, to: 50, steps: 16}, speed: 0.4 m/s}",
+                         "radius: 20 mm");
+    mech_table t = solve_all(m, 0);
+    for (int i = 0; i < t.nrows; i++) {
+        close_to(table_at(&t, i, "pinion.angle"), table_at(&t, i, "q") / 0.02, 1e-13, "th", i);
+        close_to(table_at(&t, i, "pinion.omega"), 0.4 / 0.02, 1e-13, "omega", i);
+    }
+    mech_table_free(&t);
+    mech_model_free(&m);
+}
+
+/* The rack's statics by hand: T = (I + m r^2) alpha (the rack's inertia
+ * force m r alpha at the pitch radius), and the tooth force along the 20 deg
+ * line of action carries the rack's inertia: |W| cos(20 deg) = m r alpha. */
+Test(gears, rack_forces_by_hand)
+{
+    mech_model *m = rack("20", PINION_DRIVEN, "radius: 20 mm");
+    mech_table t = solve_all(m, 1);
+    const double r = 0.02, I = 1e-4, mass = 2.0, al = 30.0;
+    for (int i = 0; i < t.nrows; i++) {
+        close_to(table_at(&t, i, "driver.torque"), (I + mass * r * r) * al, 1e-13, "torque", i);
+        close_to(fabs(table_at(&t, i, "rp.W")) * cos(20 * DEG), mass * r * al, 1e-13, "W", i);
+        cr_assert(fabs(table_at(&t, i, "power.residual")) < 1e-13);
+    }
+    mech_table_free(&t);
+    mech_model_free(&m);
+}
+
+/* ---- the planetary train's power balance ----------------------------------- */
+
+/* d/dt of the kinetic energy from the kinematic columns and the file's
+ * inertias (sun at O: no translation; carrier's centre 20 mm along it,
+ * from its angle and rates; planet's centre at P, an output point). */
+Test(gears, planetary_power_balance)
+{
+    mech_model *m = load_path("mechanisms/epicyclic.yaml");
+    mech_table t = solve_all(m, 1);
+    const double Is = 4e-5, mc = 0.3, Ic = 2e-4, mp = 0.4, Ip = 3.2e-4, rg = 0.02;
+    const double phi = 20 * DEG, rs = 0.02;
+    double worst = 0.0;
+    for (int i = 0; i < t.nrows; i++) {
+        double ws = table_at(&t, i, "sun.omega"), as = table_at(&t, i, "sun.alpha");
+        double tc = table_at(&t, i, "carrier.angle"), wc = table_at(&t, i, "carrier.omega");
+        double ac = table_at(&t, i, "carrier.alpha");
+        double wp = table_at(&t, i, "planet.omega"), ap = table_at(&t, i, "planet.alpha");
+        double vg[2] = {-wc * rg * sin(tc), wc * rg * cos(tc)};
+        double ag[2] = {-ac * rg * sin(tc) - wc * wc * rg * cos(tc),
+                        ac * rg * cos(tc) - wc * wc * rg * sin(tc)};
+        double vp[2] = {table_at(&t, i, "P.vx"), table_at(&t, i, "P.vy")};
+        double apn[2] = {table_at(&t, i, "P.ax"), table_at(&t, i, "P.ay")};
+        double dT = Is * ws * as + Ic * wc * ac + mc * (vg[0] * ag[0] + vg[1] * ag[1]) +
+                    Ip * wp * ap + mp * (vp[0] * apn[0] + vp[1] * apn[1]);
+        double torque = table_at(&t, i, "driver.torque");
+        double r = fabs(torque * ws - dT) / fabs(dT);
+        worst = fmax(worst, r);
+        cr_assert(r < 1e-13, "row %d: driver power %.17g, dT/dt %.17g", i, torque * ws, dT);
+        /* the sun: driver torque - its inertia = the tooth force's moment */
+        close_to(fabs(table_at(&t, i, "g_sp.W")) * cos(phi) * rs, fabs(torque - Is * as), 1e-13,
+                 "sun-planet tooth force", i);
+    }
+    cr_log_info("planetary power balance: worst relative difference %.3g", worst);
+    mech_table_free(&t);
+    mech_model_free(&m);
+}
+
+/* ---- the loader's errors ------------------------------------------------- */
+
+static const char BASE[] =
+    "name: e\n"
+    "units: {length: mm, angle: deg}\n"
+    "ground: {O: [0, 0], C: [90, 0], T: [0, -40]}\n"
+    "links:\n"
+    "  g1: {points: {O: [0, 0]}}\n"
+    "  g2: {points: {C: [0, 0], M: [10, 0]}}\n"
+    "  rack: {points: {R: [0, 0]}}\n"
+    "joints:\n"
+    "  - {slider: R, link: rack, on: ground, through: T, angle: 0, name: x_R}\n"
+    "driver: {link: g1, angle: {from: 0, to: 360, steps: 4}}\n"
+    "gears:\n"
+    "  - %s\n";
+
+/* The first error's line:column and that its message contains `part`. */
+static void expect_error(const char *gear, int line, int col, const char *part)
+{
+    char text[2048];
+    snprintf(text, sizeof text, BASE, gear);
+    mech_diag d;
+    mech_diag_init(&d);
+    mech_model *m = NULL;
+    int rc = mech_load_string(text, strlen(text), "g.yaml", &m, &d);
+    cr_assert_eq(rc, MECH_EINPUT, "%s: loaded", gear);
+    cr_assert_geq(d.count, 1);
+    const mech_diag_entry *e = &d.entries[0];
+    cr_assert(strstr(e->message, part), "%s: message '%s' lacks '%s'", gear, e->message, part);
+    cr_assert(e->mark.line == line && e->mark.col == col, "%s: at %d:%d, expected %d:%d (%s)",
+              gear, e->mark.line, e->mark.col, line, col, e->message);
+    mech_diag_free(&d);
+}
+
+Test(gears, loader_errors)
+{
+    /* 90 mm apart: 20 + 40 teeth of module 2 mm need 60 mm */
+    expect_error("{gear: g1, with: g2, teeth: [20, 40], module: 2 mm}", 12, 33,
+                 "are 90 mm apart on 'ground', but external gears of pitch radii 20 mm and "
+                 "40 mm need a centre distance of 60 mm");
+    expect_error("{gear: g1, with: g2, radii: [30, 50]}", 12, 33, "centre distance of 80 mm");
+    expect_error("{gear: g1, with: g2, radii: [30, 100], internal: true}", 12, 33,
+                 "internal gears of pitch radii 30 mm and 100 mm need a centre distance of 70 mm");
+    expect_error("{gear: g1, with: g1, teeth: [20, 40]}", 12, 22, "cannot mesh with itself");
+    expect_error("{gear: g1, with: g3, teeth: [20, 40]}", 12, 22, "unknown link 'g3'");
+    expect_error("{gear: g1, with: g2}", 12, 5, "a gear pair needs 'teeth");
+    expect_error("{gear: g1, with: g2, teeth: [20]}", 12, 33, "two tooth counts");
+    expect_error("{gear: g1, with: g2, teeth: [20, 20], internal: true}", 12, 33,
+                 "ring larger");
+    expect_error("{gear: g1, with: g2, teeth: [20, 40], module: 3 mm, arm: g2}", 12, 62,
+                 "gear 'g1' has no pivot on the arm 'g2'");
+    expect_error("{gear: g1, with: g2, teeth: [20, 40], module: 3 mm, arm: g1}", 12, 62,
+                 "gear 'g1' is the arm 'g1' itself");
+    expect_error("{gear: g1, with: rack, radii: [30, 60]}", 12, 5,
+                 "gear 'rack' has no pivot on the 'ground'");
+    expect_error("{gear: g1, with: g2, teeth: [20, 40], pressure_angle: 50 deg}", 12, 59,
+                 "pressure_angle");
+    expect_error("{gear: g1, with: g2, teeth: [20, 40], radius: 3}", 12, 43,
+                 "'radius' does not apply to a gear pair");
+    expect_error("{pinion: g1, rack: x_R, radius: 30 mm}", 12, 37,
+                 "the pinion's centre O is 40 mm from the rack's pitch line");
+    expect_error("{pinion: g1, rack: g2, radius: 40 mm}", 12, 24, "unknown slider 'g2'");
+    expect_error("{pinion: g1, rack: x_R}", 12, 5, "needs 'radius'");
+    expect_error("{pinion: g1, rack: x_R, radius: 40 mm, internal: true}", 12, 44,
+                 "'internal' does not apply to a rack");
+}
+
+Test(gears, mobility_counts_a_mesh)
+{
+    mech_model *m = external_pair();
+    mech_summary s;
+    mech_diag d;
+    mech_diag_init(&d);
+    cr_assert_eq(mech_check(m, &s, &d), MECH_OK);
+    cr_assert_eq(s.ngears, 1);
+    cr_assert_eq(s.nloops, 0);          /* two gears on the ground: no loop at all */
+    cr_assert_eq(s.nequations, 1);
+    cr_assert_eq(s.mobility, 1);        /* 3*2 - 2*2 - 1 */
+    mech_diag_free(&d);
+    mech_model_free(&m);
+}
