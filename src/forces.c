@@ -149,10 +149,10 @@ static int column_entries(const forces_plan *fp, const solver *sv, const double 
     int n = 0;
     if (fp->kind[c] == FC_GEAR) {  /* the tooth force: on link[1], its opposite on link[0] */
         const mech_gear *gr = &m->gears[fp->joint[c]];
-        double p[2], dir[2];
-        gears_contact(m, sv, fp->joint[c], p, dir);
-        n = push_force(e, n, g, gr->link[1], p, dir, 1.0);
-        return push_force(e, n, g, gr->link[0], p, dir, -1.0);
+        double p[2], t[2], r[2];  /* the unknown: its component along the tangent t */
+        gears_contact(m, sv, fp->joint[c], p, t, r);
+        n = push_force(e, n, g, gr->link[1], p, t, 1.0);
+        return push_force(e, n, g, gr->link[0], p, t, -1.0);
     }
     if (fp->joint[c] < 0 && m->driver.kind == MECH_DRIVE_ANGLE) {
         n = push_moment(e, n, m->driver.index, 1.0);
@@ -399,6 +399,24 @@ static void known_loads(const forces *fc, const solver *sv, double *rhs)
     springs_add_loads(m, sv, fc->g, rhs);
 }
 
+/* The separating part of each tooth force, |F| tan(pressure angle) for the
+ * tangential force F of reactions y (gears.h): a known load given y. It
+ * lies along the line of centres, so it changes no F, only the pivots'
+ * reactions: one more solve finds them. */
+static void gear_separation(const forces *fc, const solver *sv, const double *y, double *rhs)
+{
+    const mech_model *m = fc->p->m;
+    for (int i = 0; i < m->ngears; i++) {
+        const mech_gear *gr = &m->gears[i];
+        double p[2], t[2], r[2];
+        gears_contact(m, sv, i, p, t, r);
+        double k = fabs(y[fc->p->gcol + i]) * tan(gr->pressure_angle);
+        double fb[2] = {k * r[0], k * r[1]}, fa[2] = {-fb[0], -fb[1]};
+        load_force(rhs, fc, gr->link[1], p, fb);
+        load_force(rhs, fc, gr->link[0], p, fa);
+    }
+}
+
 /* ---- friction ---------------------------------------------------------- */
 
 static double smooth_sign(double v, double eps) { return v / sqrt(v * v + eps * eps); }
@@ -601,6 +619,7 @@ static void friction_fixed_point(forces *fc, const solver *sv)
         friction_loads(fc, sv, fc->y);
         for (int i = 0; i < n; i++)
             fc->fric[i] += fc->b[i];
+        gear_separation(fc, sv, fc->y, fc->fric);
         solve_rhs(fc, fc->fric, g);
         double res = 0.0, big = 0.0;
         for (int i = 0; i < n; i++) {
@@ -663,6 +682,11 @@ int forces_solve(forces *fc, const solver *sv)
     fc->residual0 = 0.0;
     if (!fp->friction || fp->want_frictionless || !fc->have_previous) {
         solve_rhs(fc, fc->b, fc->y0);
+        if (fp->m->ngears) {  /* the teeth's separating forces, from their tangential ones */
+            memcpy(fc->fric, fc->b, (size_t)n * sizeof *fc->fric);
+            gear_separation(fc, sv, fc->y0, fc->fric);
+            solve_rhs(fc, fc->fric, fc->y0);
+        }
         fc->residual0 = power_residual(fc, sv, fc->y0[drive], 0.0);
         memcpy(fc->y, fc->y0, (size_t)n * sizeof *fc->y);
     }
@@ -739,5 +763,5 @@ double forces_drive(const forces *fc, int with_friction)
 double forces_gear(const forces *fc, int i, int with_friction)
 {
     const forces_plan *fp = fc->p;
-    return (with_friction ? fc->y : fc->y0)[fp->gcol + i];
+    return (with_friction ? fc->y : fc->y0)[fp->gcol + i] / cos(fp->m->gears[i].pressure_angle);
 }

@@ -44,18 +44,19 @@ static void place(const solver *sv, int l, int k, double *p)
     kin_on_link(&sv->ks, l, r, p, NULL, NULL);
 }
 
-void gears_contact(const mech_model *m, const solver *sv, int i, double *p, double *dir)
+void gears_contact(const mech_model *m, const solver *sv, int i, double *p, double *t,
+                   double *r)
 {
     const mech_gear *g = &m->gears[i];
     p[0] = p[1] = 0.0;
-    dir[0] = 1.0;
-    dir[1] = 0.0;
+    t[0] = 1.0;
+    t[1] = r[0] = r[1] = 0.0;
     if (!sv)
         return;
     double a[2], n[2];  /* a's centre; n: unit from a's centre through the pitch point */
     place(sv, g->arm, g->arm_pivot[0], a);
     if (g->kind == MECH_GEAR_RACK) {
-        /* the rack's line is side r from the centre, to the right of the guide's
+        /* the rack's line is r from the centre, to the right of the guide's
            direction u when side > 0: n = -side (-u_y, u_x) */
         const mech_joint *jt = &m->joints[g->rack];
         double ang = sv->ks.th[jt->link[1]] + jt->angle;
@@ -74,13 +75,13 @@ void gears_contact(const mech_model *m, const solver *sv, int i, double *p, doub
     }
     p[0] = a[0] + g->radius[0] * n[0];
     p[1] = a[1] + g->radius[0] * n[1];
-    /* separating: b is pushed away from a's teeth, along n unless a is the ring */
+    t[0] = -n[1];
+    t[1] = n[0];
+    /* b is pushed away from a's teeth: along n, unless a is the ring */
     double sep = g->kind == MECH_GEAR_PAIR && g->internal && g->radius[0] > g->radius[1]
                      ? -1.0 : 1.0;
-    double cp = cos(g->pressure_angle), sp = sin(g->pressure_angle);
-    double t[2] = {-n[1], n[0]};
-    dir[0] = cp * t[0] + sep * sp * n[0];
-    dir[1] = cp * t[1] + sep * sp * n[1];
+    r[0] = sep * n[0];
+    r[1] = sep * n[1];
 }
 
 void gears_describe(const mech_model *m, int i, char *buf, size_t size)

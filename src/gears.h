@@ -15,11 +15,14 @@
 void gears_rows(mech_system *s, ex *rows);
 
 /* The tooth force of gear pair i at the published position of sv: its
- * pitch point p and the unit direction dir of the force on link[1] (the
- * force on link[0] is opposite): along the line of action, the common
- * tangent t turned by the pressure angle towards separating the pair.
- * sv NULL (the pattern is being built): any point and direction. */
-void gears_contact(const mech_model *m, const solver *sv, int i, double *p, double *dir);
+ * pitch point p, the common tangent t there (n rotated +90 deg, n the unit
+ * from link[0]'s centre through p) and the unit r that pushes link[1] away
+ * from link[0]'s teeth (along n or against it). The force on link[1] is
+ * F t + |F| tan(pressure angle) r (the line of action of the flank that
+ * carries it), its opposite on link[0]; F is the force system's unknown.
+ * sv NULL (the pattern is being built): any point and directions. */
+void gears_contact(const mech_model *m, const solver *sv, int i, double *p, double *t,
+                   double *r);
 
 /* Gear pair i in words, as mech check shows it. */
 void gears_describe(const mech_model *m, int i, char *buf, size_t size);

@@ -106,6 +106,45 @@ Test(gears, internal_pair_exact_ratio)
     mech_model_free(&m);
 }
 
+/* The internal pair's tooth force by hand: only the mesh turns the ring
+ * (I_ring alpha_ring = 75 mm F), and the separating part |F| tan(20 deg)
+ * pushes the pinion away from the ring's teeth at (-25 mm, 0), towards +x:
+ * its pivot A holds it with -|F| tan(20 deg) in x, whichever of the two is
+ * named 'gear' (the ring as 'gear' turns the separating direction round). */
+Test(gears, internal_pair_forces_by_hand)
+{
+    for (int swap = 0; swap < 2; swap++) {
+        char text[2048];
+        snprintf(text, sizeof text, "%s", INTERNAL);
+        char *g = strstr(text, "  - {gear: pinion");
+        cr_assert(g);
+        snprintf(g, sizeof text - (size_t)(g - text),
+                 "  - {name: mesh, gear: %s, with: %s, radii: [%s], internal: true}\n"
+                 "outputs: {links: [ring], forces: true}\n",
+                 swap ? "ring" : "pinion", swap ? "pinion" : "ring", swap ? "75, 25" : "25, 75");
+        char *l = strstr(text, "  pinion: {points: {A: [0, 0]}}");
+        cr_assert(l);
+        const char *links =
+            "  pinion: {points: {A: [0, 0]}, mass: 0.1 kg, center: [0, 0], inertia: 1e-4 kg*m^2}\n"
+            "  ring: {points: {C: [0, 0], R: [75, 0]}, mass: 1 kg, center: [0, 0],"
+            " inertia: 0.002 kg*m^2}\n";
+        char rest[1024];
+        snprintf(rest, sizeof rest, "%s", strstr(l, "driver:"));
+        snprintf(l, sizeof text - (size_t)(l - text), "%s%s", links, rest);
+        mech_model *m = load_text(text);
+        mech_table t = solve_all(m, 1);
+        double F = 0.002 * (2.0 / 3.0) / 0.075;
+        for (int i = 0; i < t.nrows; i++) {
+            close_to(fabs(table_at(&t, i, "mesh.W")) * cos(20 * DEG), F, 1e-12, "W", i);
+            close_to(table_at(&t, i, "A.Fx"), -F * tan(20 * DEG), 1e-12, "A.Fx", i);
+            close_to(table_at(&t, i, "driver.torque"), (1e-4 + 0.002 / 9.0) * 2.0, 1e-12,
+                     "torque", i);
+        }
+        mech_table_free(&t);
+        mech_model_free(&m);
+    }
+}
+
 /* ---- the planetary train: Willis' formula --------------------------------- */
 
 static void check_willis(const mech_table *t, const char *sun, const char *ring, double zs,
@@ -232,20 +271,34 @@ Test(gears, rack_and_pinion_s_equals_r_theta)
 }
 
 /* The rack's statics by hand: T = (I + m r^2) alpha (the rack's inertia
- * force m r alpha at the pitch radius), and the tooth force along the 20 deg
- * line of action carries the rack's inertia: |W| cos(20 deg) = m r alpha. */
+ * force m r alpha at the pitch radius); the tooth force's tangential part
+ * F = W cos(20 deg) = m r alpha carries the rack, and its separating part
+ * |F| tan(20 deg) pushes the rack down onto its guide and the pinion up off
+ * it, whichever flank carries the load (alpha of either sign): the pivot O
+ * holds the pinion with (F, -|F| tan 20 deg), the guide the rack with
+ * N = |F| tan 20 deg. */
 Test(gears, rack_forces_by_hand)
 {
-    mech_model *m = rack("20", PINION_DRIVEN, "radius: 20 mm");
-    mech_table t = solve_all(m, 1);
-    const double r = 0.02, I = 1e-4, mass = 2.0, al = 30.0;
-    for (int i = 0; i < t.nrows; i++) {
-        close_to(table_at(&t, i, "driver.torque"), (I + mass * r * r) * al, 1e-13, "torque", i);
-        close_to(fabs(table_at(&t, i, "rp.W")) * cos(20 * DEG), mass * r * al, 1e-13, "W", i);
-        cr_assert(fabs(table_at(&t, i, "power.residual")) < 1e-13);
+    for (int sign = -1; sign <= 1; sign += 2) {
+        char driver[256];
+        snprintf(driver, sizeof driver, "{link: pinion, angle: {from: -90, to: 270, steps: 36}, "
+                 "speed: 5 rad/s, acceleration: %d rad/s^2}", 30 * sign);
+        mech_model *m = rack("20", driver, "radius: 20 mm");
+        mech_table t = solve_all(m, 1);
+        const double r = 0.02, I = 1e-4, mass = 2.0, al = 30.0 * sign, tn = tan(20 * DEG);
+        const double F = mass * r * al;
+        for (int i = 0; i < t.nrows; i++) {
+            close_to(table_at(&t, i, "driver.torque"), (I + mass * r * r) * al, 1e-13, "torque",
+                     i);
+            close_to(table_at(&t, i, "rp.W") * cos(20 * DEG), F, 1e-13, "W", i);
+            close_to(table_at(&t, i, "O.Fx"), F, 1e-13, "O.Fx", i);
+            close_to(table_at(&t, i, "O.Fy"), -fabs(F) * tn, 1e-13, "O.Fy", i);
+            close_to(table_at(&t, i, "x_R.N"), fabs(F) * tn, 1e-13, "x_R.N", i);
+            cr_assert(fabs(table_at(&t, i, "power.residual")) < 1e-13);
+        }
+        mech_table_free(&t);
+        mech_model_free(&m);
     }
-    mech_table_free(&t);
-    mech_model_free(&m);
 }
 
 /* ---- the planetary train's power balance ----------------------------------- */
