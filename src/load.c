@@ -47,8 +47,8 @@ static void load_document(loader *ld, const ynode *root)
 {
     static const char *const keys[] = {"name", "description", "units", "parameters", "gravity",
                                        "ground", "links", "joints", "driver", "initial",
-                                       "branch", "loops", "loads", "springs", "outputs",
-                                       "gears"};
+                                       "branch", "loops", "loads", "springs", "gears",
+                                       "outputs"};
     mech_model *m = ld->m;
     if (!load_check_keys(ld, root, keys, COUNT(keys), "the mechanism"))
         return;

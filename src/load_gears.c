@@ -287,6 +287,9 @@ static void load_one_gear(loader *ld, const ynode *map, mech_gear *g, name_map *
                                   rack ? "rack and pinion ('pinion:')" : "gear pair ('gear:')");
     }
     int ok = rack ? load_rack(ld, map, g) : load_pair(ld, map, g);
+    for (int k = 0; k < 2 && !ok; k++)  /* no echo: "link 'g1' has 1 point" */
+        if (g->link[k] > 0 && g->link[k] < ld->m->nlinks)
+            ld->link_failed[g->link[k]] |= LINK_FAILED;
     const ynode *nm = ymap_get(map, "name");
     const char *given = nm ? load_get_name(ld, nm, "gear name") : NULL;
     if (!ok || (nm && !given))
