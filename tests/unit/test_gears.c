@@ -419,3 +419,62 @@ Test(gears, mobility_counts_a_mesh)
     mech_diag_free(&d);
     mech_model_free(&m);
 }
+
+/* ---- the geared five-bar ------------------------------------------------- */
+
+/* mechanisms/geared-five-bar.yaml by hand: th2 = 90 deg - q / 2 (the mesh),
+ * A = 15 mm (cos q, sin q), D = C + 15 mm (cos th2, sin th2), B the
+ * intersection of the circles of 60 mm about A and D to the left of A->D;
+ * and the driver power against the rate of kinetic energy from the columns
+ * (cranks turning about their fixed centres, the couplers' centres at the
+ * middle of AB and DB: v_G = (v_A + v_B) / 2, a_G likewise). */
+Test(gears, geared_five_bar_closed_form_and_power)
+{
+    mech_model *m = load_path("mechanisms/geared-five-bar.yaml");
+    mech_table t = solve_all(m, 1);
+    cr_assert_eq(t.nrows, 145);
+    const double L = 0.06, c = 0.06, w = 20.0;
+    double worst = 0.0;
+    for (int i = 0; i < t.nrows; i++) {
+        double q = table_at(&t, i, "q"), th2 = PI / 2 - q / 2;
+        close_to(table_at(&t, i, "crank2.angle"), th2, 1e-14, "th2", i);
+        double ax = 0.015 * cos(q), ay = 0.015 * sin(q);
+        double dx = c + 0.015 * cos(th2), dy = 0.015 * sin(th2);
+        double ex = dx - ax, ey = dy - ay, d = hypot(ex, ey);
+        double h = sqrt(L * L - d * d / 4);
+        double bx = ax + ex / 2 - h * ey / d, by = ay + ey / 2 + h * ex / d;
+        close_to(table_at(&t, i, "B.x"), bx, 1e-13, "B.x", i);
+        close_to(table_at(&t, i, "B.y"), by, 1e-13, "B.y", i);
+        static const char *const cpl[2][2] = {{"A", "B"}, {"D", "B"}};
+        static const char *const name[2] = {"coupler", "rod"};
+        /* crank1 turns at a constant speed: no term */
+        double dT = 2.4e-4 * table_at(&t, i, "crank2.omega") * table_at(&t, i, "crank2.alpha");
+        for (int k = 0; k < 2; k++) {
+            char col[32];
+            double v[2], a[2], om, al;
+            for (int x = 0; x < 2; x++) {
+                snprintf(col, sizeof col, "%s.v%c", cpl[k][0], "xy"[x]);
+                v[x] = table_at(&t, i, col);
+                snprintf(col, sizeof col, "%s.v%c", cpl[k][1], "xy"[x]);
+                v[x] = 0.5 * (v[x] + table_at(&t, i, col));
+                snprintf(col, sizeof col, "%s.a%c", cpl[k][0], "xy"[x]);
+                a[x] = table_at(&t, i, col);
+                snprintf(col, sizeof col, "%s.a%c", cpl[k][1], "xy"[x]);
+                a[x] = 0.5 * (a[x] + table_at(&t, i, col));
+            }
+            snprintf(col, sizeof col, "%s.omega", name[k]);
+            om = table_at(&t, i, col);
+            snprintf(col, sizeof col, "%s.alpha", name[k]);
+            al = table_at(&t, i, col);
+            dT += 0.05 * (v[0] * a[0] + v[1] * a[1]) + 1.5e-5 * om * al;
+        }
+        double P = table_at(&t, i, "driver.torque") * w;
+        double scale = fmax(fabs(dT), 1e-6);
+        worst = fmax(worst, fabs(P - dT) / scale);
+        cr_assert(fabs(P - dT) <= 1e-12 * scale, "row %d: driver power %.17g, dT/dt %.17g", i,
+                  P, dT);
+    }
+    cr_log_info("geared five-bar power balance: worst relative difference %.3g", worst);
+    mech_table_free(&t);
+    mech_model_free(&m);
+}
