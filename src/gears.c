@@ -9,30 +9,37 @@
 
 static const double PI = 3.14159265358979323846;
 
-/* th_k - th_arm - offset as an expression. */
-static ex relative_angle(mech_system *s, int link, int arm, double offset)
+/* k x, dropped when k is 0 (an arm on the ground has no angle term). */
+static ex term(expr_ctx *c, double k, ex x)
 {
-    expr_ctx *c = &s->ex;
-    ex d = expr_sub(c, s->link_angle[link], s->link_angle[arm]);
-    return expr_sub(c, d, expr_const(c, offset));
+    return k == 0.0 ? c->zero : expr_mul(c, expr_const(c, k), x);
 }
 
+/* The rows in expanded form, sum of k_i x_i + constant: the driver's term
+ * is then a product of its own, computed once per driver position (the
+ * tape's hoisted part), and `mech equations` prints each angle once. */
 void gears_rows(mech_system *s, ex *rows)
 {
     const mech_model *m = s->model;
     expr_ctx *c = &s->ex;
     for (int i = 0; i < m->ngears; i++) {
         const mech_gear *g = &m->gears[i];
-        ex a = expr_mul(c, expr_const(c, g->radius[0]),
-                        relative_angle(s, g->link[0], g->arm, g->offset[0]));
+        const ex *th = s->link_angle;
+        double ra = g->radius[0];
+        ex sum;
         if (g->kind == MECH_GEAR_RACK) {
-            ex ds = expr_sub(c, s->slide[g->rack], expr_const(c, g->offset[1]));
-            rows[i] = g->side > 0 ? expr_sub(c, ds, a) : expr_add(c, ds, a);
+            /* s - s0 - side r (th_p - th_arm - o_p) */
+            double k = g->side * ra;
+            sum = expr_add(c, s->slide[g->rack], term(c, -k, th[g->link[0]]));
+            sum = expr_add(c, sum, term(c, k, th[g->arm]));
+            rows[i] = expr_add(c, sum, expr_const(c, k * g->offset[0] - g->offset[1]));
             continue;
         }
-        ex b = expr_mul(c, expr_const(c, g->radius[1]),
-                        relative_angle(s, g->link[1], g->arm, g->offset[1]));
-        rows[i] = g->internal ? expr_sub(c, a, b) : expr_add(c, a, b);
+        /* r_a (th_a - th_arm - o_a) + sign r_b (th_b - th_arm - o_b) */
+        double rb = (g->internal ? -1.0 : 1.0) * g->radius[1];
+        sum = expr_add(c, term(c, ra, th[g->link[0]]), term(c, rb, th[g->link[1]]));
+        sum = expr_add(c, sum, term(c, -(ra + rb), th[g->arm]));
+        rows[i] = expr_add(c, sum, expr_const(c, -(ra * g->offset[0] + rb * g->offset[1])));
     }
 }
 

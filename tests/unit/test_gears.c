@@ -258,6 +258,14 @@ Test(gears, rack_and_pinion_s_equals_r_theta)
         mech_table_free(&t);
         mech_model_free(&m);
     }
+    /* the phase: s - 5 mm = r (th - 30 deg) */
+    mech_model *mo = rack("20", PINION_DRIVEN, "radius: 20 mm, offset: 30 deg, rack_offset: 5 mm");
+    mech_table to = solve_all(mo, 0);
+    for (int i = 0; i < to.nrows; i++)
+        close_to(table_at(&to, i, "x_R.s"), 0.005 + 0.02 * (table_at(&to, i, "q") - 30 * DEG),
+                 1e-14, "s with offsets", i);
+    mech_table_free(&to);
+    mech_model_free(&mo);
     /* the rack driven: the pinion follows, th = s / r */
     mech_model *m = rack("20", "{slider: x_R, displacement: {from: -30, to: 50, steps: 16}, speed: 0.4 m/s}",
                          "radius: 20 mm");
