@@ -311,6 +311,28 @@ Test(gears, rack_forces_by_hand)
 
 /* ---- the planetary train's power balance ----------------------------------- */
 
+/* The planet's pin reaction from its own balance, given the solved tooth
+ * forces W of the two meshes: each acts on its `with` gear as
+ * W cos(phi) t + |W| sin(phi) r (t the tangent, n rotated +90 deg, n the
+ * unit from the `gear`'s centre through the pitch point, r the separating
+ * direction). Here n = P / |P| for both meshes (the sun's centre O to the
+ * planet; the planet inside the ring: outwards), r = n; the sun-planet
+ * force acts on the planet, the planet-ring force on the ring (its
+ * opposite on the planet). So P (on the planet) = m_p a_P - F_sp + F_pr. */
+static void check_planet_pin(const mech_table *t, int i, double mp)
+{
+    const double phi = 20 * DEG, c = cos(phi), sn = sin(phi);
+    double px = table_at(t, i, "P.x"), py = table_at(t, i, "P.y"), d = hypot(px, py);
+    double n[2] = {px / d, py / d}, tg[2] = {-n[1], n[0]};
+    double wsp = table_at(t, i, "g_sp.W"), wpr = table_at(t, i, "g_pr.W");
+    for (int k = 0; k < 2; k++) {
+        double fsp = wsp * c * tg[k] + fabs(wsp) * sn * n[k];
+        double fpr = wpr * c * tg[k] + fabs(wpr) * sn * n[k];
+        double want = mp * table_at(t, i, k ? "P.ay" : "P.ax") - fsp + fpr;
+        close_to(table_at(t, i, k ? "P.Fy" : "P.Fx"), want, 1e-12, "planet pin", i);
+    }
+}
+
 /* d/dt of the kinetic energy from the kinematic columns and the file's
  * inertias (sun at O: no translation; carrier's centre 20 mm along it,
  * from its angle and rates; planet's centre at P, an output point). */
@@ -337,6 +359,7 @@ Test(gears, planetary_power_balance)
         double r = fabs(torque * ws - dT) / fabs(dT);
         worst = fmax(worst, r);
         cr_assert(r < 1e-13, "row %d: driver power %.17g, dT/dt %.17g", i, torque * ws, dT);
+        check_planet_pin(&t, i, mp);
         /* the sun: driver torque - its inertia = the tooth force's moment */
         close_to(fabs(table_at(&t, i, "g_sp.W")) * cos(phi) * rs, fabs(torque - Is * as), 1e-13,
                  "sun-planet tooth force", i);
@@ -483,6 +506,57 @@ Test(gears, geared_five_bar_closed_form_and_power)
                   P, dT);
     }
     cr_log_info("geared five-bar power balance: worst relative difference %.3g", worst);
+    mech_table_free(&t);
+    mech_model_free(&m);
+}
+
+/* ---- friction in a train ---------------------------------------------------- */
+
+/* mechanisms/epicyclic.yaml with Coulomb friction in the planet's pin P
+ * (mu 0.2, pin radius 5 mm) and the sun's pivot O (0.1, 4 mm): the driver
+ * power less the friction losses mu r |F| |w_rel| of the two pins, from
+ * their reaction columns (which carry the teeth's separating forces), is
+ * the rate of kinetic energy, computed as in planetary_power_balance; and
+ * the planet's pin balances it with the tooth forces on their flanks. */
+Test(gears, planetary_friction_losses)
+{
+    FILE *f = fopen("mechanisms/epicyclic.yaml", "r");
+    cr_assert(f);
+    static char text[16384];
+    size_t n = fread(text, 1, sizeof text - 1, f);
+    fclose(f);
+    text[n] = '\0';
+    char *drv = strstr(text, "\ndriver:\n");
+    cr_assert(drv);
+    static char with[17000];
+    snprintf(with, sizeof with, "%.*s\njoints:\n"
+             "  - {revolute: P, links: [carrier, planet], friction: 0.2, pin_radius: 5 mm}\n"
+             "  - {revolute: O, links: [ground, sun], friction: 0.1, pin_radius: 4 mm}%s",
+             (int)(drv - text), text, drv);
+    mech_model *m = load_text(with);
+    mech_table t = solve_all(m, 1);
+    const double Is = 4e-5, mc = 0.3, Ic = 2e-4, mp = 0.4, Ip = 3.2e-4, rg = 0.02;
+    for (int i = 0; i < t.nrows; i++) {
+        double ws = table_at(&t, i, "sun.omega"), as = table_at(&t, i, "sun.alpha");
+        double tc = table_at(&t, i, "carrier.angle"), wc = table_at(&t, i, "carrier.omega");
+        double ac = table_at(&t, i, "carrier.alpha");
+        double wp = table_at(&t, i, "planet.omega"), ap = table_at(&t, i, "planet.alpha");
+        double vg[2] = {-wc * rg * sin(tc), wc * rg * cos(tc)};
+        double ag[2] = {-ac * rg * sin(tc) - wc * wc * rg * cos(tc),
+                        ac * rg * cos(tc) - wc * wc * rg * sin(tc)};
+        double vp[2] = {table_at(&t, i, "P.vx"), table_at(&t, i, "P.vy")};
+        double apn[2] = {table_at(&t, i, "P.ax"), table_at(&t, i, "P.ay")};
+        double dT = Is * ws * as + Ic * wc * ac + mc * (vg[0] * ag[0] + vg[1] * ag[1]) +
+                    Ip * wp * ap + mp * (vp[0] * apn[0] + vp[1] * apn[1]);
+        double loss = 0.2 * 0.005 * table_at(&t, i, "P.F") * fabs(wp - wc) +
+                      0.1 * 0.004 * table_at(&t, i, "O.F") * fabs(ws);
+        double P = table_at(&t, i, "driver.torque") * ws;
+        check_planet_pin(&t, i, mp);
+        cr_assert(loss > 0.1 * dT, "row %d: losses %g, dT/dt %g: friction too small to see", i,
+                  loss, dT);
+        cr_assert(fabs(P - loss - dT) <= 1e-10 * (fabs(P) + loss),
+                  "row %d: driver power %.17g - losses %.17g != dT/dt %.17g", i, P, loss, dT);
+    }
     mech_table_free(&t);
     mech_model_free(&m);
 }
