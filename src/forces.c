@@ -703,14 +703,23 @@ int forces_solve(forces *fc, const solver *sv)
 /* The joints whose reactions are not determined at a singular position:
  * large components of A^-1 b (inverse iteration) lie along the null space;
  * when the factorisation itself failed, KLU's first singular column. */
+/* Where column c is marked in forces_singular_joints: its joint, the driver
+ * (njoints), or its gear pair (njoints + 1 + the pair). */
+static int singular_slot(const forces_plan *fp, int c)
+{
+    if (fp->kind[c] == FC_GEAR)
+        return fp->m->njoints + 1 + fp->joint[c];
+    return fp->joint[c] >= 0 ? fp->joint[c] : fp->m->njoints;
+}
+
 void forces_singular_joints(forces *fc, char *buf, size_t size)
 {
     const forces_plan *fp = fc->p;
     const mech_model *m = fp->m;
     size_t at = 0;
     buf[0] = '\0';
-    int ncols = fp->ncols, count = 0;
-    unsigned char *mark = xcalloc((size_t)m->njoints + 2, 1);
+    int ncols = fp->ncols, count = 0, nslots = m->njoints + 1 + m->ngears;
+    unsigned char *mark = xcalloc((size_t)nslots + 1, 1);
     if (!mark)
         return;
     if (fc->ls.factored) {
@@ -720,15 +729,17 @@ void forces_singular_joints(forces *fc, char *buf, size_t size)
         double big = vec_norm_inf(fc->ynext, ncols);
         for (int c = 0; c < ncols; c++)
             if (isfinite(big) && fabs(fc->ynext[c]) > 0.1 * big)
-                mark[fp->joint[c] >= 0 && fp->kind[c] != FC_GEAR ? fp->joint[c] : m->njoints] = 1;
+                mark[singular_slot(fp, c)] = 1;
     } else if (linsys_singular_col(&fc->ls) >= 0) {
-        int c = linsys_singular_col(&fc->ls);
-        mark[fp->joint[c] >= 0 && fp->kind[c] != FC_GEAR ? fp->joint[c] : m->njoints] = 1;
+        mark[singular_slot(fp, linsys_singular_col(&fc->ls))] = 1;
     }
-    for (int j = 0; j <= m->njoints && at < size; j++)
+    for (int j = 0; j < nslots && at < size; j++)
         if (mark[j])
-            at += (size_t)snprintf(buf + at, size - at, "%s%s", count++ ? ", " : "",
-                                   j < m->njoints ? m->joints[j].name : "the driver");
+            at += (size_t)snprintf(buf + at, size - at, "%s%s%s", count++ ? ", " : "",
+                                   j > m->njoints ? "gear pair " : "",
+                                   j < m->njoints ? m->joints[j].name
+                                   : j == m->njoints ? "the driver"
+                                                     : m->gears[j - m->njoints - 1].name);
     free(mark);
 }
 
