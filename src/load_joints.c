@@ -55,7 +55,7 @@ static void set_joint_name(loader *ld, mech_joint *j, const ynode *name_node, co
         snprintf(buf, sizeof buf, "%s_%d", deflt, k);
     j->name = xstrdup(buf);
     if (!j->name)
-        return;
+        return (void)load_err(ld, name_node, "out of memory");
     name_map_put(&ld->joint_map, j->name, (int)(j - m->joints));
     int first = find_joint(ld, deflt);  /* its name outlives the map: a stable key */
     if (first >= 0)
