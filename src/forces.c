@@ -700,9 +700,6 @@ int forces_solve(forces *fc, const solver *sv)
     return fc->iterations < 0 ? -2 : 0;
 }
 
-/* The joints whose reactions are not determined at a singular position:
- * large components of A^-1 b (inverse iteration) lie along the null space;
- * when the factorisation itself failed, KLU's first singular column. */
 /* Where column c is marked in forces_singular_joints: its joint, the driver
  * (njoints), or its gear pair (njoints + 1 + the pair). */
 static int singular_slot(const forces_plan *fp, int c)
@@ -712,6 +709,9 @@ static int singular_slot(const forces_plan *fp, int c)
     return fp->joint[c] >= 0 ? fp->joint[c] : fp->m->njoints;
 }
 
+/* The joints whose reactions are not determined at a singular position:
+ * large components of A^-1 b (inverse iteration) lie along the null space;
+ * when the factorisation itself failed, KLU's first singular column. */
 void forces_singular_joints(forces *fc, char *buf, size_t size)
 {
     const forces_plan *fp = fc->p;
