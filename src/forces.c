@@ -3,8 +3,9 @@
  *
  * Rows: for each moving link l, forces in x and y and the moment about its
  * centre of mass G. Columns: Fx, Fy of each revolute joint; the normal force
- * N (and, for a locked slider, the couple M) of each slider; the driver's
- * torque or force. A joint's reaction acts on its receiving link (the later
+ * N (and, for a locked slider, the couple M) of each slider; the tangential
+ * tooth force of each gear pair (its separating part follows from it:
+ * gear_separation, docs/forces.md section 9); the driver's torque or force. A joint's reaction acts on its receiving link (the later
  * one in the file for a revolute, the sliding link for a slider) and its
  * opposite on the other link.
  *
