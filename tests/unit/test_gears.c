@@ -11,7 +11,9 @@
  * W cos(phi) = m a; and the loader's errors with their line:column. */
 #include <criterion/criterion.h>
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "helpers.h"
 #include "internal.h"  /* xalloc_fail_countdown */
@@ -597,4 +599,45 @@ Test(gears, out_of_memory_is_not_a_crash)
     }
     cr_log_info("out of memory: %d allocations made to fail", tried);
     cr_assert_gt(tried, 50, "only %d allocations were tried", tried);
+}
+
+/* ---- sensitivities ----------------------------------------------------- */
+
+/* A parameter that sets a gear pair's radii is refused by --sensitivity
+ * (the derivative through the gear row is not carried), at the pair's
+ * place, rather than giving derivatives without that term. */
+Test(gears, sensitivity_through_gears_refused)
+{
+    FILE *in = fopen("mechanisms/geared-five-bar.yaml", "r");
+    cr_assert(in);
+    static char text[16384], out[17000];
+    size_t n = fread(text, 1, sizeof text - 1, in);
+    fclose(in);
+    text[n] = '\0';
+    char *u = strstr(text, "units: {length: mm, angle: deg}\n"), *mod = strstr(text, "module: 2 mm");
+    cr_assert(u && mod);
+    u += strlen("units: {length: mm, angle: deg}\n");
+    snprintf(out, sizeof out, "%.*sparameters: {md: 2 mm}\n%.*smodule: md%s", (int)(u - text),
+             text, (int)(mod - u), u, mod + strlen("module: 2 mm"));
+    char path[] = "/tmp/test_gears_XXXXXX";
+    int fd = mkstemp(path);
+    cr_assert(fd >= 0);
+    cr_assert_eq(write(fd, out, strlen(out)), (ssize_t)strlen(out));
+    close(fd);
+    mech_model *m = load_path(path);
+    mech_solve_options o;
+    mech_solve_options_default(&o);
+    mech_table t = must_solve(m, &o);
+    mech_diag d;
+    mech_diag_init(&d);
+    const char *names[] = {"md"};
+    int rc = mech_sensitivity(m, NULL, 0, &o, names, 1, &t, &d);
+    unlink(path);
+    cr_assert_neq(rc, MECH_OK);
+    cr_assert(d.count >= 1 && strstr(d.entries[0].message, "gear pair 'g12'"), "%s",
+              d.count ? d.entries[0].message : "no message");
+    cr_assert_eq(d.entries[0].mark.line, m->gears[0].mark.line);
+    mech_diag_free(&d);
+    mech_table_free(&t);
+    mech_model_free(&m);
 }
