@@ -115,7 +115,7 @@ void gears_describe(const mech_model *m, int i, char *buf, size_t size)
 
 const char *gears_row_label(const mech_model *m, char *buf, size_t size)
 {
-    size_t at = (size_t)snprintf(buf, size, "gear pair%s (", m->ngears == 1 ? "" : "s");
+    size_t at = (size_t)snprintf(buf, size, "the gearing (");
     for (int i = 0; i < m->ngears && at < size; i++)
         at += (size_t)snprintf(buf + at, size - at, "%s%s", i ? ", " : "", m->gears[i].name);
     if (at < size)

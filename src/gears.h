@@ -27,7 +27,8 @@ void gears_contact(const mech_model *m, const solver *sv, int i, double *p, doub
 /* Gear pair i in words, as mech check shows it. */
 void gears_describe(const mech_model *m, int i, char *buf, size_t size);
 
-/* "gear pairs (g12, g23)": what a row after the loop rows is, in messages. */
+/* "the gearing (g12, g23)": what a row after the loop rows is, in messages
+ * that name a loop by a row's index / 2 (diagnose.c). */
 const char *gears_row_label(const mech_model *m, char *buf, size_t size);
 
 #endif

@@ -641,3 +641,49 @@ Test(gears, sensitivity_through_gears_refused)
     mech_table_free(&t);
     mech_model_free(&m);
 }
+
+/* ---- diagnostics that name gear rows ---------------------------------------- */
+
+/* Three equal gears meshing in a triangle jam (w_a = -w_b = w_c = -w_a):
+ * at the start the three rows have rank 2 (the third is implied) and no
+ * other position assembles; both messages name the gear rows. */
+Test(gears, jammed_triangle_names_the_gears)
+{
+    static const char TRI[] =
+        "name: three gears in a triangle\n"
+        "units: {length: mm, angle: deg}\n"
+        "ground: {A: [0, 0], B: [60, 0], C: [30, 51.96152422706632]}\n"
+        "links:\n"
+        "  a: {points: {A: [0, 0]}}\n"
+        "  b: {points: {B: [0, 0]}}\n"
+        "  c: {points: {C: [0, 0]}}\n"
+        "driver: {link: a, angle: {from: 0, to: 90, steps: 3}}\n"
+        "gears:\n"
+        "  - {gear: a, with: b, radii: [30, 30]}\n"
+        "  - {gear: b, with: c, radii: [30, 30]}\n"
+        "  - {gear: c, with: a, radii: [30, 30]}\n";
+    mech_diag d;
+    mech_diag_init(&d);
+    mech_model *m = NULL;
+    mech_summary s;
+    cr_assert_eq(mech_load_string(TRI, strlen(TRI), "tri.yaml", &m, &d), MECH_OK);
+    cr_assert_eq(mech_check(m, &s, &d), MECH_OK);  /* a warning: over-constrained by the count */
+    cr_assert_eq(s.mobility, 0);
+    mech_solve_options o;
+    mech_solve_options_default(&o);
+    mech_table t = {0};
+    mech_solve(m, &o, &t, NULL, &d);
+    int rank = 0, jam = 0;
+    for (size_t e = 0; e < d.count; e++) {
+        rank |= strstr(d.entries[e].message, "implied by the others: the row of gear pair "
+                                             "'c_a'") != NULL;
+        jam |= strstr(d.entries[e].message, "cannot assemble at driver angle = 30 deg: the "
+                                            "gearing (a_b, b_c, c_a) does not close") != NULL;
+    }
+    cr_assert(rank && jam, "rank %d, jam %d: %s", rank, jam,
+              d.count ? d.entries[d.count - 1].message : "");
+    cr_assert_eq(t.nrows, 1);
+    mech_table_free(&t);
+    mech_model_free(&m);
+    mech_diag_free(&d);
+}
