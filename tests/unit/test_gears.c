@@ -687,3 +687,21 @@ Test(gears, jammed_triangle_names_the_gears)
     mech_model_free(&m);
     mech_diag_free(&d);
 }
+
+/* The rack driven (0.5 m/s, 3 m/s^2) turning a pinion of inertia I: the
+ * driver force is m a + I (a / r) / r by hand, the tooth's tangential
+ * part I (a / r) / r, on the rack against its motion (W < 0). */
+Test(gears, rack_driven_force_by_hand)
+{
+    mech_model *m = rack("20", "{slider: x_R, displacement: {from: 0, to: 60, steps: 6}, "
+                         "speed: 0.5 m/s, acceleration: 3 m/s^2}", "radius: 20 mm");
+    mech_table t = solve_all(m, 1);
+    const double r = 0.02, I = 1e-4, mass = 2.0, a = 3.0;
+    for (int i = 0; i < t.nrows; i++) {
+        close_to(table_at(&t, i, "driver.force"), mass * a + I * (a / r) / r, 1e-13, "force", i);
+        close_to(table_at(&t, i, "rp.W") * cos(20 * DEG), -I * (a / r) / r, 1e-13, "W", i);
+        close_to(table_at(&t, i, "pinion.alpha"), a / r, 1e-13, "alpha", i);
+    }
+    mech_table_free(&t);
+    mech_model_free(&m);
+}
