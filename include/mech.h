@@ -191,6 +191,34 @@ typedef struct mech_spring {
     mech_mark mark;
 } mech_spring;
 
+/* A gear pair or a rack and pinion (docs/format.md section gears,
+ * docs/forces.md): one higher pair, one constraint row after the loop rows.
+ * PAIR: gears link[0] (a, 'gear') and link[1] (b, 'with') turn about pivots
+ * fixed in the arm `arm` (the ground or a carrier); with phi_k = th[link[k]]
+ * - th[arm] - offset[k]:  radius[0] phi_0 + sign radius[1] phi_1 = 0, sign
+ * +1 external, -1 internal. RACK: pinion link[0] pivoted on the guide `arm`
+ * of the locked slider `rack` (its moving link is link[1]):
+ * s - offset[1] - side radius[0] phi_0 = 0. */
+typedef enum { MECH_GEAR_PAIR, MECH_GEAR_RACK } mech_gear_kind;
+
+typedef struct mech_gear {
+    mech_gear_kind kind;
+    char *name;        /* owned; column base name */
+    int link[2];       /* PAIR: gear a, gear b; RACK: pinion, the rack's moving link */
+    int arm;           /* link carrying both pivots (PAIR) or the pinion's pivot (RACK) */
+    int pivot[2];      /* point index of each pivot in link[k] (RACK: [1] = -1) */
+    int arm_pivot[2];  /* the same pivots as point indices in the arm (RACK: [1] = -1) */
+    int rack;          /* RACK: the slider joint; PAIR: -1 */
+    double radius[2];  /* pitch radii, m (RACK: [1] = 0) */
+    int teeth[2];      /* tooth counts when given, else 0 */
+    int internal;      /* PAIR: 1 = internal (a ring gear meshes inside) */
+    int side;          /* RACK: +1 or -1, the side of the rack's line the pinion is on */
+    double offset[2];  /* PAIR: angles th - th_arm where the pair meshes as drawn, rad;
+                          RACK: [0] pinion angle, [1] rack displacement there, m */
+    double pressure_angle; /* rad */
+    mech_mark mark;
+} mech_gear;
+
 typedef struct mech_outputs {
     int *points;       /* [npoints] name ids */
     int npoints;
@@ -230,6 +258,8 @@ typedef struct mech_model {
     int nsprings;
     struct state_loads *state_loads; /* owned: the loads that depend on the motion
                                         (src/state_loads.h), NULL when there are none */
+    mech_gear *gears;     /* [ngears] gear pairs and racks (docs/format.md) */
+    int ngears;
 } mech_model;
 
 /* Read and validate a mechanism file. On success *out is the model and the
@@ -266,9 +296,11 @@ typedef struct mech_summary {
     int npin_in_slot;     /* free sliders: 1 constraint each */
     int nunknowns;        /* link angles + slider displacements, driver excluded */
     int nloops;           /* independent loops = joints - links + 1 */
-    int nequations;       /* 2 * nloops */
-    int mobility;         /* 3 (n - 1) - 2 j_full - j_half */
+    int nequations;       /* 2 * nloops + ngears */
+    int mobility;         /* 3 (n - 1) - 2 j_full - j_half - ngears */
     int ndrivers;
+    int ngears;           /* gear pairs and racks: higher pairs, 1 constraint each (in
+                             mobility and nequations) */
 } mech_summary;
 
 /* Check the topology (connectivity, mobility, unknowns against equations).

@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "commands.h"
+#include "gears.h"
 #include "springs.h"
 #include "state_loads.h"
 
@@ -47,7 +48,7 @@ static void print_springs(const mech_model *m)
 
 static void print_summary(const mech_model *m, const mech_summary *s)
 {
-    char buf[256];
+    char buf[512];
     int nsliders = s->nprismatic + s->npin_in_slot;
     printf("%s: %s\n", m->file, m->name ? m->name : "(unnamed)");
     printf("  links      %d (ground + %d moving)\n", s->nlinks, s->nlinks - 1);
@@ -57,8 +58,13 @@ static void print_summary(const mech_model *m, const mech_summary *s)
            s->nunknowns, s->nlinks - 1 - s->nprismatic, nsliders);
     printf("  loops      %d independent%s, %d equations\n", s->nloops,
            m->nloops ? " (listed in the file)" : " (found automatically)", s->nequations);
-    printf("  mobility   %d = 3*(%d-1) - 2*%d - %d, drivers %d\n", s->mobility, s->nlinks,
-           s->nrevolute + s->nprismatic, s->npin_in_slot, s->ndrivers);
+    if (s->ngears)  /* each mesh removes one freedom (gears.c) */
+        printf("  mobility   %d = 3*(%d-1) - 2*%d - %d - %d gear%s, drivers %d\n", s->mobility,
+               s->nlinks, s->nrevolute + s->nprismatic, s->npin_in_slot, s->ngears,
+               s->ngears == 1 ? "" : "s", s->ndrivers);
+    else
+        printf("  mobility   %d = 3*(%d-1) - 2*%d - %d, drivers %d\n", s->mobility, s->nlinks,
+               s->nrevolute + s->nprismatic, s->npin_in_slot, s->ndrivers);
     printf("  driver     %s\n", drive_text(m, buf, sizeof buf));
     printf("  outputs    %d points, %d links, %d sliders%s\n", m->outputs.npoints,
            m->outputs.nlinks, m->outputs.nsliders, m->outputs.forces ? ", forces" : "");
@@ -66,6 +72,10 @@ static void print_summary(const mech_model *m, const mech_summary *s)
     for (int i = 0; m->state_loads && i < m->state_loads->nloads; i++) {
         state_loads_describe(m, i, buf, sizeof buf);
         printf("  load       %s\n", buf);
+    }
+    for (int i = 0; i < m->ngears; i++) {
+        gears_describe(m, i, buf, sizeof buf);
+        printf("  gears      %s\n", buf);
     }
 }
 

@@ -162,6 +162,8 @@ static int dynamic_columns(column_layout *cl, const mech_model *m, const column_
     if (rq->friction == 2)
         rc |= force_columns(cl, m, label, 0);
     rc |= spring_columns(cl, m);
+    for (int i = 0; i < m->ngears; i++)  /* each mesh's tooth force (docs/forces.md) */
+        rc |= add(cl, SRC_GEAR, i, 0, m->gears[i].name, ".W", "N");
     for (int j = 0; j < m->njoints; j++)
         free(label[j]);
     free(label);
@@ -297,6 +299,7 @@ static void source_values(const column_group *g, const row_sources *rs, double *
     case SRC_RCOND: v[0] = sv->rcond; break;
     case SRC_SUBSTEPS: v[0] = rs->substeps; break;
     case SRC_SPRING: spring_values(&sv->p->m->springs[g->obj], sv, v); break;
+    case SRC_GEAR: v[0] = forces_gear(rs->fc, g->obj, 1); break;
     }
 }
 

@@ -26,7 +26,8 @@ typedef enum {
     SRC_RESIDUAL,
     SRC_RCOND,
     SRC_SUBSTEPS,
-    SRC_SPRING           /* obj: spring; comp 0..2: length (angle), rate, force (torque) */
+    SRC_SPRING,          /* obj: spring; comp 0..2: length (angle), rate, force (torque) */
+    SRC_GEAR             /* obj: gear pair; the tooth force along the line of action */
 } column_source;
 
 typedef struct column_desc {

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "diagnose.h"
+#include "gears.h"
 
 static const double PI = 3.14159265358979323846;
 
@@ -43,6 +44,8 @@ const char *diagnose_loop_label(const solver *sv, int k, char *buf, size_t size)
 {
     const mech_model *m = sv->p->m;
     const loop_set *ls = &sv->p->sys->loops;
+    if (k >= ls->nloops)  /* a gear pair's row (after the loops'; k is a row / 2) */
+        return gears_row_label(m, buf, size);
     size_t at = (size_t)snprintf(buf, size, "loop %d (", k + 1);
     if (ls->from_file && k < m->nloops) {
         for (int i = 0; i < m->loops[k].npoints && at < size; i++)
@@ -360,10 +363,16 @@ void diagnose_redundant(cont *c, double q)
     int count = dependent_rows(nr, ns, a, cf, named);
     char list[600] = "", lb[256], qb[64];
     size_t at = 0;
-    for (int i = 0; i < count && at < sizeof list; i++)
-        at += (size_t)snprintf(list + at, sizeof list - at, "%s%s equation of %s",
-                               i ? ", " : "", sv->p->row[named[i]] % 2 ? "y" : "x",
-                               diagnose_loop_label(sv, sv->p->row[named[i]] / 2, lb, sizeof lb));
+    for (int i = 0; i < count && at < sizeof list; i++) {
+        int row = sv->p->row[named[i]], g = row - 2 * sv->p->sys->loops.nloops;
+        if (g >= 0 && g < sv->p->m->ngears)  /* a gear pair's row (gears.c) */
+            at += (size_t)snprintf(list + at, sizeof list - at, "%srow of gear pair '%s'",
+                                   i ? ", " : "", sv->p->m->gears[g].name);
+        else
+            at += (size_t)snprintf(list + at, sizeof list - at, "%s%s equation of %s",
+                                   i ? ", " : "", row % 2 ? "y" : "x",
+                                   diagnose_loop_label(sv, row / 2, lb, sizeof lb));
+    }
     free(a);
     free(cf);
     free(named);

@@ -3,8 +3,9 @@
  *
  * Rows: for each moving link l, forces in x and y and the moment about its
  * centre of mass G. Columns: Fx, Fy of each revolute joint; the normal force
- * N (and, for a locked slider, the couple M) of each slider; the driver's
- * torque or force. A joint's reaction acts on its receiving link (the later
+ * N (and, for a locked slider, the couple M) of each slider; the tangential
+ * tooth force of each gear pair (its separating part follows from it:
+ * gear_separation, docs/forces.md section 9); the driver's torque or force. A joint's reaction acts on its receiving link (the later
  * one in the file for a revolute, the sliding link for a slider) and its
  * opposite on the other link.
  *
@@ -22,6 +23,7 @@
 #include <string.h>
 
 #include "forces.h"
+#include "gears.h"
 #include "springs.h"
 #include "state_loads.h"
 
@@ -135,7 +137,7 @@ static void column_geometry(const solver *sv, const mech_joint *jt, fc_kind kind
     case FC_FY: dir[0] = 0.0; dir[1] = 1.0; break;
     case FC_NORMAL: dir[0] = -u[1]; dir[1] = u[0]; break;
     case FC_DRIVE: dir[0] = u[0]; dir[1] = u[1]; break;
-    case FC_MOMENT: dir[0] = dir[1] = 0.0; break;
+    case FC_MOMENT: case FC_GEAR: dir[0] = dir[1] = 0.0; break;
     }
 }
 
@@ -147,6 +149,13 @@ static int column_entries(const forces_plan *fp, const solver *sv, const double 
 {
     const mech_model *m = fp->m;
     int n = 0;
+    if (fp->kind[c] == FC_GEAR) {  /* the tooth force: on link[1], its opposite on link[0] */
+        const mech_gear *gr = &m->gears[fp->joint[c]];
+        double p[2], t[2], r[2];  /* the unknown: its component along the tangent t */
+        gears_contact(m, sv, fp->joint[c], p, t, r);
+        n = push_force(e, n, g, gr->link[1], p, t, 1.0);
+        return push_force(e, n, g, gr->link[0], p, t, -1.0);
+    }
     if (fp->joint[c] < 0 && m->driver.kind == MECH_DRIVE_ANGLE) {
         n = push_moment(e, n, m->driver.index, 1.0);
     } else {
@@ -190,6 +199,9 @@ static void make_columns(forces_plan *fp)
         if (jt->friction > 0.0)
             fp->has_friction = 1;
     }
+    fp->gcol = fp->ncols;
+    for (int g = 0; g < m->ngears; g++)
+        add_column(fp, FC_GEAR, g);
     add_column(fp, FC_DRIVE, -1);
 }
 
@@ -244,7 +256,7 @@ int forces_plan_init(forces_plan *fp, const solver_plan *sp, int friction, mech_
     memset(fp, 0, sizeof *fp);
     fp->m = m;
     fp->nrows = 3 * (m->nlinks - 1);
-    size_t nc = 2 * (size_t)m->njoints + 2;
+    size_t nc = 2 * (size_t)m->njoints + (size_t)m->ngears + 2;
     fp->kind = xcalloc(nc, sizeof *fp->kind);
     fp->joint = xcalloc(nc, sizeof *fp->joint);
     fp->jcol = xcalloc((size_t)m->njoints + 1, sizeof *fp->jcol);
@@ -391,6 +403,24 @@ static void known_loads(const forces *fc, const solver *sv, double *rhs)
     }
     springs_add_loads(m, sv, fc->g, rhs);
     state_loads_add(m->state_loads, sv, fc->sl_reg, fc->g, rhs);
+}
+
+/* The separating part of each tooth force, |F| tan(pressure angle) for the
+ * tangential force F of reactions y (gears.h): a known load given y. It
+ * lies along the line of centres, so it changes no F, only the pivots'
+ * reactions: one more solve finds them. */
+static void gear_separation(const forces *fc, const solver *sv, const double *y, double *rhs)
+{
+    const mech_model *m = fc->p->m;
+    for (int i = 0; i < m->ngears; i++) {
+        const mech_gear *gr = &m->gears[i];
+        double p[2], t[2], r[2];
+        gears_contact(m, sv, i, p, t, r);
+        double k = fabs(y[fc->p->gcol + i]) * tan(gr->pressure_angle);
+        double fb[2] = {k * r[0], k * r[1]}, fa[2] = {-fb[0], -fb[1]};
+        load_force(rhs, fc, gr->link[1], p, fb);
+        load_force(rhs, fc, gr->link[0], p, fa);
+    }
 }
 
 /* ---- friction ---------------------------------------------------------- */
@@ -596,6 +626,7 @@ static void friction_fixed_point(forces *fc, const solver *sv)
         friction_loads(fc, sv, fc->y);
         for (int i = 0; i < n; i++)
             fc->fric[i] += fc->b[i];
+        gear_separation(fc, sv, fc->y, fc->fric);
         solve_rhs(fc, fc->fric, g);
         double res = 0.0, big = 0.0;
         for (int i = 0; i < n; i++) {
@@ -659,6 +690,11 @@ int forces_solve(forces *fc, const solver *sv)
     fc->residual0 = 0.0;
     if (!fp->friction || fp->want_frictionless || !fc->have_previous) {
         solve_rhs(fc, fc->b, fc->y0);
+        if (fp->m->ngears) {  /* the teeth's separating forces, from their tangential ones */
+            memcpy(fc->fric, fc->b, (size_t)n * sizeof *fc->fric);
+            gear_separation(fc, sv, fc->y0, fc->fric);
+            solve_rhs(fc, fc->fric, fc->y0);
+        }
         fc->residual0 = power_residual(fc, sv, fc->y0[drive], 0.0);
         memcpy(fc->y, fc->y0, (size_t)n * sizeof *fc->y);
     }
@@ -672,6 +708,15 @@ int forces_solve(forces *fc, const solver *sv)
     return fc->iterations < 0 ? -2 : 0;
 }
 
+/* Where column c is marked in forces_singular_joints: its joint, the driver
+ * (njoints), or its gear pair (njoints + 1 + the pair). */
+static int singular_slot(const forces_plan *fp, int c)
+{
+    if (fp->kind[c] == FC_GEAR)
+        return fp->m->njoints + 1 + fp->joint[c];
+    return fp->joint[c] >= 0 ? fp->joint[c] : fp->m->njoints;
+}
+
 /* The joints whose reactions are not determined at a singular position:
  * large components of A^-1 b (inverse iteration) lie along the null space;
  * when the factorisation itself failed, KLU's first singular column. */
@@ -681,8 +726,8 @@ void forces_singular_joints(forces *fc, char *buf, size_t size)
     const mech_model *m = fp->m;
     size_t at = 0;
     buf[0] = '\0';
-    int ncols = fp->ncols, count = 0;
-    unsigned char *mark = xcalloc((size_t)m->njoints + 2, 1);
+    int ncols = fp->ncols, count = 0, nslots = m->njoints + 1 + m->ngears;
+    unsigned char *mark = xcalloc((size_t)nslots + 1, 1);
     if (!mark)
         return;
     if (fc->ls.factored) {
@@ -692,15 +737,17 @@ void forces_singular_joints(forces *fc, char *buf, size_t size)
         double big = vec_norm_inf(fc->ynext, ncols);
         for (int c = 0; c < ncols; c++)
             if (isfinite(big) && fabs(fc->ynext[c]) > 0.1 * big)
-                mark[fp->joint[c] >= 0 ? fp->joint[c] : m->njoints] = 1;
+                mark[singular_slot(fp, c)] = 1;
     } else if (linsys_singular_col(&fc->ls) >= 0) {
-        int c = linsys_singular_col(&fc->ls);
-        mark[fp->joint[c] >= 0 ? fp->joint[c] : m->njoints] = 1;
+        mark[singular_slot(fp, linsys_singular_col(&fc->ls))] = 1;
     }
-    for (int j = 0; j <= m->njoints && at < size; j++)
+    for (int j = 0; j < nslots && at < size; j++)
         if (mark[j])
-            at += (size_t)snprintf(buf + at, size - at, "%s%s", count++ ? ", " : "",
-                                   j < m->njoints ? m->joints[j].name : "the driver");
+            at += (size_t)snprintf(buf + at, size - at, "%s%s%s", count++ ? ", " : "",
+                                   j > m->njoints ? "gear pair " : "",
+                                   j < m->njoints ? m->joints[j].name
+                                   : j == m->njoints ? "the driver"
+                                                     : m->gears[j - m->njoints - 1].name);
     free(mark);
 }
 
@@ -730,4 +777,10 @@ double forces_drive(const forces *fc, int with_friction)
 {
     const forces_plan *fp = fc->p;
     return (with_friction ? fc->y : fc->y0)[fp->ncols - 1];
+}
+
+double forces_gear(const forces *fc, int i, int with_friction)
+{
+    const forces_plan *fp = fc->p;
+    return (with_friction ? fc->y : fc->y0)[fp->gcol + i] / cos(fp->m->gears[i].pressure_angle);
 }

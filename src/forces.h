@@ -8,7 +8,7 @@
 #include "solve.h"
 
 /* What one column of the force system is. */
-typedef enum { FC_FX, FC_FY, FC_NORMAL, FC_MOMENT, FC_DRIVE } fc_kind;
+typedef enum { FC_FX, FC_FY, FC_NORMAL, FC_MOMENT, FC_DRIVE, FC_GEAR } fc_kind;
 
 /* The force system of a mechanism (fixed: built once, read only, shared). */
 typedef struct forces_plan {
@@ -19,7 +19,10 @@ typedef struct forces_plan {
     int nrows;              /* 3 per moving link */
     int ncols;
     fc_kind *kind;          /* [ncols] */
-    int *joint;             /* [ncols] joint of a reaction column (-1: the driver) */
+    int *joint;             /* [ncols] joint of a reaction column (-1: the driver; FC_GEAR:
+                               the gear pair) */
+    int gcol;               /* first tooth-force column (one per gear pair, before the
+                               driver's, which stays last) */
     int *jcol;              /* [njoints] first column of each joint */
     int *Ap, *Ai;           /* [ncols+1], [nnz] */
     int *slot;              /* [nnz] where column c's k-th entry, in the order
@@ -72,6 +75,9 @@ int forces_solve(forces *fc, const solver *sv);
 void forces_joint(const forces *fc, const solver *sv, int j, int with_friction, double *fx,
                   double *fy, double *n, double *mo);
 double forces_drive(const forces *fc, int with_friction);
+/* Tooth force of gear pair i along its line of action (gears.h), N: the
+ * sign of its tangential part F (on link[1], along t). */
+double forces_gear(const forces *fc, int i, int with_friction);
 /* After forces_solve returned -1: the names of the joints involved. */
 void forces_singular_joints(forces *fc, char *buf, size_t size);
 

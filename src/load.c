@@ -19,6 +19,8 @@
  *         | {distributed, link, from, to, direction}]
  *   springs: [{between: [P, Q], links, name, stiffness, free_length, preload, damping}
  *           | {at: JOINT, name, stiffness, free_angle, preload, damping}]   (load_springs.c)
+ *   gears: [{gear, with, teeth, module, radii, internal, arm, pressure_angle, offset, name}
+ *          | {pinion, rack, radius, teeth, module, offset, rack_offset, ...}] (load_gears.c)
  *   outputs: {points: [...], links: [...], sliders: [...], forces: bool}
  *
  * Every problem is recorded with its file:line:column and loading goes on,
@@ -45,7 +47,8 @@ static void load_document(loader *ld, const ynode *root)
 {
     static const char *const keys[] = {"name", "description", "units", "parameters", "gravity",
                                        "ground", "links", "joints", "driver", "initial",
-                                       "branch", "loops", "loads", "springs", "outputs"};
+                                       "branch", "loops", "loads", "springs", "gears",
+                                       "outputs"};
     mech_model *m = ld->m;
     if (!load_check_keys(ld, root, keys, COUNT(keys), "the mechanism"))
         return;
@@ -84,6 +87,8 @@ static void load_document(loader *ld, const ynode *root)
     if ((v = ymap_get(root, "joints")))
         load_joints(ld, v);
     load_add_implicit_revolutes(ld);
+    if ((v = ymap_get(root, "gears")))  /* before the points check: a gear may have one */
+        load_gears(ld, v);
     load_check_link_points(ld);
     load_warn_point_typos(ld);
     if ((v = ymap_get(root, "driver")))

@@ -140,4 +140,7 @@ void load_state_line(loader *ld, const ynode *map);
 /* ---- load_springs.c: springs and dampers. */
 void load_springs(loader *ld, const ynode *seq);
 
+/* ---- load_gears.c: gear pairs and racks. */
+void load_gears(loader *ld, const ynode *seq);
+
 #endif

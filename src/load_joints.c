@@ -55,7 +55,7 @@ static void set_joint_name(loader *ld, mech_joint *j, const ynode *name_node, co
         snprintf(buf, sizeof buf, "%s_%d", deflt, k);
     j->name = xstrdup(buf);
     if (!j->name)
-        return;
+        return (void)load_err(ld, name_node, "out of memory");
     name_map_put(&ld->joint_map, j->name, (int)(j - m->joints));
     int first = find_joint(ld, deflt);  /* its name outlives the map: a stable key */
     if (first >= 0)
@@ -416,6 +416,8 @@ void load_check_link_points(loader *ld)
     for (int ji = 0; ji < m->njoints; ji++)
         if (m->joints[ji].kind == MECH_JOINT_SLIDER)
             slides[m->joints[ji].link[0]] = 1;
+    for (int g = 0; g < m->ngears; g++)  /* a gear turning on its pivot: one point will do */
+        slides[m->gears[g].link[0]] = slides[m->gears[g].link[1]] = 1;
     for (int li = 1; li < m->nlinks; li++) {
         const mech_link *l = &m->links[li];
         if (!l->name || (ld->link_failed[li] & LINK_FAILED) || slides[li])

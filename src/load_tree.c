@@ -366,9 +366,11 @@ int load_find_link_or_report(loader *ld, const ynode *n, const char *what)
     if (load_errors_full(ld))
         return load_err(ld, n, "unknown link"), -1;
     const char **names = xcalloc((size_t)ld->m->nlinks, sizeof *names);
+    size_t known = 0;  /* a link whose name ran out of memory has none */
     for (int i = 0; names && i < ld->m->nlinks; i++)
-        names[i] = ld->m->links[i].name;
-    load_err_unknown(ld, n, "link", "links", name, names, names ? (size_t)ld->m->nlinks : 0);
+        if (ld->m->links[i].name)
+            names[known++] = ld->m->links[i].name;
+    load_err_unknown(ld, n, "link", "links", name, names, known);
     free(names);
     return -1;
 }

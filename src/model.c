@@ -77,6 +77,9 @@ void mech_model_free(mech_model **pm)
         free(m->springs[i].name);
     free(m->springs);
     state_loads_free(m->state_loads);
+    for (int i = 0; i < m->ngears; i++)
+        free(m->gears[i].name);
+    free(m->gears);
     free(m->outputs.points);
     free(m->outputs.links);
     free(m->outputs.sliders);
@@ -353,24 +356,32 @@ int mech_check(const mech_model *m, mech_summary *s, mech_diag *d)
         return diag_error(d, m->file, (mech_mark){0, 0}, "out of memory"), MECH_ENOMEM;
     }
     count_joints(m, s, njoints_of);
+    s->ngears = m->ngears;
+    for (int g = 0; g < m->ngears; g++)  /* a mesh holds a gear as a joint does */
+        for (int k = 0; k < 2; k++)
+            njoints_of[m->gears[g].link[k]]++;
     int joints = m->njoints;
     int nangles = m->nlinks - 1 - s->nprismatic;
     int nsliders = s->nprismatic + s->npin_in_slot;
     s->nunknowns = nangles + nsliders - s->ndrivers;
     s->nloops = joints - m->nlinks + 1;
-    s->nequations = 2 * s->nloops;
-    s->mobility = 3 * (m->nlinks - 1) - 2 * (s->nrevolute + s->nprismatic) - s->npin_in_slot;
+    s->nequations = 2 * s->nloops + m->ngears;
+    s->mobility = 3 * (m->nlinks - 1) - 2 * (s->nrevolute + s->nprismatic) - s->npin_in_slot -
+                  m->ngears;
     size_t before = d->nerrors;
     int connected = check_connected(m, work, d);
     int dangling = report_dangling(m, njoints_of, d);
     if (connected && !dangling && s->mobility != s->ndrivers) {
         mech_mark at = m->has_driver ? m->driver.mark : (mech_mark){0, 0};
         int excess = s->mobility - s->ndrivers, abs_excess = excess < 0 ? -excess : excess;
-        char gruebler[128];
+        char gruebler[192];
+        char mesh[32] = "";
+        if (m->ngears)
+            snprintf(mesh, sizeof mesh, " - %d gear%s", m->ngears, m->ngears == 1 ? "" : "s");
         snprintf(gruebler, sizeof gruebler, "%d degree%s of freedom (Gruebler: 3*(%d-1) - 2*%d "
-                 "- %d = %d) but %d driver, so %d unknown%s for %d loop equations",
+                 "- %d%s = %d) but %d driver, so %d unknown%s for %d loop equations",
                  s->mobility, s->mobility == 1 || s->mobility == -1 ? "" : "s", m->nlinks,
-                 s->nrevolute + s->nprismatic, s->npin_in_slot, s->mobility, s->ndrivers,
+                 s->nrevolute + s->nprismatic, s->npin_in_slot, mesh, s->mobility, s->ndrivers,
                  s->nunknowns, s->nunknowns == 1 ? "" : "s", s->nequations);
         if (excess > 0) {
             diag_error(d, m->file, at,

@@ -67,8 +67,9 @@ static int seeded(const mech_model *m, const mech_override *ov, int nov, const c
 }
 
 /* The seeded load carries derivatives into the points only. A parameter
- * that also sets a slider's angle would be differentiated without that
- * term: found by loading the file with the parameter nudged, and refused. */
+ * that also sets a slider's angle, or a gear pair's radii or phase, would be
+ * differentiated without that term: found by loading the file with the
+ * parameter nudged, and refused. */
 static int check_slider_angles(const mech_model *m, const mech_override *ov, int nov,
                                const mech_param *p, mech_diag *d)
 {
@@ -99,6 +100,17 @@ static int check_slider_angles(const mech_model *m, const mech_override *ov, int
             mech_model_free(&nm);
             return rc;
         }
+    for (int g = 0; g < m->ngears && nm->ngears == m->ngears; g++) {  /* gears.c's rows */
+        const mech_gear *a = &m->gears[g], *b = &nm->gears[g];
+        if (a->radius[0] != b->radius[0] || a->radius[1] != b->radius[1] ||
+            a->offset[0] != b->offset[0] || a->offset[1] != b->offset[1]) {
+            rc = diag_error(d, m->file, a->mark, "parameter '%s' sets the radii or the phase of "
+                            "gear pair '%s': sensitivities through a gear pair are not computed",
+                            p->name, a->name);
+            mech_model_free(&nm);
+            return rc;
+        }
+    }
     mech_model_free(&nm);
     return MECH_OK;
 }

@@ -255,6 +255,39 @@ static void place_guides(anim_ctx *c, box *b, double margin)
     }
 }
 
+/* A gear's pitch circle (docs/format.md 6.4): drawn about its pivot; the box
+ * grows to hold it. Gear k of pair i is `which` = 2 i + k. */
+enum { GEAR_SEGMENTS = 72 };
+
+static void gear_of(const anim_ctx *c, int which, int *link, int *p, double *radius)
+{
+    const mech_gear *g = &c->m->gears[which / 2];
+    int k = which % 2;
+    *link = g->link[k];
+    *p = c->m->links[g->link[k]].points[g->pivot[k]].id;
+    *radius = g->radius[k];
+}
+
+static void place_gears(const anim_ctx *c, box *b)
+{
+    for (int w = 0; w < 2 * c->m->ngears; w++) {
+        if (c->m->gears[w / 2].kind == MECH_GEAR_RACK && w % 2)
+            continue;
+        int l, p;
+        double rad;
+        gear_of(c, w, &l, &p, &rad);
+        for (int r = 0; r < c->nrows; r++) {
+            double x = c->X[(size_t)r * c->np + p], y = c->Y[(size_t)r * c->np + p];
+            if (isfinite(x) && isfinite(y)) {
+                b->xmin = fmin(b->xmin, x - rad);
+                b->xmax = fmax(b->xmax, x + rad);
+                b->ymin = fmin(b->ymin, y - rad);
+                b->ymax = fmax(b->ymax, y + rad);
+            }
+        }
+    }
+}
+
 /* The scale (the larger side of box b is ANIM_DRAW px; pads leave room for
  * symbols), the page size, and X, Y from metres to screen px. */
 static void set_scale(anim_ctx *c, const box *b)
@@ -329,6 +362,7 @@ static int anim_prepare(anim_ctx *c, mech_diag *d)
     bounds(c, &b);
     double size = fmax(fmax(b.xmax - b.xmin, b.ymax - b.ymin), 1e-9);
     place_guides(c, &b, 0.08 * size);
+    place_gears(c, &b);
     set_scale(c, &b);
     rc = choose_frames(c, d);
     if (rc == MECH_OK)
@@ -382,6 +416,25 @@ static int guide_shape(const anim_ctx *c, int j, int r, double *xs, double *ys)
         ys[e] = c->Y[(size_t)r * c->np + tp] - c->s * c->guide[j][e] * sin(a);
     }
     return 2;
+}
+
+/* Gear `which`'s pitch circle from a spoke: the pivot, the rim along the
+ * gear's x axis, once round (the spoke shows it turn). */
+static int gear_shape(const anim_ctx *c, int which, int r, double *xs, double *ys)
+{
+    int l, p;
+    double rad;
+    gear_of(c, which, &l, &p, &rad);
+    double x = c->X[(size_t)r * c->np + p], y = c->Y[(size_t)r * c->np + p];
+    double a = c->ang[(size_t)r * c->m->nlinks + l], pr = c->s * rad;
+    xs[0] = x;
+    ys[0] = y;
+    for (int k = 0; k <= GEAR_SEGMENTS; k++) {
+        double t = a + 2.0 * 3.14159265358979323846 * k / GEAR_SEGMENTS;
+        xs[k + 1] = x + pr * cos(t);
+        ys[k + 1] = y - pr * sin(t);  /* screen y points down */
+    }
+    return GEAR_SEGMENTS + 2;
 }
 
 static void put_vertices(FILE *f, const double *xs, const double *ys, int n)
@@ -649,7 +702,7 @@ static int emit_animation(FILE *f, const void *vctx)
     const anim_ctx *c = vctx;
     const mech_model *m = c->m;
     char b3[32];
-    int maxv = 4;
+    int maxv = m->ngears ? GEAR_SEGMENTS + 2 : 4;
     for (int i = 0; i < m->nlinks; i++)
         if (c->nhull[i] > maxv)
             maxv = c->nhull[i];
@@ -665,6 +718,16 @@ static int emit_animation(FILE *f, const void *vctx)
     put_scale_bar(f, c);
     put_guides_and_pivots(f, c, xs, ys);
     put_links_and_blocks(f, c, xs, ys);
+    for (int w = 0; w < 2 * m->ngears; w++) {  /* pitch circles over the links */
+        if (m->gears[w / 2].kind == MECH_GEAR_RACK && w % 2)
+            continue;
+        int l = m->gears[w / 2].link[w % 2];
+        char attrs[128];
+        snprintf(attrs, sizeof attrs, "fill=\"none\" stroke=\"%s\" stroke-width=\"2\" "
+                 "stroke-dasharray=\"6 3\"", c->o->test_colours ? "#8a8a8a"
+                                                  : l ? link_stroke[l % 6] : "#555");
+        put_shape(f, c, "polyline", attrs, gear_shape, w, 1, xs, ys);
+    }
     for (int p = 0; p < c->np; p++)
         put_point(f, c, p, dur);
     if (c->o->pause_at >= 0 && c->nframes > 1) /* tests: a still of the running animation */

@@ -86,7 +86,13 @@ static void print_text(const mech_system *s, FILE *out)
     for (int r = 0; r < s->m; r++) {
         fprintf(out, "  f%d = ", r + 1);
         expr_print(&s->ex, s->f[r], &nm, 0, out);
-        fprintf(out, "    [loop %d, %c]\n", r / 2 + 1, r % 2 ? 'y' : 'x');
+        int g = r - 2 * s->loops.nloops;  /* gears.c's rows follow the loops' */
+        if (g >= 0 && g < s->model->ngears)
+            fprintf(out, "    [gear pair '%s']\n", s->model->gears[g].name);
+        else if (g >= 0)
+            fprintf(out, "    [row %d]\n", r + 1);
+        else
+            fprintf(out, "    [loop %d, %c]\n", r / 2 + 1, r % 2 ? 'y' : 'x');
     }
     fprintf(out, "\njacobian df/dx (%d nonzeros):\n", s->nnz);
     for (int j = 0; j < n; j++)
@@ -174,8 +180,13 @@ static void latex_coefficients(const mech_system *s, FILE *out)
 
 static void latex_loops(const mech_system *s, FILE *out)
 {
-    fprintf(out, "\\subsection*{Loops (%s)}\n\\begin{enumerate}\n",
+    fprintf(out, "\\subsection*{Loops (%s)}\n",
             s->loops.from_file ? "as listed in the file" : "found automatically");
+    if (s->loops.nloops == 0) {  /* a gear train: an empty list is not LaTeX */
+        fputs("None: the gear rows alone fix the unknowns.\n", out);
+        return;
+    }
+    fputs("\\begin{enumerate}\n", out);
     for (int k = 0; k < s->loops.nloops; k++) {
         char buf[4096];
         FILE *mem = fmemopen(buf, sizeof buf, "w");

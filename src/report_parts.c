@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "report.h"
+#include "gears.h"
 #include "springs.h"
 
 #define RAD2DEG_R 57.295779513082321
@@ -96,8 +97,11 @@ static void put_summary(FILE *f, const mech_model *m, const mech_summary *s)
     snprintf(b, sizeof b, "%d independent%s, %d equations", s->nloops,
              m->nloops ? " (listed in the file)" : " (found automatically)", s->nequations);
     row_text(f, "loops", b);
-    snprintf(b, sizeof b, "%d = 3*(%d-1) - 2*%d - %d, drivers %d", s->mobility, s->nlinks,
-             s->nrevolute + s->nprismatic, s->npin_in_slot, s->ndrivers);
+    char mesh[32] = "";  /* each gear pair or rack removes one freedom (gears.c) */
+    if (s->ngears)
+        snprintf(mesh, sizeof mesh, " - %d gear%s", s->ngears, s->ngears == 1 ? "" : "s");
+    snprintf(b, sizeof b, "%d = 3*(%d-1) - 2*%d - %d%s, drivers %d", s->mobility, s->nlinks,
+             s->nrevolute + s->nprismatic, s->npin_in_slot, mesh, s->ndrivers);
     row_text(f, "mobility", b);
     driver_text(m, 0, b, sizeof b);
     row_text(f, "driver", b);
@@ -111,6 +115,10 @@ static void put_summary(FILE *f, const mech_model *m, const mech_summary *s)
     for (int i = 0; i < m->nsprings; i++) {
         springs_describe(m, i, b, sizeof b);
         row_text(f, "spring", b);
+    }
+    for (int i = 0; i < m->ngears; i++) {
+        gears_describe(m, i, b, sizeof b);
+        row_text(f, "gears", b);
     }
     fputs("</table>\n", f);
 }

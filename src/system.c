@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "gears.h"
 #include "param_grad.h"
 #include "system.h"
 
@@ -291,7 +292,7 @@ static int build_residual(mech_system *s, mech_diag *d)
 {
     const mech_model *m = s->model;
     const loop_set *ls = &s->loops;
-    int rows = 2 * ls->nloops, maxterms = 1;
+    int rows = 2 * ls->nloops + m->ngears, maxterms = 1;
     for (int k = 0; k < ls->nloops; k++)
         if (ls->start[k + 1] - ls->start[k] > maxterms)
             maxterms = ls->start[k + 1] - ls->start[k];
@@ -309,6 +310,7 @@ static int build_residual(mech_system *s, mech_diag *d)
         s->f[2 * k] = balanced_sum(&s->ex, xs, nt);
         s->f[2 * k + 1] = balanced_sum(&s->ex, ys, nt);
     }
+    gears_rows(s, s->f + 2 * ls->nloops);  /* gear pairs: one row each, after the loops */
     free(xs);
     free(ys);
     return MECH_OK;
@@ -535,7 +537,7 @@ int sys_new_with(const mech_model *m, sys_mode mode, const sys_params *params,
     }
     if ((rc = loops_build(m, &s->span, &s->loops, d)) != MECH_OK)
         goto fail;
-    s->m = 2 * s->loops.nloops;
+    s->m = 2 * s->loops.nloops + m->ngears;
     /* more equations than unknowns: redundant constraints, which the solver
        treats in the least-squares sense and checks for consistency */
     if (s->m < s->n) {

@@ -122,6 +122,14 @@ for f in mechanisms/*.yaml; do
     fi
 done
 
+# ---- mech check lists the gears and counts them (docs/format.md 6.4) ----
+
+if run "mech check epicyclic" 0 "$MECH" check mechanisms/epicyclic.yaml; then
+    has_line "$tmp/out" "^  gears      g_sp: 'sun' with 'planet', external on 'carrier', r 20:40 mm, z 20:40, ratio -0.5, pressure angle 20 deg\$" "mech check lists a gear pair"
+    has_line "$tmp/out" "^  gears      g_pr: 'planet' with 'ground', internal on 'carrier', r 40:100 mm, z 40:100, ratio +0.4, pressure angle 20 deg\$" "mech check lists an internal pair"
+    has_line "$tmp/out" '^  mobility   1 = 3\*(4-1) - 2\*3 - 0 - 2 gears, drivers 1$' "mech check counts the gears"
+fi
+
 # ---- mech solve ---------------------------------------------------------
 
 # has_line FILE PATTERN LABEL: pass when FILE has a line matching PATTERN

@@ -67,7 +67,10 @@ def test_solve_equals_the_csv_bit_for_bit(path):
     r = mech.solve(path)
     assert_same_as_cli(r, path)
     assert r.stats['steps'] == r.nrows
-    assert r.stats['iterations'] >= r.nrows
+    # a gear train with no loop is linear: its predictor is exact, Newton
+    # has nothing to do (docs/format.md 6.4)
+    if mech.check(path)['structure']['loops'] > 0:
+        assert r.stats['iterations'] >= r.nrows
     assert r.stats['worst_residual'] < 1e-9
 
 
