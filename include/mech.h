@@ -100,7 +100,9 @@ typedef struct mech_joint {
     mech_mark mark;
 } mech_joint;
 
-typedef enum { MECH_DRIVE_ANGLE, MECH_DRIVE_SLIDER } mech_drive_kind;
+/* MECH_DRIVE_TIME: the sweep variable is time; the motion is given by the
+ * model's `motions` (the `drivers:` list, docs/format.md section 7.3). */
+typedef enum { MECH_DRIVE_ANGLE, MECH_DRIVE_SLIDER, MECH_DRIVE_TIME } mech_drive_kind;
 
 typedef struct mech_driver {
     mech_drive_kind kind;
@@ -111,6 +113,17 @@ typedef struct mech_driver {
     double accel;      /* rad/s^2 or m/s^2 */
     mech_mark mark;
 } mech_driver;
+
+/* One entry of `drivers:` (docs/format.md section 7.3): a link angle or a
+ * slider displacement given as a law of the time t, compiled symbolically
+ * (src/drivers.h). */
+typedef struct mech_motion {
+    mech_drive_kind kind; /* MECH_DRIVE_ANGLE: link index; MECH_DRIVE_SLIDER: joint index */
+    int index;
+    char *text;           /* owned: the law as written */
+    struct mech_law *law; /* owned: its expression tree (src/drivers.h) */
+    mech_mark mark;
+} mech_motion;
 
 typedef struct mech_guess {
     int is_slider;     /* 0: link angle, 1: slider displacement */
@@ -228,6 +241,9 @@ typedef struct mech_model {
     mech_spring *springs; /* [nsprings] springs and dampers (last: the fields before
                              keep their places) */
     int nsprings;
+    mech_motion *motions; /* [nmotions] drivers as laws of time (driver.kind ==
+                             MECH_DRIVE_TIME: driver.values are the times), or none */
+    int nmotions;
 } mech_model;
 
 /* Read and validate a mechanism file. On success *out is the model and the

@@ -59,7 +59,9 @@ static int kinematic_columns(column_layout *cl, const mech_model *m, const mech_
     static const char *const link_unit[] = {"rad", "rad/s", "rad/s^2"};
     static const char *const slide_sfx[] = {".s", ".v", ".a"};
     static const char *const slide_unit[] = {"m", "m/s", "m/s^2"};
-    int rc = add(cl, SRC_DRIVER, 0, 0, "q", "", m->driver.kind == MECH_DRIVE_ANGLE ? "rad" : "m");
+    int time = m->driver.kind == MECH_DRIVE_TIME;  /* drivers as laws of t */
+    int rc = add(cl, SRC_DRIVER, 0, 0, time ? "t" : "q", "",
+                 time ? "s" : m->driver.kind == MECH_DRIVE_ANGLE ? "rad" : "m");
     for (int i = 0; i < o->npoints; i++)
         for (int k = 0; k < 6; k++)
             if (k < 2 || (k < 4 ? level & MECH_WANT_VELOCITY : level & MECH_WANT_ACCELERATION))

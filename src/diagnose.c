@@ -16,6 +16,8 @@ const char *diagnose_q_text(const mech_model *m, double q, char *buf, size_t siz
 {
     if (is_angle_driver(m))
         snprintf(buf, size, "%.6g deg", q * 180.0 / PI);
+    else if (m->driver.kind == MECH_DRIVE_TIME)
+        snprintf(buf, size, "%.6g s", q);
     else
         snprintf(buf, size, "%.6g mm", q * 1e3);
     return buf;
@@ -24,18 +26,19 @@ const char *diagnose_q_text(const mech_model *m, double q, char *buf, size_t siz
 const char *diagnose_q_interval(const mech_model *m, double a, double b, char *buf,
                                 size_t size)
 {
-    double unit = is_angle_driver(m) ? 180.0 / PI : 1e3;
+    double unit = is_angle_driver(m) ? 180.0 / PI : m->driver.kind == MECH_DRIVE_TIME ? 1.0 : 1e3;
     double lo = fmin(a, b) * unit, hi = fmax(a, b) * unit, width = hi - lo;
     int dec = width > 0.0 ? (int)ceil(-log10(width)) + 1 : 6;
     dec = dec < 0 ? 0 : dec > 12 ? 12 : dec;
-    const char *u = is_angle_driver(m) ? "deg" : "mm";
+    const char *u = is_angle_driver(m) ? "deg" : m->driver.kind == MECH_DRIVE_TIME ? "s" : "mm";
     snprintf(buf, size, "%.*f %s and %.*f %s", dec, lo, u, dec, hi, u);
     return buf;
 }
 
 const char *diagnose_driver_word(const mech_model *m)
 {
-    return is_angle_driver(m) ? "driver angle" : "driver displacement";
+    return is_angle_driver(m) ? "driver angle"
+           : m->driver.kind == MECH_DRIVE_TIME ? "time" : "driver displacement";
 }
 
 /* "loop 2 (A-B-C-D-A)" */

@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "drivers.h"
 #include "param_grad.h"
 #include "system.h"
 
@@ -133,7 +134,11 @@ static int position_names(const mech_system *s, int var, char **text, char **lat
     const mech_model *m = s->model;
     const char *symbol, *name;
     int is_angle;
-    if (var == SYS_VAR_Q(s->n)) {
+    if (var == SYS_VAR_Q(s->n) && m->driver.kind == MECH_DRIVE_TIME) {
+        *text = xstrdup("t");  /* drivers as laws of time: q is t */
+        *latex = xstrdup("t");
+        return *text && *latex ? 0 : -1;
+    } else if (var == SYS_VAR_Q(s->n)) {
         is_angle = m->driver.kind == MECH_DRIVE_ANGLE;
         const int i = m->driver.index;
         symbol = is_angle ? m->links[i].symbol : m->joints[i].symbol;
@@ -287,7 +292,7 @@ static int build_residual(mech_system *s, mech_diag *d)
 {
     const mech_model *m = s->model;
     const loop_set *ls = &s->loops;
-    int rows = 2 * ls->nloops, maxterms = 1;
+    int rows = s->m, maxterms = 1;
     for (int k = 0; k < ls->nloops; k++)
         if (ls->start[k + 1] - ls->start[k] > maxterms)
             maxterms = ls->start[k + 1] - ls->start[k];
@@ -305,6 +310,9 @@ static int build_residual(mech_system *s, mech_diag *d)
         s->f[2 * k] = balanced_sum(&s->ex, xs, nt);
         s->f[2 * k + 1] = balanced_sum(&s->ex, ys, nt);
     }
+    /* drivers as laws of time: one row each, after the loops */
+    drivers_residual(m, &s->ex, s->link_angle, s->slide, expr_var(&s->ex, SYS_VAR_Q(s->n)),
+                     s->f + 2 * ls->nloops);
     free(xs);
     free(ys);
     return MECH_OK;
@@ -530,7 +538,7 @@ int sys_new_with(const mech_model *m, sys_mode mode, const sys_params *params,
     }
     if ((rc = loops_build(m, &s->span, &s->loops, d)) != MECH_OK)
         goto fail;
-    s->m = 2 * s->loops.nloops;
+    s->m = 2 * s->loops.nloops + drivers_rows(m);
     /* more equations than unknowns: redundant constraints, which the solver
        treats in the least-squares sense and checks for consistency */
     if (s->m < s->n) {
