@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "columns.h"
+#include "drivers.h"
 #include "springs.h"
 
 void columns_free(column_layout *cl)
@@ -126,9 +127,14 @@ static int force_columns(column_layout *cl, const mech_model *m, char **label, i
             rc |= add(cl, SRC_REACTION, j, k, label[j], name, k == 3 ? "N*m" : "N");
         }
     }
-    if (m->driver.kind == MECH_DRIVE_ANGLE)
+    for (int k = 0; k < drivers_rows(m); k++) {  /* laws of time: one load per driver */
+        int angle = m->motions[k].kind == MECH_DRIVE_ANGLE;
+        snprintf(name, sizeof name, "%s%s", angle ? ".torque" : ".force", suffix);
+        rc |= add(cl, SRC_DRIVE_LOAD, k, 0, drivers_name(m, k), name, angle ? "N*m" : "N");
+    }
+    if (drivers_rows(m) == 0 && m->driver.kind == MECH_DRIVE_ANGLE)
         rc |= add(cl, SRC_DRIVE_LOAD, 0, 0, "driver.torque", suffix, "N*m");
-    else
+    else if (drivers_rows(m) == 0)
         rc |= add(cl, SRC_DRIVE_LOAD, 0, 0, "driver.force", suffix, "N");
     rc |= add(cl, SRC_POWER_RESIDUAL, 0, 0, "power.residual", suffix, "-");
     for (int c = first; !rc && c < cl->ncols; c++)
@@ -290,7 +296,7 @@ static void source_values(const column_group *g, const row_sources *rs, double *
         break;
     case SRC_SLIDER: slider_values(sv, g->obj, v); break;
     case SRC_REACTION: reaction_values(rs, g->obj, g->set, v); break;
-    case SRC_DRIVE_LOAD: v[0] = forces_drive(rs->fc, g->set); break;
+    case SRC_DRIVE_LOAD: v[0] = forces_drive_of(rs->fc, g->set, g->obj); break;
     case SRC_POWER_RESIDUAL: v[0] = g->set ? rs->fc->residual : rs->fc->residual0; break;
     case SRC_FRICTION_POWER: v[0] = rs->fc->friction_power; break;
     case SRC_FRICTION_ITERATIONS: v[0] = rs->fc->iterations; break;

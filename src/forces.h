@@ -19,7 +19,9 @@ typedef struct forces_plan {
     int nrows;              /* 3 per moving link */
     int ncols;
     fc_kind *kind;          /* [ncols] */
-    int *joint;             /* [ncols] joint of a reaction column (-1: the driver) */
+    int *joint;             /* [ncols] joint of a reaction column (-1: the driver;
+                               -1 - k: driver k of `drivers:`) */
+    int ndrive;             /* driver columns, the last ones: 1, or the `drivers:` */
     int *jcol;              /* [njoints] first column of each joint */
     int *Ap, *Ai;           /* [ncols+1], [nnz] */
     int *slot;              /* [nnz] where column c's k-th entry, in the order
@@ -71,6 +73,8 @@ int forces_solve(forces *fc, const solver *sv);
 void forces_joint(const forces *fc, const solver *sv, int j, int with_friction, double *fx,
                   double *fy, double *n, double *mo);
 double forces_drive(const forces *fc, int with_friction);
+/* The load of driver k: 0 for `driver:`, 0 .. ndrive-1 for `drivers:`. */
+double forces_drive_of(const forces *fc, int with_friction, int k);
 /* After forces_solve returned -1: the names of the joints involved. */
 void forces_singular_joints(forces *fc, char *buf, size_t size);
 
