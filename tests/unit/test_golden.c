@@ -50,6 +50,11 @@
 #include "compare.h"
 #include "mech.h"
 
+/* src/drivers.c: a law of time and its first two derivatives, evaluated on
+ * the law's tree by forward differentiation (src/drivers.h; declared here
+ * because drivers.h brings in the library's internal.h) */
+double law_eval(const struct mech_law *l, double t, double *dt, double *dtt);
+
 #define PI 3.14159265358979323846
 #define TWO_PI (2.0 * PI)
 #define DEG (PI / 180.0)
@@ -294,8 +299,9 @@ static void load_golden(golden *g, const char *name)
     cr_assert(g->m->has_driver, "%s: no driver", g->yaml);
 
     cr_assert_geq(g->t.nrows, 1, "%s: no data rows", g->csv);
-    g->qc = col(g, "q");
-    cr_assert_eq(g->qc, 0, "%s: the first column is not q", g->csv);
+    /* q, or t when the drivers are laws of time (docs/format.md 7.3) */
+    g->qc = col(g, g->m->driver.kind == MECH_DRIVE_TIME ? "t" : "q");
+    cr_assert_eq(g->qc, 0, "%s: the first column is not q (or t)", g->csv);
     g->kind = malloc(g->t.ncols * sizeof *g->kind);
     cr_assert_not_null(g->kind);
     for (size_t j = 0; j < g->t.ncols; j++) {
@@ -467,7 +473,8 @@ Test(golden, columns_and_driver_range)
         const mech_driver *dr = &m->driver;
         worst w;
         worst_init(&w, "driver", 1e-12);
-        cr_assert_str_eq(g->t.units[g->qc], dr->kind == MECH_DRIVE_ANGLE ? "rad" : "m",
+        cr_assert_str_eq(g->t.units[g->qc], dr->kind == MECH_DRIVE_TIME ? "s"
+                                            : dr->kind == MECH_DRIVE_ANGLE ? "rad" : "m",
                          "%s: column q has unit [%s]", g->csv, g->t.units[g->qc]);
         cr_assert_eq(g->t.nrows, (size_t)dr->nvalues,
                      "%s: %zu data rows, but %s has %d driver positions", g->csv, g->t.nrows,
@@ -507,9 +514,29 @@ Test(golden, columns_and_driver_range)
                 cr_assert_geq(colf(g, "%s.%s", m->joints[m->outputs.sliders[i]].name, sc[k]), 0,
                               "%s: no column %s.%s for an output of %s", g->csv,
                               m->joints[m->outputs.sliders[i]].name, sc[k], g->yaml);
+        /* laws of time: each driven coordinate is its law at t, its rates the
+           law's derivatives (forward differentiation of the law's tree,
+           drivers.c, not the solver's symbolic derivatives) */
+        for (int k = 0; dr->kind == MECH_DRIVE_TIME && k < m->nmotions; k++) {
+            const mech_motion *mo = &m->motions[k];
+            int angle = mo->kind == MECH_DRIVE_ANGLE;
+            const char *mn = angle ? m->links[mo->index].name : m->joints[mo->index].name;
+            int cc[3] = {colf(g, "%s.%s", mn, angle ? "angle" : "s"),
+                         colf(g, "%s.%s", mn, angle ? "omega" : "v"),
+                         colf(g, "%s.%s", mn, angle ? "alpha" : "a")};
+            for (size_t i = 0; i < g->t.nrows; i++) {
+                double want[3];
+                want[0] = law_eval(mo->law, qval(g, i), &want[1], &want[2]);
+                for (int c = 0; c < 3; c++)
+                    if (cc[c] >= 0)
+                        check_value(g, &w, g->t.names[cc[c]], i, want[c], val(g, i, cc[c]),
+                                    fmax(1.0, fabs(want[c])), 1e-12);
+            }
+        }
         /* the driver's own columns: its position is q, its rates the file's */
-        const char *dname = dr->kind == MECH_DRIVE_ANGLE ? m->links[dr->index].name
-                                                         : m->joints[dr->index].name;
+        const char *dname = dr->kind == MECH_DRIVE_TIME ? "(none)"
+                            : dr->kind == MECH_DRIVE_ANGLE ? m->links[dr->index].name
+                                                           : m->joints[dr->index].name;
         int c0 = colf(g, "%s.%s", dname, dr->kind == MECH_DRIVE_ANGLE ? "angle" : "s");
         int c1 = colf(g, "%s.%s", dname, dr->kind == MECH_DRIVE_ANGLE ? "omega" : "v");
         int c2 = colf(g, "%s.%s", dname, dr->kind == MECH_DRIVE_ANGLE ? "alpha" : "a");
