@@ -3,6 +3,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "drivers.h"
 #include "system.h"
 
 static void describe_unknown(const mech_system *s, int i, FILE *out)
@@ -72,7 +73,8 @@ static void print_text(const mech_system *s, FILE *out)
         fputc('\n', out);
     }
     fprintf(out, "input q: %s = %s, with rates %s and %s\n\n", s->names[n],
-            m->driver.kind == MECH_DRIVE_ANGLE ? "driver link angle" : "driver slider displacement",
+            m->driver.kind == MECH_DRIVE_TIME ? "time, the drivers' laws' variable"
+            : m->driver.kind == MECH_DRIVE_ANGLE ? "driver link angle" : "driver slider displacement",
             s->names[SYS_VAR_QDOT(n)], s->names[SYS_VAR_QDDOT(n)]);
     print_coefficients(s, out);
     fprintf(out, "loops (%d, %s):\n", s->loops.nloops,
@@ -86,7 +88,10 @@ static void print_text(const mech_system *s, FILE *out)
     for (int r = 0; r < s->m; r++) {
         fprintf(out, "  f%d = ", r + 1);
         expr_print(&s->ex, s->f[r], &nm, 0, out);
-        fprintf(out, "    [loop %d, %c]\n", r / 2 + 1, r % 2 ? 'y' : 'x');
+        if (r >= 2 * s->loops.nloops)  /* drivers as laws of time: one row each */
+            fprintf(out, "    [driver '%s']\n", drivers_name(m, r - 2 * s->loops.nloops));
+        else
+            fprintf(out, "    [loop %d, %c]\n", r / 2 + 1, r % 2 ? 'y' : 'x');
     }
     fprintf(out, "\njacobian df/dx (%d nonzeros):\n", s->nnz);
     for (int j = 0; j < n; j++)
