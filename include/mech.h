@@ -511,7 +511,8 @@ int mech_analysis_solve(const mech_analysis *a, const double *q, int nq, mech_ta
                         mech_solve_stats *stats, mech_diag *d);
 
 /* Parse a driver position from the command line: bare numbers are degrees
- * (is_angle) or millimetres, or give a unit ("2.0864 rad", "0.15 m"). */
+ * (is_angle) or millimetres, or give a unit ("2.0864 rad", "0.15 m");
+ * is_angle == 2: a time (drivers as laws of t), bare numbers in seconds. */
 int mech_parse_value(const char *text, int is_angle, double *si, char *err, size_t errsize);
 
 /* Parse a comma-separated list of point, moving-link and slider names into
