@@ -1,5 +1,5 @@
 /* src/drivers.h: drivers as laws of time (docs/format.md section 7.3,
- * docs/solver.md section 7).
+ * docs/solver.md section 8).
  *
  * A law is a unit-checked expression of the sweep variable t, such as
  * "30 deg + 20 deg * sin(6.2832 * t / 1 s)", parsed at load time into a
