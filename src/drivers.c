@@ -85,6 +85,10 @@ static double default_scale(const expr_env *env, dim d)
 static int node(lparser *p, law_op op, int a, int b, double k)
 {
     struct mech_law *l = p->law;
+    if (op == LAW_CONST && !isfinite(k)) {  /* "t + 0^-1 s": no law */
+        lfail(p, p->s, "value is not a finite number");
+        return 0;
+    }
     if (l->n == l->cap) {
         int cap = l->cap ? 2 * l->cap : 16;
         law_node *more = xrealloc_array(l->nodes, (size_t)cap, sizeof *more);
