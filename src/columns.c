@@ -74,6 +74,20 @@ static int kinematic_columns(column_layout *cl, const mech_model *m, const mech_
     for (int i = 0; i < o->nsliders; i++)
         rc |= add_levels(cl, level, SRC_SLIDER, o->sliders[i], m->joints[o->sliders[i]].name,
                          slide_sfx, slide_unit);
+    /* drivers as laws of time: each driven coordinate, as q is for `driver:`,
+       after the outputs when they do not list it */
+    for (int k = 0; k < drivers_rows(m); k++) {
+        const mech_motion *mo = &m->motions[k];
+        int angle = mo->kind == MECH_DRIVE_ANGLE, listed = 0;
+        for (int i = 0; angle && i < o->nlinks; i++)
+            listed |= o->links[i] == mo->index;
+        for (int i = 0; !angle && i < o->nsliders; i++)
+            listed |= o->sliders[i] == mo->index;
+        if (!listed)
+            rc |= add_levels(cl, level, angle ? SRC_LINK : SRC_SLIDER, mo->index,
+                             drivers_name(m, k), angle ? link_sfx : slide_sfx,
+                             angle ? link_unit : slide_unit);
+    }
     return rc;
 }
 

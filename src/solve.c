@@ -15,6 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "drivers.h"
 #include "solve.h"
 
 enum { PHASE_POSITION, PHASE_VELOCITY, PHASE_ACCELERATION, NPHASES };
@@ -73,6 +74,14 @@ static void needed_unknowns(solver_plan *sp, unsigned char *need)
     for (int i = 0; i < o->nsliders; i++) {
         int var = sp->tree.slide_var[o->sliders[i]];
         if (var >= 0 && var < sp->n)
+            need[var] = 1;
+    }
+    for (int k = 0; k < drivers_rows(m); k++) {  /* their columns are always output */
+        int var = m->motions[k].kind == MECH_DRIVE_SLIDER
+                      ? sp->tree.slide_var[m->motions[k].index] : -1;
+        if (m->motions[k].kind == MECH_DRIVE_ANGLE)
+            kin_need_link(&sp->tree, m->motions[k].index, need);
+        else if (var >= 0 && var < sp->n)
             need[var] = 1;
     }
     for (int b = 0; b < m->nbranches; b++) {

@@ -14,6 +14,9 @@
 
 #include "helpers.h"
 
+/* src/drivers.c (declared here: drivers.h brings in the library's internals) */
+double law_eval(const struct mech_law *l, double t, double *dt, double *dtt);
+
 #define PI 3.14159265358979323846
 #define DEG (PI / 180.0)
 
@@ -278,5 +281,129 @@ Test(drivers, slider_law)
         cr_assert_float_eq(table_at(&t, r, "crank.angle"), acos(c), 1e-12);
     }
     mech_table_free(&t);
+    mech_model_free(&m);
+}
+
+/* A slider driver with masses: its force times its velocity against the
+ * rate of kinetic energy minus gravity's power, computed here from the
+ * crank angle, the rod angle and the block's motion. */
+Test(drivers, slider_force_power_balance)
+{
+    static const char *const text =
+        "name: pushed slider-crank with masses\n"
+        "units: {length: mm, angle: deg}\n"
+        "gravity: [0, -9.81]\n"
+        "ground: {O: [0, 0]}\n"
+        "links:\n"
+        "  crank: {points: {O: [0, 0], A: [20, 0]}, mass: 0.5 kg, center: [10, 2],"
+        " inertia: 3e-5 kg*m^2}\n"
+        "  rod:   {points: {A: [0, 0], B: [60, 0]}, mass: 0.4 kg, center: [30, 0],"
+        " inertia: 1.2e-4 kg*m^2}\n"
+        "  block: {points: {B: [0, 0]}, mass: 1.5 kg, center: [0, 0], inertia: 1e-4 kg*m^2}\n"
+        "joints:\n"
+        "  - {slider: B, link: block, on: ground, through: O, angle: 0, name: s_B}\n"
+        "initial: {crank: 60 deg}\n"
+        "sweep: {time: {from: 0 s, to: 1 s, steps: 20}}\n"
+        "drivers: [{slider: s_B, displacement: \"70 mm + 5 mm * sin(2 * pi * t / 1 s)\"}]\n"
+        "outputs: {points: [A], links: [rod], forces: true}\n";
+    mech_model *m = load_text(text);
+    mech_table t = must_solve(m, NULL);
+    double worst = 0.0, biggest = 0.0;
+    for (int r = 0; r < t.nrows; r++) {
+        double tm = table_at(&t, r, "t");
+        /* the block: s(t) and its derivatives by hand */
+        double w = 2 * PI, s = 0.070 + 0.005 * sin(w * tm), sd = 0.005 * w * cos(w * tm),
+               sdd = -0.005 * w * w * sin(w * tm);
+        cr_assert_float_eq(table_at(&t, r, "s_B.s"), s, 1e-15);  /* always output */
+        cr_assert_float_eq(table_at(&t, r, "s_B.v"), sd, 1e-14);
+        cr_assert_float_eq(table_at(&t, r, "s_B.a"), sdd, 1e-13);
+        double ax = table_at(&t, r, "A.x"), ay = table_at(&t, r, "A.y");
+        double avx = table_at(&t, r, "A.vx"), avy = table_at(&t, r, "A.vy");
+        double aax = table_at(&t, r, "A.ax"), aay = table_at(&t, r, "A.ay");
+        double th = atan2(ay, ax), om = (ax * avy - ay * avx) / (ax * ax + ay * ay);
+        double al = (ax * aay - ay * aax) / (ax * ax + ay * ay);  /* |OA| constant */
+        double rth = table_at(&t, r, "rod.angle"), rom = table_at(&t, r, "rod.omega"),
+               ral = table_at(&t, r, "rod.alpha");
+        /* crank centre G1 = R(th) (10, 2) mm; rod centre G2 = A + R(rth) (30, 0) mm */
+        double g1x = 0.010 * cos(th) - 0.002 * sin(th), g1y = 0.010 * sin(th) + 0.002 * cos(th);
+        double v1x = -om * g1y, v1y = om * g1x;
+        double a1x = -al * g1y - om * om * g1x, a1y = al * g1x - om * om * g1y;
+        double rx = 0.030 * cos(rth), ry = 0.030 * sin(rth);
+        double v2x = avx - rom * ry, v2y = avy + rom * rx;
+        double a2x = aax - ral * ry - rom * rom * rx, a2y = aay + ral * rx - rom * rom * ry;
+        double dT = 0.5 * (v1x * a1x + v1y * a1y) + 3e-5 * om * al +
+                    0.4 * (v2x * a2x + v2y * a2y) + 1.2e-4 * rom * ral + 1.5 * sd * sdd;
+        double pg = -9.81 * (0.5 * v1y + 0.4 * v2y);  /* the block moves along x */
+        double pd = table_at(&t, r, "s_B.force") * sd;
+        worst = fmax(worst, fabs(pd + pg - dT));
+        biggest = fmax(biggest, fabs(pd));
+    }
+    cr_assert_gt(biggest, 1e-3, "the driver does no work (%g W)", biggest);
+    cr_assert_lt(worst, 1e-12 * fmax(1.0, biggest), "power balance off by %g W (of %g W)", worst,
+                 biggest);
+    if (getenv("MECH_HARD_VERBOSE"))
+        fprintf(stderr, "[drivers] slider driver power balance: worst %.2g W of %.2g W\n", worst,
+                biggest);
+    mech_table_free(&t);
+    mech_model_free(&m);
+}
+
+/* Laws that are refused, each with its message and column (the law is the
+ * 2nd driver of FIVE_BAR, at line 12, its text from column 28). */
+static void expect_law_error(const char *law, int col, const char *part)
+{
+    char text[2048];
+    snprintf(text, sizeof text, FIVE_BAR, "90 deg + 2 rad/s * t", law);
+    mech_diag d;
+    mech_diag_init(&d);
+    mech_model *m = NULL;
+    cr_assert_eq(mech_load_string(text, strlen(text), "l.yaml", &m, &d), MECH_EINPUT, "%s: loaded",
+                 law);
+    cr_assert_geq(d.count, 1);
+    const mech_diag_entry *e = &d.entries[0];
+    cr_assert(strstr(e->message, part), "%s: message '%s' lacks '%s'", law, e->message, part);
+    cr_assert(e->mark.line == 12 && e->mark.col == col, "%s: at %d:%d, expected 12:%d (%s)", law,
+              e->mark.line, e->mark.col, col, e->message);
+    mech_diag_free(&d);
+}
+
+Test(drivers, law_errors)
+{
+    expect_law_error("10 mm/s * t", 28, "must be an angle of t, not a length");
+    expect_law_error("1 rad + omega * t", 36, "unknown name 'omega'");
+    expect_law_error("1 rad / t", 34, "division by an expression of t");
+    expect_law_error("sqrt(t / 1 s) * 1 rad", 28, "only sin and cos may take t");
+    expect_law_error("1 rad * sin(t)", 36, "needs an angle or a pure number, not a time");
+    expect_law_error("1 rad * (t / 1 s)^-1", 45, "power of an expression of t must be 0 to 64");
+    expect_law_error("1 rad + 2 s", 34, "cannot add an angle (rad) and a time (s)");
+    expect_law_error("2 t", 30, "unexpected 't' after the law");
+    expect_law_error("", 28, "value missing");
+}
+
+/* The laws' own derivatives (drivers.c law_eval, used for the golden check
+ * and the starts) against central differences. */
+Test(drivers, law_derivatives)
+{
+    char text[2048];
+    snprintf(text, sizeof text, FIVE_BAR, "0.3 rad + 1.5 rad/s^2 * t^2 - 0.2 rad/s^3 * t^3",
+             "45 deg + 40 deg * (t / 1 s - sin(2 * pi * t / 1 s) / (2 * pi / 1 rad)) + "
+             "5 deg * cos(3 rad/s * t)^2");
+    mech_model *m = load_text(text);
+    cr_assert_eq(m->nmotions, 2);
+    for (int k = 0; k < 2; k++)
+        for (double tm = 0.05; tm < 1.0; tm += 0.1) {
+            double d1, d2, h = 1e-4;
+            double f = law_eval(m->motions[k].law, tm, &d1, &d2);
+            double fp = law_eval(m->motions[k].law, tm + h, NULL, NULL);
+            double fm = law_eval(m->motions[k].law, tm - h, NULL, NULL);
+            cr_assert_float_eq(d1, (fp - fm) / (2 * h), 1e-7, "law %d at %g: %g", k, tm, d1);
+            cr_assert_float_eq(d2, (fp - 2 * f + fm) / (h * h), 1e-5, "law %d at %g: %g", k, tm,
+                               d2);
+        }
+    /* and the first law by hand */
+    double d1, d2, f = law_eval(m->motions[0].law, 0.5, &d1, &d2);
+    cr_assert_float_eq(f, 0.3 + 1.5 * 0.25 - 0.2 * 0.125, 1e-15);
+    cr_assert_float_eq(d1, 3.0 * 0.5 - 0.6 * 0.25, 1e-15);
+    cr_assert_float_eq(d2, 3.0 - 1.2 * 0.5, 1e-15);
     mech_model_free(&m);
 }
