@@ -490,12 +490,13 @@ static void limit_words(cont *c, double hrow, char *why, size_t size)
     in_line_text(&c->sv, upper, c->xc, line, sizeof line);
     if (!line[0])
         return;
-    double unit = is_angle_driver(m) ? 180.0 / PI : 1e3;
+    int time = m->driver.kind == MECH_DRIVE_TIME;  /* laws of time: t in s */
+    double unit = is_angle_driver(m) ? 180.0 / PI : time ? 1.0 : 1e3;
     double acc = fmax(1e-9 * fabs(hrow), 1e-11 * fmax(fabs(upper), fabs(hrow))) * unit;
     int dec = (int)floor(-log10(acc)) - 1;
     snprintf(why, size, "; at %.*f %s, %s%s", dec < 0 ? 0 : dec > 12 ? 12 : dec, upper * unit,
-             is_angle_driver(m) ? "deg" : "mm", line,
-             is_angle_driver(m) ? "" : ": dead centre of the slider");
+             is_angle_driver(m) ? "deg" : time ? "s" : "mm", line,
+             is_angle_driver(m) || time ? "" : ": dead centre of the slider");
 }
 
 /* The interval(s) where the mechanism assembles, from row 0 and the last
