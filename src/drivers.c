@@ -85,6 +85,10 @@ static double default_scale(const expr_env *env, dim d)
 static int node(lparser *p, law_op op, int a, int b, double k)
 {
     struct mech_law *l = p->law;
+    if (l->n >= LAW_MAX_NODES) {  /* law_eval works in a fixed buffer */
+        lfail(p, p->s, "the law is too long (more than %d operations)", LAW_MAX_NODES);
+        return 0;
+    }
     if (op == LAW_CONST && !isfinite(k)) {  /* "t + 0^-1 s": no law */
         lfail(p, p->s, "value is not a finite number");
         return 0;
@@ -362,9 +366,13 @@ static lval parse_power(lparser *p)
         lfail(p, at, "a power of an expression of t must be 0 to 64");
         return a;
     }
-    lval r = number(1.0, NONE, a.bare);
-    for (int i = 0; i < e; i++)
-        r = mul(p, r, a);
+    lval r = number(1.0, NONE, a.bare);  /* by squaring: t^64 is 7 products */
+    for (lval base = a; e > 0; e >>= 1) {
+        if (e & 1)
+            r = mul(p, r, base);
+        if (e > 1)
+            base = mul(p, base, base);
+    }
     return r;
 }
 
@@ -485,9 +493,7 @@ void law_free(struct mech_law *l)
  * operands come first). */
 double law_eval(const struct mech_law *l, double t, double *dt, double *dtt)
 {
-    double v[3 * 256], *buf = l->n <= 256 ? v : xcalloc(3 * (size_t)l->n, sizeof *buf);
-    if (!buf)
-        return NAN;
+    double buf[3 * LAW_MAX_NODES];  /* no allocation: called at a restart of the sweep */
     double *f = buf, *f1 = buf + l->n, *f2 = buf + 2 * l->n;
     for (int i = 0; i < l->n; i++) {
         const law_node *nd = &l->nodes[i];
@@ -519,8 +525,6 @@ double law_eval(const struct mech_law *l, double t, double *dt, double *dtt)
         *dt = isnan(r) ? NAN : f1[l->root];
     if (dtt)
         *dtt = isnan(r) ? NAN : f2[l->root];
-    if (buf != v)
-        free(buf);
     return r;
 }
 

@@ -14,6 +14,8 @@
 #include "expr.h"
 #include "internal.h"
 
+enum { LAW_MAX_NODES = 2048 };  /* operations in one law (law_eval's buffer) */
+
 typedef enum { LAW_CONST, LAW_T, LAW_ADD, LAW_MUL, LAW_NEG, LAW_SIN, LAW_COS } law_op;
 
 typedef struct law_node {
