@@ -36,7 +36,9 @@
  *   mechanisms/slider-crank.yaml (x = r cos q + sqrt(l^2 - r^2 sin^2 q)),
  *   every column to 1e-10 relative (tests/unit/closed_forms.h, shared with
  *   test_solve.c; the dimensions are written here from the YAML text, not
- *   read through the loader). */
+ *   read through the loader); mechanisms/five-bar.yaml (drivers as laws of
+ *   time: the coupler point P by circle-circle intersection, its rates from
+ *   the differentiated distance constraints). */
 #include <criterion/criterion.h>
 #include <dirent.h>
 #include <math.h>
