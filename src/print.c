@@ -88,8 +88,8 @@ static void print_text(const mech_system *s, FILE *out)
     for (int r = 0; r < s->m; r++) {
         fprintf(out, "  f%d = ", r + 1);
         expr_print(&s->ex, s->f[r], &nm, 0, out);
-        if (r >= 2 * s->loops.nloops)  /* drivers as laws of time: one row each */
-            fprintf(out, "    [driver '%s']\n", drivers_name(m, r - 2 * s->loops.nloops));
+        if (r >= s->m - drivers_rows(m))  /* drivers as laws of time: the last rows */
+            fprintf(out, "    [driver '%s']\n", drivers_name(m, r - (s->m - drivers_rows(m))));
         else
             fprintf(out, "    [loop %d, %c]\n", r / 2 + 1, r % 2 ? 'y' : 'x');
     }

@@ -310,9 +310,10 @@ static int build_residual(mech_system *s, mech_diag *d)
         s->f[2 * k] = balanced_sum(&s->ex, xs, nt);
         s->f[2 * k + 1] = balanced_sum(&s->ex, ys, nt);
     }
-    /* drivers as laws of time: one row each, after the loops */
+    /* drivers as laws of time: one row each, the last rows (after the loops
+       and any other rows) */
     drivers_residual(m, &s->ex, s->link_angle, s->slide, expr_var(&s->ex, SYS_VAR_Q(s->n)),
-                     s->f + 2 * ls->nloops);
+                     s->f + s->m - drivers_rows(m));
     free(xs);
     free(ys);
     return MECH_OK;
