@@ -64,6 +64,11 @@ int drivers_of_slider(const mech_model *m, int j);
  * a different number of drivers: the drivers in conflict, or the links
  * left free. */
 void drivers_report_count(const mech_model *m, int mobility, mech_diag *d);
+/* solve.c, when the system with drivers is structurally singular: an error
+ * naming the drivers that over-determine their part of the mechanism and
+ * the unknowns left free (a maximum matching of rows and unknowns and its
+ * Dulmage-Mendelsohn parts). MECH_EINPUT, or MECH_ENOMEM. */
+int drivers_report_structure(const mech_system *s, mech_diag *d);
 /* model.c: free the model's motions. */
 void drivers_free(mech_model *m);
 

@@ -445,7 +445,9 @@ int solver_plan_init(solver_plan *sp, const mech_model *m, const mech_solve_opti
         } else {
             b = choose_blocks(sp, need, row_on, col_on);
         }
-        if (b > 0)
+        if (b > 0 && drivers_rows(m) > 0)  /* name the conflicting drivers, the free unknowns */
+            rc = drivers_report_structure(sp->sys, d);
+        else if (b > 0)
             rc = diag_error(d, m->file, m->driver.mark,
                             "the loop equations are structurally singular: some unknown "
                             "appears in no equation that could determine it (see 'mech equations')");

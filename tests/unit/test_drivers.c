@@ -407,3 +407,41 @@ Test(drivers, law_derivatives)
     cr_assert_float_eq(d2, 3.0 - 1.2 * 0.5, 1e-15);
     mech_model_free(&m);
 }
+
+/* As many drivers as degrees of freedom, but both on the four-bar of a
+ * four-bar plus a separate dyad: the solve names the conflicting drivers
+ * and the links left free (a maximum matching of the equations). */
+Test(drivers, conflicting_drivers_named)
+{
+    static const char *const text =
+        "name: four-bar plus a dyad\n"
+        "units: {length: mm, angle: deg}\n"
+        "ground: {O: [0, 0], C: [70, 0], D: [0, 100], F: [80, 100]}\n"
+        "links:\n"
+        "  crank:   {points: {O: [0, 0], A: [20, 0]}}\n"
+        "  coupler: {points: {A: [0, 0], B: [60, 0]}}\n"
+        "  rocker:  {points: {C: [0, 0], B: [50, 0]}}\n"
+        "  arm1:    {points: {D: [0, 0], G: [50, 0]}}\n"
+        "  arm2:    {points: {G: [0, 0], H: [50, 0]}}\n"
+        "  arm3:    {points: {F: [0, 0], H: [40, 0]}}\n"
+        "sweep: {time: {from: 0 s, to: 0.1 s, steps: 10}}\n"
+        "drivers:\n"
+        "  - {link: crank, angle: \"10 rad/s * t\"}\n"
+        "  - {link: rocker, angle: \"100 deg\"}\n";
+    mech_model *m = load_text(text);  /* the counts agree: mech_check passes */
+    mech_solve_options o;
+    mech_solve_options_default(&o);
+    mech_diag d;
+    mech_diag_init(&d);
+    mech_table t = {0};
+    cr_assert_eq(mech_solve(m, &o, &t, NULL, &d), MECH_EINPUT);
+    cr_assert_geq(d.count, 1);
+    const mech_diag_entry *e = &d.entries[0];
+    cr_assert(strstr(e->message, "the drivers of 'crank', 'rocker' over-determine") &&
+                  strstr(e->message, "'arm1', 'arm2', 'arm3' move freely"),
+              "message: %s", e->message);
+    cr_assert(e->mark.line == 13 && e->mark.col == 5, "at %d:%d", e->mark.line, e->mark.col);
+    mech_diag_free(&d);
+    mech_table_free(&t);
+    mech_model_free(&m);
+}
