@@ -240,6 +240,9 @@ Test(drivers, five_bar_power_balance)
                     table_at(&t, r, "crank2.torque") * table_at(&t, r, "crank2.omega");
         worst = fmax(worst, fabs(pd + pg - dT));
         biggest = fmax(biggest, fabs(pd));
+        /* the solver's own balance (forces.c sums the drivers' powers) */
+        cr_assert_lt(fabs(table_at(&t, r, "power.residual")), 1e-12, "row %d: power.residual %g",
+                     r, table_at(&t, r, "power.residual"));
     }
     cr_assert_gt(biggest, 1e-3, "the drivers do no work (%g W)", biggest);
     cr_assert_lt(worst, 1e-12 * fmax(1.0, biggest), "power balance off by %g W (of %g W)", worst,
