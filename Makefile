@@ -145,6 +145,7 @@ test: deps
 	MECH=$(BUILD)/mech MECH_SANITIZE=$(if $(SAN),1,) sh tests/sweep_random.sh
 	MECH=$(BUILD)/mech MECH_SANITIZE=$(if $(SAN),1,) sh tests/codegen.sh
 	MECH=$(BUILD)/mech sh tests/report.sh
+	MECH=$(BUILD)/mech sh tests/drivers.sh
 	MECH=$(BUILD)/mech sh tests/parallel/recipes.sh
 	@$(MAKE) --no-print-directory test-install test-python
 

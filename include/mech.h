@@ -100,7 +100,9 @@ typedef struct mech_joint {
     mech_mark mark;
 } mech_joint;
 
-typedef enum { MECH_DRIVE_ANGLE, MECH_DRIVE_SLIDER } mech_drive_kind;
+/* MECH_DRIVE_TIME: the sweep variable is time; the motion is given by the
+ * model's `motions` (the `drivers:` list, docs/format.md section 7.3). */
+typedef enum { MECH_DRIVE_ANGLE, MECH_DRIVE_SLIDER, MECH_DRIVE_TIME } mech_drive_kind;
 
 typedef struct mech_driver {
     mech_drive_kind kind;
@@ -111,6 +113,17 @@ typedef struct mech_driver {
     double accel;      /* rad/s^2 or m/s^2 */
     mech_mark mark;
 } mech_driver;
+
+/* One entry of `drivers:` (docs/format.md section 7.3): a link angle or a
+ * slider displacement given as a law of the time t, compiled symbolically
+ * (src/drivers.h). */
+typedef struct mech_motion {
+    mech_drive_kind kind; /* MECH_DRIVE_ANGLE: link index; MECH_DRIVE_SLIDER: joint index */
+    int index;
+    char *text;           /* owned: the law as written */
+    struct mech_law *law; /* owned: its expression tree (src/drivers.h) */
+    mech_mark mark;
+} mech_motion;
 
 typedef struct mech_guess {
     int is_slider;     /* 0: link angle, 1: slider displacement */
@@ -260,6 +273,9 @@ typedef struct mech_model {
                                         (src/state_loads.h), NULL when there are none */
     mech_gear *gears;     /* [ngears] gear pairs and racks (docs/format.md) */
     int ngears;
+    mech_motion *motions; /* [nmotions] drivers as laws of time (driver.kind ==
+                             MECH_DRIVE_TIME: driver.values are the times), or none */
+    int nmotions;
 } mech_model;
 
 /* Read and validate a mechanism file. On success *out is the model and the
@@ -529,7 +545,8 @@ int mech_analysis_solve(const mech_analysis *a, const double *q, int nq, mech_ta
                         mech_solve_stats *stats, mech_diag *d);
 
 /* Parse a driver position from the command line: bare numbers are degrees
- * (is_angle) or millimetres, or give a unit ("2.0864 rad", "0.15 m"). */
+ * (is_angle) or millimetres, or give a unit ("2.0864 rad", "0.15 m");
+ * is_angle == 2: a time (drivers as laws of t), bare numbers in seconds. */
 int mech_parse_value(const char *text, int is_angle, double *si, char *err, size_t errsize);
 
 /* Parse a comma-separated list of point, moving-link and slider names into

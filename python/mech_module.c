@@ -279,6 +279,9 @@ static PyObject *driver_dict(const mech_model *m)
     int angle = dr->kind == MECH_DRIVE_ANGLE;
     if (!m->has_driver)
         return Py_NewRef(Py_None);
+    if (dr->kind == MECH_DRIVE_TIME)  /* drivers as laws of time: the sweep of t, in s */
+        return Py_BuildValue("{s:s,s:i,s:d,s:d}", "kind", "time", "positions", dr->nvalues,
+                             "from", dr->values[0], "to", dr->values[dr->nvalues - 1]);
     return Py_BuildValue("{s:s,s:s,s:i,s:d,s:d,s:d,s:d}", "kind", angle ? "angle" : "slider",
                          angle ? "link" : "joint",
                          angle ? m->links[dr->index].name : m->joints[dr->index].name,
@@ -392,7 +395,7 @@ typedef struct solve_request {
 static int solve_options(const mech_model *m, const solve_request *r, mech_solve_options *o,
                          mech_outputs *sel, int *has_sel)
 {
-    int is_angle = m->driver.kind == MECH_DRIVE_ANGLE;
+    int is_angle = m->driver.kind == MECH_DRIVE_TIME ? 2 : m->driver.kind == MECH_DRIVE_ANGLE;
     long steps = 0;
     mech_solve_options_default(o);
     *has_sel = 0;

@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "commands.h"
+#include "drivers.h"
 #include "gears.h"
 #include "springs.h"
 #include "state_loads.h"
@@ -54,8 +55,9 @@ static void print_summary(const mech_model *m, const mech_summary *s)
     printf("  links      %d (ground + %d moving)\n", s->nlinks, s->nlinks - 1);
     printf("  joints     %d (%d revolute, %d prismatic slider, %d pin-in-slot slider)\n",
            s->nrevolute + nsliders, s->nrevolute, s->nprismatic, s->npin_in_slot);
-    printf("  unknowns   %d (%d link angles + %d slider displacements - 1 driver)\n",
-           s->nunknowns, s->nlinks - 1 - s->nprismatic, nsliders);
+    printf("  unknowns   %d (%d link angles + %d slider displacements - %d driver%s)\n",
+           s->nunknowns, s->nlinks - 1 - s->nprismatic, nsliders, s->ndrivers,
+           s->ndrivers == 1 ? "" : "s");
     printf("  loops      %d independent%s, %d equations\n", s->nloops,
            m->nloops ? " (listed in the file)" : " (found automatically)", s->nequations);
     if (s->ngears)  /* each mesh removes one freedom (gears.c) */
@@ -65,7 +67,18 @@ static void print_summary(const mech_model *m, const mech_summary *s)
     else
         printf("  mobility   %d = 3*(%d-1) - 2*%d - %d, drivers %d\n", s->mobility, s->nlinks,
                s->nrevolute + s->nprismatic, s->npin_in_slot, s->ndrivers);
-    printf("  driver     %s\n", drive_text(m, buf, sizeof buf));
+    if (m->has_driver && m->driver.kind == MECH_DRIVE_TIME) {
+        const mech_driver *dr = &m->driver;
+        printf("  sweep      time t from %g s to %g s, %d position%s\n", dr->values[0],
+               dr->values[dr->nvalues - 1], dr->nvalues, dr->nvalues == 1 ? "" : "s");
+        for (int i = 0; i < m->nmotions; i++)
+            printf("  driver     %s of %s '%s' = %s\n",
+                   m->motions[i].kind == MECH_DRIVE_ANGLE ? "angle" : "displacement",
+                   m->motions[i].kind == MECH_DRIVE_ANGLE ? "link" : "slider",
+                   drivers_name(m, i), m->motions[i].text);
+    } else {
+        printf("  driver     %s\n", drive_text(m, buf, sizeof buf));
+    }
     printf("  outputs    %d points, %d links, %d sliders%s\n", m->outputs.npoints,
            m->outputs.nlinks, m->outputs.nsliders, m->outputs.forces ? ", forces" : "");
     print_springs(m);

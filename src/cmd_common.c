@@ -128,8 +128,9 @@ static int parse_end(const char *command, const char *opt, const char *text, int
     if (!(fabs(*si) <= MAX_DRIVER)) {
         snprintf(err, sizeof err, "%s '%.40s' is %.3g %s: a driver %s must be within +-%s "
                  "(beyond, a step is lost in the rounding of the position)", opt, text, *si,
-                 is_angle ? "rad" : "m", is_angle ? "angle" : "displacement",
-                 is_angle ? "1e6 rad (5.7e7 deg)" : "1e6 m");
+                 is_angle == 2 ? "s" : is_angle ? "rad" : "m",
+                 is_angle == 2 ? "time" : is_angle ? "angle" : "displacement",
+                 is_angle == 2 ? "1e6 s" : is_angle ? "1e6 rad (5.7e7 deg)" : "1e6 m");
         return cmd_usage_error(command, "%s", err);
     }
     return -1;
@@ -138,7 +139,7 @@ static int parse_end(const char *command, const char *opt, const char *text, int
 int cmd_apply_range(const char *command, const char *from, const char *to, int steps,
                     const mech_model *m, mech_solve_options *o)
 {
-    int is_angle = m->driver.kind == MECH_DRIVE_ANGLE, code;
+    int is_angle = m->driver.kind == MECH_DRIVE_TIME ? 2 : m->driver.kind == MECH_DRIVE_ANGLE, code;
     if (from) {
         if ((code = parse_end(command, "--from", from, is_angle, &o->from)) >= 0 ||
             (code = parse_end(command, "--to", to, is_angle, &o->to)) >= 0)

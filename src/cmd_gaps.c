@@ -19,16 +19,18 @@ static double requested_q(const mech_model *m, const mech_solve_options *o, int 
  * `decimals` decimals. */
 static void q_text(const mech_model *m, double q, int decimals, char *buf, size_t size)
 {
-    int angle = m->driver.kind == MECH_DRIVE_ANGLE;
-    snprintf(buf, size, "%.*f %s", decimals, angle ? q * 57.295779513082321 : q * 1e3,
-             angle ? "deg" : "mm");
+    int angle = m->driver.kind == MECH_DRIVE_ANGLE, time = m->driver.kind == MECH_DRIVE_TIME;
+    snprintf(buf, size, "%.*f %s", decimals,
+             angle ? q * 57.295779513082321 : time ? q : q * 1e3,
+             angle ? "deg" : time ? "s" : "mm");
 }
 
 /* Decimals that a limit found to 1e-12 of the row spacing h deserves,
  * bounded by the position's own rounding floor (about 1e-11 of it, rad or m). */
 static int limit_decimals(const mech_model *m, double q, double h)
 {
-    double unit = m->driver.kind == MECH_DRIVE_ANGLE ? 57.295779513082321 : 1e3;
+    double unit = m->driver.kind == MECH_DRIVE_ANGLE ? 57.295779513082321
+                  : m->driver.kind == MECH_DRIVE_TIME ? 1.0 : 1e3;
     double acc = fmax(1e-12 * fabs(h), 1e-11 * fmax(fabs(q), fabs(h))) * unit;
     int d = (int)floor(-log10(acc));
     return d < 0 ? 0 : d > 12 ? 12 : d;

@@ -173,7 +173,7 @@ static int parse_end(const char *opt, const char *text, int is_angle, double *si
 /* --from/--to/--steps into o. -1, or the exit status. */
 static int apply_range(const report_args *a, const mech_model *m, mech_solve_options *o)
 {
-    int is_angle = m->driver.kind == MECH_DRIVE_ANGLE, code;
+    int is_angle = m->driver.kind == MECH_DRIVE_TIME ? 2 : m->driver.kind == MECH_DRIVE_ANGLE, code;
     if (a->from) {
         if ((code = parse_end("--from", a->from, is_angle, &o->from)) >= 0 ||
             (code = parse_end("--to", a->to, is_angle, &o->to)) >= 0)

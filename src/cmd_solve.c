@@ -303,8 +303,9 @@ static void print_stats(const mech_model *m, const mech_solve_stats *st, FILE *o
     fprintf(out, "  worst residual     %.3g m\n", st->worst_residual);
     if (st->steps)
         fprintf(out, "  smallest rcond     %.3g at q = %.6g %s\n", st->min_rcond,
-                angle ? st->worst_rcond_q * 57.29577951308232 : st->worst_rcond_q * 1e3,
-                angle ? "deg" : "mm");
+                angle ? st->worst_rcond_q * 57.29577951308232
+                : m->driver.kind == MECH_DRIVE_TIME ? st->worst_rcond_q : st->worst_rcond_q * 1e3,
+                angle ? "deg" : m->driver.kind == MECH_DRIVE_TIME ? "s" : "mm");
     fprintf(out, "  factorizations     %d full, %d refactor\n", st->factorizations,
             st->refactorizations);
     if (st->worst_power_residual > 0.0 || st->max_friction_iterations > 0)

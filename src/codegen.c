@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "codegen.h"
+#include "drivers.h"
 
 /* ---- analysis ---------------------------------------------------------------- */
 
@@ -53,7 +54,9 @@ static int make_identifiers(codegen *g)
     if (!g->col_ident || !g->unk_ident)
         return -1;
     for (int c = 0; c < g->cols.ncols; c++)
-        if (!(g->col_ident[c] = identifier(g->upper, "COL_", g->cols.cols[c].name)))
+        /* the input column is COL_Q whatever its name (q, or t for laws of time) */
+        if (!(g->col_ident[c] = identifier(g->upper, "COL_", g->cols.cols[c].src == SRC_DRIVER
+                                                                 ? "q" : g->cols.cols[c].name)))
             return -1;
     for (int k = 0; k < sp->ns; k++) {
         int var = sp->col[k], idx = sp->sys->unk_index[var];
@@ -250,7 +253,8 @@ static void emit_driver_macros(const codegen *g, FILE *f)
     fprintf(f, "/* The file's driver (%s): its range in %d steps, its speed and acceleration. */\n"
                "#define %s_DRIVER_FROM %s\n#define %s_DRIVER_TO %s\n#define %s_DRIVER_STEPS %d\n"
                "#define %s_DRIVER_SPEED %s\n#define %s_DRIVER_ACCEL %s\n\n",
-            dr->kind == MECH_DRIVE_ANGLE ? "an angle, rad" : "a slider, m",
+            dr->kind == MECH_DRIVE_TIME ? "time, s: the drivers' laws are in the equations"
+            : dr->kind == MECH_DRIVE_ANGLE ? "an angle, rad" : "a slider, m",
             dr->nvalues > 0 ? dr->nvalues - 1 : 0, P, a, P, b, P,
             dr->nvalues > 0 ? dr->nvalues - 1 : 0, P, s, P, acc);
 }
@@ -455,6 +459,23 @@ static void emit_init(const codegen *g, FILE *f)
             codegen_number(v, sizeof v, gs->value);
             fprintf(f, "    s->x[%d] = %s;\n", g->unk_col[var], v);
         }
+    }
+    /* drivers as laws of time: the driven unknowns start at their laws at the
+       file's first time, as cont_start does (drivers_guess) */
+    if (drivers_rows(m) > 0 && m->driver.nvalues > 0) {
+        double *guess = xcalloc((size_t)g->sp.n + 1, sizeof *guess);
+        for (int v = 0; guess && v < g->sp.n; v++)
+            guess[v] = NAN;
+        if (guess)
+            drivers_guess(m, g->sp.sys->link_var, g->sp.sys->joint_var, m->driver.values[0],
+                          guess);
+        for (int v = 0; guess && v < g->sp.n; v++)
+            if (!isnan(guess[v]) && g->unk_col[v] >= 0) {
+                char num[40];
+                codegen_number(num, sizeof num, guess[v]);
+                fprintf(f, "    s->x[%d] = %s;\n", g->unk_col[v], num);
+            }
+        free(guess);
     }
     fprintf(f, "    s->branch = -1;\n    s->first = 1;\n}\n\n");
 }

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "columns.h"
+#include "drivers.h"
 #include "springs.h"
 
 void columns_free(column_layout *cl)
@@ -59,7 +60,9 @@ static int kinematic_columns(column_layout *cl, const mech_model *m, const mech_
     static const char *const link_unit[] = {"rad", "rad/s", "rad/s^2"};
     static const char *const slide_sfx[] = {".s", ".v", ".a"};
     static const char *const slide_unit[] = {"m", "m/s", "m/s^2"};
-    int rc = add(cl, SRC_DRIVER, 0, 0, "q", "", m->driver.kind == MECH_DRIVE_ANGLE ? "rad" : "m");
+    int time = m->driver.kind == MECH_DRIVE_TIME;  /* drivers as laws of t */
+    int rc = add(cl, SRC_DRIVER, 0, 0, time ? "t" : "q", "",
+                 time ? "s" : m->driver.kind == MECH_DRIVE_ANGLE ? "rad" : "m");
     for (int i = 0; i < o->npoints; i++)
         for (int k = 0; k < 6; k++)
             if (k < 2 || (k < 4 ? level & MECH_WANT_VELOCITY : level & MECH_WANT_ACCELERATION))
@@ -71,6 +74,20 @@ static int kinematic_columns(column_layout *cl, const mech_model *m, const mech_
     for (int i = 0; i < o->nsliders; i++)
         rc |= add_levels(cl, level, SRC_SLIDER, o->sliders[i], m->joints[o->sliders[i]].name,
                          slide_sfx, slide_unit);
+    /* drivers as laws of time: each driven coordinate, as q is for `driver:`,
+       after the outputs when they do not list it */
+    for (int k = 0; k < drivers_rows(m); k++) {
+        const mech_motion *mo = &m->motions[k];
+        int angle = mo->kind == MECH_DRIVE_ANGLE, listed = 0;
+        for (int i = 0; angle && i < o->nlinks; i++)
+            listed |= o->links[i] == mo->index;
+        for (int i = 0; !angle && i < o->nsliders; i++)
+            listed |= o->sliders[i] == mo->index;
+        if (!listed)
+            rc |= add_levels(cl, level, angle ? SRC_LINK : SRC_SLIDER, mo->index,
+                             drivers_name(m, k), angle ? link_sfx : slide_sfx,
+                             angle ? link_unit : slide_unit);
+    }
     return rc;
 }
 
@@ -124,9 +141,14 @@ static int force_columns(column_layout *cl, const mech_model *m, char **label, i
             rc |= add(cl, SRC_REACTION, j, k, label[j], name, k == 3 ? "N*m" : "N");
         }
     }
-    if (m->driver.kind == MECH_DRIVE_ANGLE)
+    for (int k = 0; k < drivers_rows(m); k++) {  /* laws of time: one load per driver */
+        int angle = m->motions[k].kind == MECH_DRIVE_ANGLE;
+        snprintf(name, sizeof name, "%s%s", angle ? ".torque" : ".force", suffix);
+        rc |= add(cl, SRC_DRIVE_LOAD, k, 0, drivers_name(m, k), name, angle ? "N*m" : "N");
+    }
+    if (drivers_rows(m) == 0 && m->driver.kind == MECH_DRIVE_ANGLE)
         rc |= add(cl, SRC_DRIVE_LOAD, 0, 0, "driver.torque", suffix, "N*m");
-    else
+    else if (drivers_rows(m) == 0)
         rc |= add(cl, SRC_DRIVE_LOAD, 0, 0, "driver.force", suffix, "N");
     rc |= add(cl, SRC_POWER_RESIDUAL, 0, 0, "power.residual", suffix, "-");
     for (int c = first; !rc && c < cl->ncols; c++)
@@ -290,7 +312,7 @@ static void source_values(const column_group *g, const row_sources *rs, double *
         break;
     case SRC_SLIDER: slider_values(sv, g->obj, v); break;
     case SRC_REACTION: reaction_values(rs, g->obj, g->set, v); break;
-    case SRC_DRIVE_LOAD: v[0] = forces_drive(rs->fc, g->set); break;
+    case SRC_DRIVE_LOAD: v[0] = forces_drive_of(rs->fc, g->set, g->obj); break;
     case SRC_POWER_RESIDUAL: v[0] = g->set ? rs->fc->residual : rs->fc->residual0; break;
     case SRC_FRICTION_POWER: v[0] = rs->fc->friction_power; break;
     case SRC_FRICTION_ITERATIONS: v[0] = rs->fc->iterations; break;

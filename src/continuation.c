@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "diagnose.h"
+#include "drivers.h"
 
 static const double PI = 3.14159265358979323846;
 
@@ -287,6 +288,8 @@ int cont_start(cont *c, double q)
 {
     solver *sv = &c->sv;
     unsigned rng = 20261121u;
+    /* drivers as laws of time: the driven unknowns start at their laws */
+    drivers_guess(c->m, sv->p->sys->link_var, sv->p->sys->joint_var, q, c->guess);
     int attempts = has_unguessed(c) ? START_ATTEMPTS : 1, branch = -1;
     step_status s = STEP_NO_ASSEMBLY, first = STEP_OK;
     double first_resid = 0.0;

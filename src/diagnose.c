@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "diagnose.h"
+#include "drivers.h"
 #include "gears.h"
 
 static const double PI = 3.14159265358979323846;
@@ -17,6 +18,8 @@ const char *diagnose_q_text(const mech_model *m, double q, char *buf, size_t siz
 {
     if (is_angle_driver(m))
         snprintf(buf, size, "%.6g deg", q * 180.0 / PI);
+    else if (m->driver.kind == MECH_DRIVE_TIME)
+        snprintf(buf, size, "%.6g s", q);
     else
         snprintf(buf, size, "%.6g mm", q * 1e3);
     return buf;
@@ -25,18 +28,19 @@ const char *diagnose_q_text(const mech_model *m, double q, char *buf, size_t siz
 const char *diagnose_q_interval(const mech_model *m, double a, double b, char *buf,
                                 size_t size)
 {
-    double unit = is_angle_driver(m) ? 180.0 / PI : 1e3;
+    double unit = is_angle_driver(m) ? 180.0 / PI : m->driver.kind == MECH_DRIVE_TIME ? 1.0 : 1e3;
     double lo = fmin(a, b) * unit, hi = fmax(a, b) * unit, width = hi - lo;
     int dec = width > 0.0 ? (int)ceil(-log10(width)) + 1 : 6;
     dec = dec < 0 ? 0 : dec > 12 ? 12 : dec;
-    const char *u = is_angle_driver(m) ? "deg" : "mm";
+    const char *u = is_angle_driver(m) ? "deg" : m->driver.kind == MECH_DRIVE_TIME ? "s" : "mm";
     snprintf(buf, size, "%.*f %s and %.*f %s", dec, lo, u, dec, hi, u);
     return buf;
 }
 
 const char *diagnose_driver_word(const mech_model *m)
 {
-    return is_angle_driver(m) ? "driver angle" : "driver displacement";
+    return is_angle_driver(m) ? "driver angle"
+           : m->driver.kind == MECH_DRIVE_TIME ? "time" : "driver displacement";
 }
 
 /* "loop 2 (A-B-C-D-A)" */
@@ -365,7 +369,12 @@ void diagnose_redundant(cont *c, double q)
     size_t at = 0;
     for (int i = 0; i < count && at < sizeof list; i++) {
         int row = sv->p->row[named[i]], g = row - 2 * sv->p->sys->loops.nloops;
-        if (g >= 0 && g < sv->p->m->ngears)  /* a gear pair's row (gears.c) */
+        const mech_system *sys = sv->p->sys;
+        if (row >= sys->m - drivers_rows(sv->p->m))  /* a law of time's row (drivers.c) */
+            at += (size_t)snprintf(list + at, sizeof list - at, "%srow of driver '%s'",
+                                   i ? ", " : "",
+                                   drivers_name(sv->p->m, row - (sys->m - drivers_rows(sv->p->m))));
+        else if (g >= 0 && g < sv->p->m->ngears)  /* a gear pair's row (gears.c) */
             at += (size_t)snprintf(list + at, sizeof list - at, "%srow of gear pair '%s'",
                                    i ? ", " : "", sv->p->m->gears[g].name);
         else
@@ -496,12 +505,13 @@ static void limit_words(cont *c, double hrow, char *why, size_t size)
     in_line_text(&c->sv, upper, c->xc, line, sizeof line);
     if (!line[0])
         return;
-    double unit = is_angle_driver(m) ? 180.0 / PI : 1e3;
+    int time = m->driver.kind == MECH_DRIVE_TIME;  /* laws of time: t in s */
+    double unit = is_angle_driver(m) ? 180.0 / PI : time ? 1.0 : 1e3;
     double acc = fmax(1e-9 * fabs(hrow), 1e-11 * fmax(fabs(upper), fabs(hrow))) * unit;
     int dec = (int)floor(-log10(acc)) - 1;
     snprintf(why, size, "; at %.*f %s, %s%s", dec < 0 ? 0 : dec > 12 ? 12 : dec, upper * unit,
-             is_angle_driver(m) ? "deg" : "mm", line,
-             is_angle_driver(m) ? "" : ": dead centre of the slider");
+             is_angle_driver(m) ? "deg" : time ? "s" : "mm", line,
+             is_angle_driver(m) || time ? "" : ": dead centre of the slider");
 }
 
 /* The interval(s) where the mechanism assembles, from row 0 and the last

@@ -19,6 +19,9 @@ int flywheel_compute(const mech_table *t, const mech_model *m, double cs, flywhe
 {
     memset(f, 0, sizeof *f);
     int cq = mech_table_column(t, "q"), ct = mech_table_column(t, "driver.torque");
+    if (m->driver.kind == MECH_DRIVE_TIME)
+        return snprintf(why, size, "the drivers are laws of time: a flywheel needs one crank "
+                        "swept through its angle ('driver:')"), -1;
     if (m->driver.kind != MECH_DRIVE_ANGLE)
         return snprintf(why, size, "the driver is a slider: a flywheel needs a crank"), -1;
     if (cq < 0 || ct < 0)

@@ -22,6 +22,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "drivers.h"
 #include "forces.h"
 #include "gears.h"
 #include "springs.h"
@@ -156,10 +157,17 @@ static int column_entries(const forces_plan *fp, const solver *sv, const double 
         n = push_force(e, n, g, gr->link[1], p, t, 1.0);
         return push_force(e, n, g, gr->link[0], p, t, -1.0);
     }
-    if (fp->joint[c] < 0 && m->driver.kind == MECH_DRIVE_ANGLE) {
-        n = push_moment(e, n, m->driver.index, 1.0);
+    /* a driver's column: joint -1 (the `driver:`) or -1 - k (law k of `drivers:`) */
+    mech_drive_kind dkind = m->driver.kind;
+    int dindex = m->driver.index;
+    if (fp->joint[c] < 0 && drivers_rows(m) > 0) {
+        dkind = m->motions[-1 - fp->joint[c]].kind;
+        dindex = m->motions[-1 - fp->joint[c]].index;
+    }
+    if (fp->joint[c] < 0 && dkind == MECH_DRIVE_ANGLE) {
+        n = push_moment(e, n, dindex, 1.0);
     } else {
-        const mech_joint *jt = &m->joints[fp->joint[c] >= 0 ? fp->joint[c] : m->driver.index];
+        const mech_joint *jt = &m->joints[fp->joint[c] >= 0 ? fp->joint[c] : dindex];
         int a, b;
         joint_links(jt, &a, &b);
         double p[2], dir[2];
@@ -202,7 +210,9 @@ static void make_columns(forces_plan *fp)
     fp->gcol = fp->ncols;
     for (int g = 0; g < m->ngears; g++)
         add_column(fp, FC_GEAR, g);
-    add_column(fp, FC_DRIVE, -1);
+    fp->ndrive = drivers_rows(m) > 0 ? drivers_rows(m) : 1;
+    for (int k = 0; k < fp->ndrive; k++)
+        add_column(fp, FC_DRIVE, -1 - k);
 }
 
 static int build_pattern(forces_plan *fp)
@@ -256,7 +266,7 @@ int forces_plan_init(forces_plan *fp, const solver_plan *sp, int friction, mech_
     memset(fp, 0, sizeof *fp);
     fp->m = m;
     fp->nrows = 3 * (m->nlinks - 1);
-    size_t nc = 2 * (size_t)m->njoints + (size_t)m->ngears + 2;
+    size_t nc = 2 * (size_t)m->njoints + (size_t)m->ngears + 2 + (size_t)drivers_rows(m);
     fp->kind = xcalloc(nc, sizeof *fp->kind);
     fp->joint = xcalloc(nc, sizeof *fp->joint);
     fp->jcol = xcalloc((size_t)m->njoints + 1, sizeof *fp->jcol);
@@ -519,13 +529,34 @@ static void solve_rhs(forces *fc, const double *rhs, double *y)
         y[c] *= fc->cscale[c];
 }
 
-/* P_driver + P_loads + P_gravity - P_friction - dT/dt, relative to the
- * largest of those terms. */
-static double power_residual(const forces *fc, const solver *sv, double drive, double pfric)
+/* The drivers' power for the reactions y: the driver's load times its
+ * speed, or (laws of time) the sum over the drivers of each load times the
+ * rate of its coordinate. */
+static double drive_power(const forces *fc, const solver *sv, const double *y)
 {
     const forces_plan *fp = fc->p;
     const mech_model *m = fp->m;
-    double pd = drive * m->driver.speed, kin = 0.0, ext = 0.0, scale = fabs(pd) + fabs(pfric);
+    int first = fp->ncols - fp->ndrive;
+    if (drivers_rows(m) == 0)
+        return y[first] * m->driver.speed;
+    double p = 0.0;
+    for (int k = 0; k < fp->ndrive; k++) {
+        const mech_motion *mo = &m->motions[k];
+        int var = mo->kind == MECH_DRIVE_SLIDER ? sv->p->tree.slide_var[mo->index] : -1;
+        double rate = mo->kind == MECH_DRIVE_ANGLE ? sv->ks.om[mo->index]
+                      : var >= 0 ? sv->vel[var] : 0.0;
+        p += y[first + k] * rate;
+    }
+    return p;
+}
+
+/* P_driver + P_loads + P_gravity - P_friction - dT/dt, relative to the
+ * largest of those terms. */
+static double power_residual(const forces *fc, const solver *sv, double pd, double pfric)
+{
+    const forces_plan *fp = fc->p;
+    const mech_model *m = fp->m;
+    double kin = 0.0, ext = 0.0, scale = fabs(pd) + fabs(pfric);
     for (int l = 1; l < m->nlinks; l++) {
         const mech_link *k = &m->links[l];
         if (!k->has_mass)
@@ -677,7 +708,7 @@ static void friction_fixed_point(forces *fc, const solver *sv)
 int forces_solve(forces *fc, const solver *sv)
 {
     const forces_plan *fp = fc->p;
-    int n = fp->nrows, drive = fp->ncols - 1;
+    int n = fp->nrows;
     update_centres(fc, sv);
     state_loads_eval(fp->m->state_loads, sv, fc->sl_reg);
     known_loads(fc, sv, fc->b);
@@ -695,7 +726,7 @@ int forces_solve(forces *fc, const solver *sv)
             gear_separation(fc, sv, fc->y0, fc->fric);
             solve_rhs(fc, fc->fric, fc->y0);
         }
-        fc->residual0 = power_residual(fc, sv, fc->y0[drive], 0.0);
+        fc->residual0 = power_residual(fc, sv, drive_power(fc, sv, fc->y0), 0.0);
         memcpy(fc->y, fc->y0, (size_t)n * sizeof *fc->y);
     }
     fc->have_previous = 1;
@@ -703,8 +734,8 @@ int forces_solve(forces *fc, const solver *sv)
     fc->friction_power = 0.0;
     if (fp->friction)
         friction_fixed_point(fc, sv);
-    fc->drive_power = fc->y[drive] * fp->m->driver.speed;
-    fc->residual = power_residual(fc, sv, fc->y[drive], fc->friction_power);
+    fc->drive_power = drive_power(fc, sv, fc->y);
+    fc->residual = power_residual(fc, sv, fc->drive_power, fc->friction_power);
     return fc->iterations < 0 ? -2 : 0;
 }
 
@@ -783,4 +814,10 @@ double forces_gear(const forces *fc, int i, int with_friction)
 {
     const forces_plan *fp = fc->p;
     return (with_friction ? fc->y : fc->y0)[fp->gcol + i] / cos(fp->m->gears[i].pressure_angle);
+}
+
+double forces_drive_of(const forces *fc, int with_friction, int k)
+{
+    const forces_plan *fp = fc->p;
+    return (with_friction ? fc->y : fc->y0)[fp->ncols - fp->ndrive + k];
 }

@@ -19,10 +19,11 @@ typedef struct forces_plan {
     int nrows;              /* 3 per moving link */
     int ncols;
     fc_kind *kind;          /* [ncols] */
-    int *joint;             /* [ncols] joint of a reaction column (-1: the driver; FC_GEAR:
-                               the gear pair) */
+    int *joint;             /* [ncols] joint of a reaction column (-1: the driver;
+                               -1 - k: driver k of `drivers:`; FC_GEAR: the gear pair) */
     int gcol;               /* first tooth-force column (one per gear pair, before the
-                               driver's, which stays last) */
+                               drivers', which stay last) */
+    int ndrive;             /* driver columns, the last ones: 1, or the `drivers:` */
     int *jcol;              /* [njoints] first column of each joint */
     int *Ap, *Ai;           /* [ncols+1], [nnz] */
     int *slot;              /* [nnz] where column c's k-th entry, in the order
@@ -78,6 +79,8 @@ double forces_drive(const forces *fc, int with_friction);
 /* Tooth force of gear pair i along its line of action (gears.h), N: the
  * sign of its tangential part F (on link[1], along t). */
 double forces_gear(const forces *fc, int i, int with_friction);
+/* The load of driver k: 0 for `driver:`, 0 .. ndrive-1 for `drivers:`. */
+double forces_drive_of(const forces *fc, int with_friction, int k);
 /* After forces_solve returned -1: the names of the joints involved. */
 void forces_singular_joints(forces *fc, char *buf, size_t size);
 

@@ -11,7 +11,9 @@
  *                  symbol, mass, center, inertia}}            required
  *   joints: [{revolute: P, links: [a, b], name, friction, pin_radius}
  *          | {slider: P, link, on, through, angle, rotation, name, symbol, friction}]
- *   driver: {link | slider, angle | displacement, speed, acceleration}  required
+ *   driver: {link | slider, angle | displacement, speed, acceleration}  required, or
+ *   sweep: {time: RANGE} with drivers: [{link, angle: LAW} | {slider, displacement: LAW}]
+ *                                   (laws of the time t: load_drivers.c)
  *   initial: {link or slider name: value}
  *   branch: [{points: [A, B, C], turn: ccw | cw}]
  *   loops: [[A, B, C, A] | "A B C A"]
@@ -48,14 +50,15 @@ static void load_document(loader *ld, const ynode *root)
     static const char *const keys[] = {"name", "description", "units", "parameters", "gravity",
                                        "ground", "links", "joints", "driver", "initial",
                                        "branch", "loops", "loads", "springs", "gears",
-                                       "outputs"};
+                                       "outputs", "sweep", "drivers"};
     mech_model *m = ld->m;
     if (!load_check_keys(ld, root, keys, COUNT(keys), "the mechanism"))
         return;
     const ynode *v;
     static const char *const required[] = {"name", "ground", "links", "driver"};
     for (size_t i = 0; i < COUNT(required); i++)
-        if (!ymap_get(root, required[i]) && !load_misspelt(root, required[i], keys, COUNT(keys)))
+        if (!ymap_get(root, required[i]) &&
+            !(strcmp(required[i], "driver") == 0 && ymap_get(root, "drivers")) && !load_misspelt(root, required[i], keys, COUNT(keys)))
             load_err(ld, root, "missing '%s' (a mechanism file needs name, ground, links and driver)",
                      required[i]);
     if ((v = ymap_get(root, "name")))
@@ -91,8 +94,15 @@ static void load_document(loader *ld, const ynode *root)
         load_gears(ld, v);
     load_check_link_points(ld);
     load_warn_point_typos(ld);
-    if ((v = ymap_get(root, "driver")))
+    const ynode *dv = ymap_get(root, "drivers"), *sw = ymap_get(root, "sweep");
+    if ((v = ymap_get(root, "driver")) && (dv || sw))
+        load_err(ld, load_key_of(root, dv ? "drivers" : "sweep"),
+                 "'driver' and '%s' together: give 'driver' (one driver, swept through its "
+                 "range) or 'drivers' with 'sweep' (laws of the time t)", dv ? "drivers" : "sweep");
+    else if (v)
         load_driver(ld, v);
+    else if (dv || sw)
+        load_sweep_drivers(ld, sw, dv);
     if ((v = ymap_get(root, "initial")))
         load_initial(ld, v);
     if ((v = ymap_get(root, "branch")))

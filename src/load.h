@@ -120,6 +120,10 @@ void load_warn_point_typos(loader *ld);
 
 /* ---- load_motion.c: driver, initial guesses, branch conditions, loops. */
 void load_driver(loader *ld, const ynode *map);
+/* A driver's (or the sweep's) range: a list or {from, to, steps} of q. */
+void load_range(loader *ld, const ynode *n, quantity q, mech_driver *dr);
+/* load_drivers.c: 'sweep: {time: RANGE}' and 'drivers: [...]' (laws of time) */
+void load_sweep_drivers(loader *ld, const ynode *sweep, const ynode *drivers);
 void load_initial(loader *ld, const ynode *map);
 void load_branches(loader *ld, const ynode *seq);
 void load_loops(loader *ld, const ynode *seq);

@@ -79,9 +79,10 @@ static void check_list_radians(loader *ld, const ynode *n, const mech_driver *dr
         warn_radians(ld, n, big, hi - lo, step);
 }
 
-static void load_range(loader *ld, const ynode *n, quantity q, mech_driver *dr)
+void load_range(loader *ld, const ynode *n, quantity q, mech_driver *dr)
 {
-    const char *what = q == Q_ANGLE ? "driver angle" : "driver displacement";
+    const char *what = q == Q_ANGLE ? "driver angle" : q == Q_TIME ? "sweep time"
+                                                                    : "driver displacement";
     if (n->kind == YNODE_SCALAR || n->kind == YNODE_SEQ) {
         size_t count = n->kind == YNODE_SCALAR ? 1 : n->n;
         if (count == 0 || count > MAX_STEPS)

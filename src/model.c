@@ -4,6 +4,7 @@
 #include <string.h>
 #include <strings.h>
 
+#include "drivers.h"
 #include "internal.h"
 #include "state_loads.h"
 
@@ -65,6 +66,7 @@ void mech_model_free(mech_model **pm)
         free(m->point_names[i]);
     free(m->point_names);
     free(m->driver.values);
+    drivers_free(m);
     free(m->guesses);
     free(m->branches);
     for (int i = 0; i < m->nloops; i++) {
@@ -127,6 +129,9 @@ static int report_dangling(const mech_model *m, const int *njoints_of, mech_diag
         if (m->has_driver && m->driver.kind == MECH_DRIVE_SLIDER &&
             m->joints[m->driver.index].link[0] == i)
             driven = 1;
+        for (int k = 0; k < drivers_rows(m); k++)
+            driven |= m->motions[k].kind == MECH_DRIVE_ANGLE ? m->motions[k].index == i
+                      : m->joints[m->motions[k].index].link[0] == i;
         if (njoints_of[i] == 1 && !driven) {
             diag_error(d, m->file, m->links[i].mark,
                        "link '%s' is attached by a single joint, so nothing fixes its position: "
@@ -347,7 +352,7 @@ int mech_check(const mech_model *m, mech_summary *s, mech_diag *d)
 {
     memset(s, 0, sizeof *s);
     s->nlinks = m->nlinks;
-    s->ndrivers = m->has_driver ? 1 : 0;
+    s->ndrivers = drivers_rows(m) ? drivers_rows(m) : m->has_driver ? 1 : 0;
     int *work = xcalloc((size_t)m->nlinks, sizeof *work);
     int *njoints_of = xcalloc((size_t)m->nlinks, sizeof *njoints_of);
     if (!work || !njoints_of) {
@@ -371,7 +376,10 @@ int mech_check(const mech_model *m, mech_summary *s, mech_diag *d)
     size_t before = d->nerrors;
     int connected = check_connected(m, work, d);
     int dangling = report_dangling(m, njoints_of, d);
-    if (connected && !dangling && s->mobility != s->ndrivers) {
+    if (connected && !dangling && s->mobility != s->ndrivers && s->mobility > 0 &&
+        drivers_rows(m) > 0) {
+        drivers_report_count(m, s->mobility, d);
+    } else if (connected && !dangling && s->mobility != s->ndrivers) {
         mech_mark at = m->has_driver ? m->driver.mark : (mech_mark){0, 0};
         int excess = s->mobility - s->ndrivers, abs_excess = excess < 0 ? -excess : excess;
         char gruebler[192];

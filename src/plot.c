@@ -13,6 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "drivers.h"
 #include "plot_svg.h"
 
 /* SI unit of a column -> display unit and factor (docs/plots.md, Units). */
@@ -191,10 +192,39 @@ static void plan_forces(plan *p, const mech_model *m)
     }
 }
 
+/* Drivers as laws of time: their torques in one figure, their forces in
+ * another, each with and without friction when both exist. */
+static void plan_drivers(plan *p, const mech_model *m)
+{
+    const char **it = xcalloc((size_t)m->nmotions + 1, sizeof *it);
+    for (int kind = 0; it && kind < 2; kind++) {  /* 0 torques (links), 1 forces (sliders) */
+        int n = 0;
+        for (int i = 0; i < m->nmotions; i++)
+            if ((m->motions[i].kind == MECH_DRIVE_SLIDER) == kind)
+                it[n++] = drivers_name(m, i);
+        static const char *const sfx[2][2] = {{".torque", ".torque.nofriction"},
+                                              {".force", ".force.nofriction"}};
+        static const char *const both_label[] = {" with friction", " no friction"};
+        static const char *const one_label[] = {""};
+        char nf[160];
+        snprintf(nf, sizeof nf, "%s%s", n ? it[0] : "", sfx[kind][1]);
+        int both = n > 0 && mech_table_column(p->t, nf) >= 0;
+        if (n > 0)
+            add_group(p, kind ? "driver-forces" : "driver-torques",
+                      kind ? "Driver forces" : "Driver torques", kind ? "force" : "torque", it,
+                      it, n, sfx[kind], both ? both_label : one_label, both ? 2 : 1);
+    }
+    free(it);
+}
+
 /* The driver torque (or force), with and without friction when both exist. */
 static void plan_driver(plan *p, const mech_model *m)
 {
     const mech_table *t = p->t;
+    if (m->nmotions > 0 && m->driver.kind == MECH_DRIVE_TIME) {
+        plan_drivers(p, m);
+        return;
+    }
     const char *drv = mech_table_column(t, "driver.torque") >= 0 ? "driver.torque"
                       : mech_table_column(t, "driver.force") >= 0 ? "driver.force" : NULL;
     if (!drv)
@@ -259,13 +289,17 @@ typedef struct fig_ctx {
 static double xval(const fig_ctx *c, int r)
 {
     double q = mech_table_get(c->t, r, 0);
+    if (c->m->has_driver && c->m->driver.kind == MECH_DRIVE_TIME)
+        return q;  /* drivers as laws of time: t in s */
     return c->m->has_driver && c->m->driver.kind == MECH_DRIVE_SLIDER ? q * 1e3 : q * RAD2DEG;
 }
 
 static void x_title(const fig_ctx *c, FILE *f)
 {
     const mech_model *m = c->m;
-    if (m->has_driver && m->driver.kind == MECH_DRIVE_SLIDER) {
+    if (m->has_driver && m->driver.kind == MECH_DRIVE_TIME) {
+        fputs("time t [s]", f);
+    } else if (m->has_driver && m->driver.kind == MECH_DRIVE_SLIDER) {
         fputs("displacement of slider ", f);
         plot_put_text(f, m->joints[m->driver.index].name);
         fputs(" [mm]", f);

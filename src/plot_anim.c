@@ -531,11 +531,12 @@ static void put_caption(FILE *f, const anim_ctx *c, const char *dur)
     plot_put_text(f, m->name ? m->name : m->file);
     fputs("</text>\n<text x=\"12\" y=\"40\" fill=\"#555\">", f);
     int slider_drv = m->has_driver && m->driver.kind == MECH_DRIVE_SLIDER;
-    double qk = slider_drv ? 1e3 : RAD2DEG;
-    const char *qu = slider_drv ? "mm" : "deg";
+    int time_drv = m->has_driver && m->driver.kind == MECH_DRIVE_TIME;  /* laws of t */
+    double qk = time_drv ? 1.0 : slider_drv ? 1e3 : RAD2DEG;
+    const char *qu = time_drv ? "s" : slider_drv ? "mm" : "deg";
     if (c->nframes == 1)
         fprintf(f, "driver %s = %s %s (position %d of %d)",
-                slider_drv ? "displacement" : "angle",
+                time_drv ? "time" : slider_drv ? "displacement" : "angle",
                 plot_fmt(b1, mech_table_get(c->t, c->rows[0], 0) * qk, 3), qu, c->rows[0],
                 c->nrows);
     else

@@ -266,12 +266,15 @@ static void path_legend(FILE *f, const path_ctx *c)
     const mech_model *m = c->m;
     int slider = m->has_driver && m->driver.kind == MECH_DRIVE_SLIDER;
     char b[32];
-    double q0 = c->t->nrows > 0 ? mech_table_get(c->t, 0, 0) * (slider ? 1e3 : RAD2DEG) : 0;
+    int time = m->has_driver && m->driver.kind == MECH_DRIVE_TIME;  /* laws of t: s */
+    double q0 = c->t->nrows > 0 ? mech_table_get(c->t, 0, 0) *
+                                      (time ? 1.0 : slider ? 1e3 : RAD2DEG) : 0;
     fprintf(f, "<use xlink:href=\"#m0\" x=\"%d\" y=\"%d\" fill=\"#555\" stroke=\"#fff\"/>"
                "<text x=\"%d\" y=\"%d\" font-size=\"11\">start: %s %s</text>\n"
                "<use xlink:href=\"#arrow\" x=\"%d\" y=\"%d\" fill=\"#555\"/>"
                "<text x=\"%d\" y=\"%d\" font-size=\"11\">direction of motion</text>\n",
-            lx + 14, ly + h + 8, lx + 26, ly + h + 12, plot_fmt(b, q0, 2), slider ? "mm" : "deg",
+            lx + 14, ly + h + 8, lx + 26, ly + h + 12, plot_fmt(b, q0, 2),
+            time ? "s" : slider ? "mm" : "deg",
             lx + 14, ly + h + 30, lx + 26, ly + h + 34);
 }
 

@@ -3,6 +3,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "drivers.h"
 #include "system.h"
 
 static void describe_unknown(const mech_system *s, int i, FILE *out)
@@ -72,7 +73,8 @@ static void print_text(const mech_system *s, FILE *out)
         fputc('\n', out);
     }
     fprintf(out, "input q: %s = %s, with rates %s and %s\n\n", s->names[n],
-            m->driver.kind == MECH_DRIVE_ANGLE ? "driver link angle" : "driver slider displacement",
+            m->driver.kind == MECH_DRIVE_TIME ? "time, the drivers' laws' variable"
+            : m->driver.kind == MECH_DRIVE_ANGLE ? "driver link angle" : "driver slider displacement",
             s->names[SYS_VAR_QDOT(n)], s->names[SYS_VAR_QDDOT(n)]);
     print_coefficients(s, out);
     fprintf(out, "loops (%d, %s):\n", s->loops.nloops,
@@ -87,7 +89,9 @@ static void print_text(const mech_system *s, FILE *out)
         fprintf(out, "  f%d = ", r + 1);
         expr_print(&s->ex, s->f[r], &nm, 0, out);
         int g = r - 2 * s->loops.nloops;  /* gears.c's rows follow the loops' */
-        if (g >= 0 && g < s->model->ngears)
+        if (r >= s->m - drivers_rows(m))  /* drivers as laws of time: the last rows */
+            fprintf(out, "    [driver '%s']\n", drivers_name(m, r - (s->m - drivers_rows(m))));
+        else if (g >= 0 && g < s->model->ngears)
             fprintf(out, "    [gear pair '%s']\n", s->model->gears[g].name);
         else if (g >= 0)
             fprintf(out, "    [row %d]\n", r + 1);

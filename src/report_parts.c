@@ -8,6 +8,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "drivers.h"
 #include "report.h"
 #include "gears.h"
 #include "springs.h"
@@ -68,6 +69,15 @@ static void driver_text(const mech_model *m, int range, char *buf, size_t n)
         return;
     }
     const mech_driver *dr = &m->driver;
+    if (dr->kind == MECH_DRIVE_TIME) {  /* laws of time: the sweep and the laws */
+        size_t at = (size_t)snprintf(buf, n, "time t from %.6g to %.6g s, %d position%s",
+                                     dr->values[0], dr->values[dr->nvalues - 1], dr->nvalues,
+                                     dr->nvalues == 1 ? "" : "s");
+        for (int i = 0; !range && i < m->nmotions && at < n; i++)
+            at += (size_t)snprintf(buf + at, n - at, "; %s = %s", drivers_name(m, i),
+                                   m->motions[i].text);
+        return;
+    }
     int angle = dr->kind == MECH_DRIVE_ANGLE;
     double k = angle ? RAD2DEG_R : 1e3;
     if (range)
@@ -227,8 +237,9 @@ static void put_stats(FILE *f, const mech_model *m, const mech_solve_stats *st)
     row_text(f, "worst residual", b);
     if (st->steps) {
         snprintf(b, sizeof b, "%.3g at q = %.6g %s", st->min_rcond,
-                 angle ? st->worst_rcond_q * RAD2DEG_R : st->worst_rcond_q * 1e3,
-                 angle ? "deg" : "mm");
+                 angle ? st->worst_rcond_q * RAD2DEG_R
+                 : m->driver.kind == MECH_DRIVE_TIME ? st->worst_rcond_q : st->worst_rcond_q * 1e3,
+                 angle ? "deg" : m->driver.kind == MECH_DRIVE_TIME ? "s" : "mm");
         row_text(f, "smallest rcond", b);
     }
     snprintf(b, sizeof b, "%d full, %d refactor", st->factorizations, st->refactorizations);

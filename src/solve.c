@@ -15,6 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "drivers.h"
 #include "solve.h"
 
 enum { PHASE_POSITION, PHASE_VELOCITY, PHASE_ACCELERATION, NPHASES };
@@ -73,6 +74,14 @@ static void needed_unknowns(solver_plan *sp, unsigned char *need)
     for (int i = 0; i < o->nsliders; i++) {
         int var = sp->tree.slide_var[o->sliders[i]];
         if (var >= 0 && var < sp->n)
+            need[var] = 1;
+    }
+    for (int k = 0; k < drivers_rows(m); k++) {  /* their columns are always output */
+        int var = m->motions[k].kind == MECH_DRIVE_SLIDER
+                      ? sp->tree.slide_var[m->motions[k].index] : -1;
+        if (m->motions[k].kind == MECH_DRIVE_ANGLE)
+            kin_need_link(&sp->tree, m->motions[k].index, need);
+        else if (var >= 0 && var < sp->n)
             need[var] = 1;
     }
     for (int b = 0; b < m->nbranches; b++) {
@@ -445,7 +454,9 @@ int solver_plan_init_with(solver_plan *sp, const mech_model *m, const mech_solve
         } else {
             b = choose_blocks(sp, need, row_on, col_on);
         }
-        if (b > 0)
+        if (b > 0 && drivers_rows(m) > 0)  /* name the conflicting drivers, the free unknowns */
+            rc = drivers_report_structure(sp->sys, d);
+        else if (b > 0)
             rc = diag_error(d, m->file, m->driver.mark,
                             "the loop equations are structurally singular: some unknown "
                             "appears in no equation that could determine it (see 'mech equations')");

@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "gears.h"
+#include "drivers.h"
 #include "param_grad.h"
 #include "system.h"
 
@@ -134,7 +135,11 @@ static int position_names(const mech_system *s, int var, char **text, char **lat
     const mech_model *m = s->model;
     const char *symbol, *name;
     int is_angle;
-    if (var == SYS_VAR_Q(s->n)) {
+    if (var == SYS_VAR_Q(s->n) && m->driver.kind == MECH_DRIVE_TIME) {
+        *text = xstrdup("t");  /* drivers as laws of time: q is t */
+        *latex = xstrdup("t");
+        return *text && *latex ? 0 : -1;
+    } else if (var == SYS_VAR_Q(s->n)) {
         is_angle = m->driver.kind == MECH_DRIVE_ANGLE;
         const int i = m->driver.index;
         symbol = is_angle ? m->links[i].symbol : m->joints[i].symbol;
@@ -292,7 +297,7 @@ static int build_residual(mech_system *s, mech_diag *d)
 {
     const mech_model *m = s->model;
     const loop_set *ls = &s->loops;
-    int rows = 2 * ls->nloops + m->ngears, maxterms = 1;
+    int rows = s->m, maxterms = 1;
     for (int k = 0; k < ls->nloops; k++)
         if (ls->start[k + 1] - ls->start[k] > maxterms)
             maxterms = ls->start[k + 1] - ls->start[k];
@@ -311,6 +316,10 @@ static int build_residual(mech_system *s, mech_diag *d)
         s->f[2 * k + 1] = balanced_sum(&s->ex, ys, nt);
     }
     gears_rows(s, s->f + 2 * ls->nloops);  /* gear pairs: one row each, after the loops */
+    /* drivers as laws of time: one row each, the last rows (after the loops
+       and any other rows) */
+    drivers_residual(m, &s->ex, s->link_angle, s->slide, expr_var(&s->ex, SYS_VAR_Q(s->n)),
+                     s->f + s->m - drivers_rows(m));
     free(xs);
     free(ys);
     return MECH_OK;
@@ -537,7 +546,7 @@ int sys_new_with(const mech_model *m, sys_mode mode, const sys_params *params,
     }
     if ((rc = loops_build(m, &s->span, &s->loops, d)) != MECH_OK)
         goto fail;
-    s->m = 2 * s->loops.nloops + m->ngears;
+    s->m = 2 * s->loops.nloops + m->ngears + drivers_rows(m);
     /* more equations than unknowns: redundant constraints, which the solver
        treats in the least-squares sense and checks for consistency */
     if (s->m < s->n) {

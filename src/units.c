@@ -671,6 +671,7 @@ int mech_parse_value(const char *text, int is_angle, double *si, char *err, size
     u.scale[Q_LENGTH] = 1e-3;                            /* bare lengths: millimetres */
     expr_env env = {&u, NULL, 0};
     size_t pos;
-    return quantity_eval(text, is_angle ? Q_ANGLE : Q_LENGTH, &env, si, err, errsize, &pos) == 0
+    quantity q = is_angle == 2 ? Q_TIME : is_angle ? Q_ANGLE : Q_LENGTH;  /* 2: a time, s */
+    return quantity_eval(text, q, &env, si, err, errsize, &pos) == 0
                ? MECH_OK : MECH_EINPUT;
 }

@@ -36,7 +36,9 @@
  *   mechanisms/slider-crank.yaml (x = r cos q + sqrt(l^2 - r^2 sin^2 q)),
  *   every column to 1e-10 relative (tests/unit/closed_forms.h, shared with
  *   test_solve.c; the dimensions are written here from the YAML text, not
- *   read through the loader). */
+ *   read through the loader); mechanisms/five-bar.yaml (drivers as laws of
+ *   time: the coupler point P by circle-circle intersection, its rates from
+ *   the differentiated distance constraints). */
 #include <criterion/criterion.h>
 #include <dirent.h>
 #include <math.h>
@@ -49,6 +51,11 @@
 #include "closed_forms.h"
 #include "compare.h"
 #include "mech.h"
+
+/* src/drivers.c: a law of time and its first two derivatives, evaluated on
+ * the law's tree by forward differentiation (src/drivers.h; declared here
+ * because drivers.h brings in the library's internal.h) */
+double law_eval(const struct mech_law *l, double t, double *dt, double *dtt);
 
 #define PI 3.14159265358979323846
 #define TWO_PI (2.0 * PI)
@@ -294,8 +301,9 @@ static void load_golden(golden *g, const char *name)
     cr_assert(g->m->has_driver, "%s: no driver", g->yaml);
 
     cr_assert_geq(g->t.nrows, 1, "%s: no data rows", g->csv);
-    g->qc = col(g, "q");
-    cr_assert_eq(g->qc, 0, "%s: the first column is not q", g->csv);
+    /* q, or t when the drivers are laws of time (docs/format.md 7.3) */
+    g->qc = col(g, g->m->driver.kind == MECH_DRIVE_TIME ? "t" : "q");
+    cr_assert_eq(g->qc, 0, "%s: the first column is not q (or t)", g->csv);
     g->kind = malloc(g->t.ncols * sizeof *g->kind);
     cr_assert_not_null(g->kind);
     for (size_t j = 0; j < g->t.ncols; j++) {
@@ -467,7 +475,8 @@ Test(golden, columns_and_driver_range)
         const mech_driver *dr = &m->driver;
         worst w;
         worst_init(&w, "driver", 1e-12);
-        cr_assert_str_eq(g->t.units[g->qc], dr->kind == MECH_DRIVE_ANGLE ? "rad" : "m",
+        cr_assert_str_eq(g->t.units[g->qc], dr->kind == MECH_DRIVE_TIME ? "s"
+                                            : dr->kind == MECH_DRIVE_ANGLE ? "rad" : "m",
                          "%s: column q has unit [%s]", g->csv, g->t.units[g->qc]);
         cr_assert_eq(g->t.nrows, (size_t)dr->nvalues,
                      "%s: %zu data rows, but %s has %d driver positions", g->csv, g->t.nrows,
@@ -507,9 +516,29 @@ Test(golden, columns_and_driver_range)
                 cr_assert_geq(colf(g, "%s.%s", m->joints[m->outputs.sliders[i]].name, sc[k]), 0,
                               "%s: no column %s.%s for an output of %s", g->csv,
                               m->joints[m->outputs.sliders[i]].name, sc[k], g->yaml);
+        /* laws of time: each driven coordinate is its law at t, its rates the
+           law's derivatives (forward differentiation of the law's tree,
+           drivers.c, not the solver's symbolic derivatives) */
+        for (int k = 0; dr->kind == MECH_DRIVE_TIME && k < m->nmotions; k++) {
+            const mech_motion *mo = &m->motions[k];
+            int angle = mo->kind == MECH_DRIVE_ANGLE;
+            const char *mn = angle ? m->links[mo->index].name : m->joints[mo->index].name;
+            int cc[3] = {colf(g, "%s.%s", mn, angle ? "angle" : "s"),
+                         colf(g, "%s.%s", mn, angle ? "omega" : "v"),
+                         colf(g, "%s.%s", mn, angle ? "alpha" : "a")};
+            for (size_t i = 0; i < g->t.nrows; i++) {
+                double want[3];
+                want[0] = law_eval(mo->law, qval(g, i), &want[1], &want[2]);
+                for (int c = 0; c < 3; c++)
+                    if (cc[c] >= 0)
+                        check_value(g, &w, g->t.names[cc[c]], i, want[c], val(g, i, cc[c]),
+                                    fmax(1.0, fabs(want[c])), 1e-12);
+            }
+        }
         /* the driver's own columns: its position is q, its rates the file's */
-        const char *dname = dr->kind == MECH_DRIVE_ANGLE ? m->links[dr->index].name
-                                                         : m->joints[dr->index].name;
+        const char *dname = dr->kind == MECH_DRIVE_TIME ? "(none)"
+                            : dr->kind == MECH_DRIVE_ANGLE ? m->links[dr->index].name
+                                                           : m->joints[dr->index].name;
         int c0 = colf(g, "%s.%s", dname, dr->kind == MECH_DRIVE_ANGLE ? "angle" : "s");
         int c1 = colf(g, "%s.%s", dname, dr->kind == MECH_DRIVE_ANGLE ? "omega" : "v");
         int c2 = colf(g, "%s.%s", dname, dr->kind == MECH_DRIVE_ANGLE ? "alpha" : "a");
@@ -1312,6 +1341,62 @@ Test(golden, forces_power_balance)
                 cr_assert(fabs(val(g, i, (int)j)) <= 1e-9, "%s: %s = %g at data row %zu", g->csv,
                           g->t.names[j], val(g, i, (int)j), i + 1);
         }
+    }
+    free_all(gs, n);
+}
+
+/* mechanisms/five-bar.yaml, from its text: O = (0, 0), E = (50, 0) mm;
+ * cranks OA = EB = 25 mm, arms AP = BP = 60 mm, P on the clockwise side of
+ * A -> B; crank1 = 90 deg + 360 deg/s t, crank2 = 60 deg + 20 deg sin(2 pi t
+ * / 1 s), t from 0 to 1 s in 100 steps (drivers as laws of time). P by the
+ * intersection of the circles (A, 60 mm) and (B, 60 mm); its velocity and
+ * acceleration from the time derivatives of |P - A|^2 = |P - B|^2 = l^2,
+ * with the laws' rates written out here. */
+Test(golden, five_bar_matches_closed_form)
+{
+    int n;
+    golden *gs = load_all(&n);
+    int gi = closed_form_file(gs, n, "five-bar");
+    for (int f = gi; f >= 0 && f == gi; f++) {
+        golden *g = &gs[f];
+        worst w;
+        worst_init(&w, "five-bar closed form", TOL_CLOSED);
+        const double r = 0.025, l = 0.060, ex = 0.050, tw = 2 * PI, h = 20 * DEG;
+        cr_assert_eq(g->t.nrows, (size_t)101, "%s: %zu rows", g->csv, g->t.nrows);
+        static const char *const pc[] = {"P.x", "P.y", "P.vx", "P.vy", "P.ax", "P.ay"};
+        for (size_t i = 0; i < g->t.nrows; i++) {
+            double t = (double)i / 100.0;
+            check_value(g, &w, "t", i, t, qval(g, i), 1.0, 1e-15);
+            double t1 = 90 * DEG + tw * t, w1 = tw, a1 = 0.0;
+            double t2 = 60 * DEG + h * sin(tw * t), w2 = h * tw * cos(tw * t),
+                   a2 = -h * tw * tw * sin(tw * t);
+            double A[2] = {r * cos(t1), r * sin(t1)}, B[2] = {ex + r * cos(t2), r * sin(t2)};
+            double Av[2] = {-r * sin(t1) * w1, r * cos(t1) * w1};
+            double Bv[2] = {-r * sin(t2) * w2, r * cos(t2) * w2};
+            double Aa[2] = {-r * (cos(t1) * w1 * w1 + sin(t1) * a1),
+                            -r * (sin(t1) * w1 * w1 - cos(t1) * a1)};
+            double Ba[2] = {-r * (cos(t2) * w2 * w2 + sin(t2) * a2),
+                            -r * (sin(t2) * w2 * w2 - cos(t2) * a2)};
+            double dx = B[0] - A[0], dy = B[1] - A[1], d = hypot(dx, dy);
+            double along = d / 2, hh = sqrt(l * l - along * along);  /* equal arms */
+            double P[2] = {A[0] + along * dx / d - hh * dy / d, A[1] + along * dy / d + hh * dx / d};
+            double u[2] = {P[0] - A[0], P[1] - A[1]}, v[2] = {P[0] - B[0], P[1] - B[1]};
+            double det = u[0] * v[1] - u[1] * v[0];
+            double r1 = u[0] * Av[0] + u[1] * Av[1], r2 = v[0] * Bv[0] + v[1] * Bv[1];
+            double Pv[2] = {(r1 * v[1] - u[1] * r2) / det, (u[0] * r2 - r1 * v[0]) / det};
+            double du[2] = {Pv[0] - Av[0], Pv[1] - Av[1]}, dv[2] = {Pv[0] - Bv[0], Pv[1] - Bv[1]};
+            double s1 = u[0] * Aa[0] + u[1] * Aa[1] - (du[0] * du[0] + du[1] * du[1]);
+            double s2 = v[0] * Ba[0] + v[1] * Ba[1] - (dv[0] * dv[0] + dv[1] * dv[1]);
+            double Pa[2] = {(s1 * v[1] - u[1] * s2) / det, (u[0] * s2 - s1 * v[0]) / det};
+            double want[6] = {P[0], P[1], Pv[0], Pv[1], Pa[0], Pa[1]};
+            for (int k = 0; k < 6; k++) {
+                int c = col(g, pc[k]);
+                cr_assert_geq(c, 0, "%s: no column %s", g->csv, pc[k]);
+                double scale = k < 2 ? l : k < 4 ? 1.0 : 10.0;  /* m, m/s, m/s^2 */
+                check_value(g, &w, pc[k], i, want[k], val(g, i, c), scale, TOL_CLOSED);
+            }
+        }
+        worst_report(g, &w);
     }
     free_all(gs, n);
 }
