@@ -63,4 +63,30 @@ printf 'name: x\nground: {O: [0, 0]}\nlinks:\n  crank: {points: {O: [0, 0], A: [
 run "drivers without sweep" 2 "$MECH" check "$tmp/nosweep.yaml" &&
     has_line "$tmp/err" "nosweep.yaml:5:10: error: 'drivers' needs 'sweep" "drivers without sweep: message"
 
+# two drivers on a gear train: a planetary differential, sun and ring driven
+# by laws of time (tests/truths/differential.yaml); the laws differentiated
+# by hand and Willis' formula for the carrier and the planet, every row
+D=tests/truths/differential.yaml
+if run "solve the differential" 0 "$MECH" solve "$D" -o "$tmp/d.csv"; then
+    worst=$(awk -F, 'NR > 1 {
+        t = $1
+        s[0] = 300 * t + 0.5 * sin(20 * t); s[1] = 300 + 10 * cos(20 * t); s[2] = -200 * sin(20 * t)
+        r[0] = -50 * t + 2000 * t * t;      r[1] = -50 + 4000 * t;         r[2] = 4000
+        for (k = 0; k < 3; k++) {
+            c = (20 * s[k] + 100 * r[k]) / 120       # Willis, z_s = 20, z_r = 100
+            p = c - 20 / 40 * (s[k] - c)             # the planet, z_p = 40, relative to c
+            split("" , want); want[2 + k] = s[k]; want[5 + k] = r[k]; want[8 + k] = c; want[11 + k] = p
+            for (col in want) {
+                e = ($col - want[col]) / (abs(want[col]) > 1 ? abs(want[col]) : 1)
+                if (abs(e) > worst) worst = abs(e)
+            }
+        }
+    }
+    function abs(x) { return x < 0 ? -x : x }
+    END { printf "%.3g\n", worst }' "$tmp/d.csv")
+    awk -v w="$worst" 'BEGIN { exit !(w < 1e-12) }' && pass ||
+        fail "differential: worst relative error $worst against Willis and the laws"
+    [ "$(wc -l <"$tmp/d.csv")" -eq 402 ] && pass || fail "differential: $(wc -l <"$tmp/d.csv") lines"
+fi
+
 summary
