@@ -200,7 +200,7 @@ bench:
 	    build/bench/bench-solve build/bench/bench-hand build/bench/bench-accuracy build/bench/bench-scale \
 	    build/bench/mech build/bench/bench-alloc build/bench/bench-sweep
 	{ build/bench/bench-eval mechanisms/*.yaml && \
-	  build/bench/bench-solve mechanisms/*.yaml && \
+	  build/bench/bench-solve mechanisms/*.yaml bench/files/*.yaml && \
 	  build/bench/bench-hand mechanisms && \
 	  MECH=build/bench/mech BUILD=build/bench sh bench/bench_codegen.sh && \
 	  sh bench/bench_ratio.sh build/bench/bench-hand && \
