@@ -158,6 +158,51 @@ run "bad --friction" 2 "$MECH" codegen mechanisms/conveyor.yaml -o "$tmp/x.c" --
     ! grep -q 'NF_NF\|kinetostatics' "$tmp/nf.c" && pass || fail "--no-forces: forces generated"
 rm -f "$tmp/x.c"
 
+# ---- mech solve --jit ----
+# the generated code compiled (through a compiler that logs its runs) and
+# loaded: the same CSV as the interpreter's, byte for byte, and no note
+mkdir -p "$tmp/jt"
+printf '#!/bin/sh\necho run >>"%s/cc.log"\nexec %s "$@"\n' "$tmp" "$CC" >"$tmp/cc-log"
+chmod +x "$tmp/cc-log"
+for file in mechanisms/*.yaml; do
+    base=$(basename "$file" .yaml)
+    for opts in "" --forces; do
+        rm -f "$tmp/cc.log"
+        "$MECH" solve "$file" -q $opts -o "$tmp/interp.csv" 2>/dev/null
+        if TMPDIR=$tmp/jt CC=$tmp/cc-log "$MECH" solve "$file" -q --jit $opts -o "$tmp/jit.csv" \
+                2>"$tmp/jit.err" && cmp -s "$tmp/interp.csv" "$tmp/jit.csv" && [ -s "$tmp/cc.log" ] &&
+                ! grep -q 'note: --jit' "$tmp/jit.err"; then
+            pass
+        else
+            fail "solve --jit $opts $base: not the interpreter's table, or not compiled: $(head -n 2 "$tmp/jit.err")"
+        fi
+    done
+done
+[ -z "$(ls "$tmp/jt")" ] && pass || fail "solve --jit left files in TMPDIR: $(ls "$tmp/jt")"
+# where it cannot: the interpreter, the same table and exit status, a note
+# jit_fallback LABEL WHY FILE [OPTIONS]
+jit_fallback() {
+    label=$1 why=$2 file=$3
+    shift 3
+    "$MECH" solve "$file" -q "$@" -o "$tmp/interp.csv" 2>/dev/null
+    want=$?
+    TMPDIR=$tmp/jt "$MECH" solve "$file" -q --jit "$@" -o "$tmp/jit.csv" 2>"$tmp/jit.err"
+    got=$?
+    if [ "$got" = "$want" ] && cmp -s "$tmp/interp.csv" "$tmp/jit.csv" &&
+            grep -q "note: --jit.*$why" "$tmp/jit.err"; then
+        pass
+    else
+        fail "solve --jit, $label: exit $got (interpreter $want), or another table, or no note '$why': $(head -n 1 "$tmp/jit.err")"
+    fi
+}
+CC=false jit_fallback "compiler fails" "no C compiler ran" mechanisms/fourbar.yaml
+CC=$tmp/no-such-cc jit_fallback "no compiler" "no C compiler ran" mechanisms/fourbar.yaml
+jit_fallback "step halving" "another step than the interpreter" tests/truths/fourbar-coarse.yaml
+jit_fallback "a gap" "found no assembly at row 111" tests/hard/non-grashof-crank.yaml
+jit_fallback "--tol" "does not follow --tol" mechanisms/fourbar.yaml --tol 1e-13
+jit_fallback "--diagnostics" "does not follow --diagnostics" mechanisms/fourbar.yaml --diagnostics
+jit_fallback "redundant constraints" "redundant constraints" tests/hard/redundant-parallelogram.yaml
+
 # ---- status codes: one position from the file's guesses, or given ones ----
 # at: FILE Q [X...]: the driver's first line for that position
 at() {
