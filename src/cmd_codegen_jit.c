@@ -237,6 +237,7 @@ static int jit_sweep(const jit *j, const mech_model *m, const double *q, int nq,
             return snprintf(note, size, "column %d is %s, mech solve's %s", c + 1, names[c],
                             t->columns[c].name), -1;
     void *s = calloc(1, j->state_size());
+    free(t->values);  /* the header's room for no rows */
     t->values = xcalloc((size_t)nq * (size_t)nout + 1, sizeof *t->values);
     if (!s || !t->values) {
         free(s);

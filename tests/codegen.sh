@@ -248,6 +248,13 @@ for p in cg block linear newton; do
         fail "--prefix $p: $(cat "$tmp/err" "$tmp/cc" | head -n 2)"
 done
 
+# with forces: prefixes that meet the force code's own names
+for p in force friction kinetostatics smooth fv; do
+    "$MECH" codegen mechanisms/conveyor.yaml --friction both -o "$tmp/$p.c" --prefix $p 2>"$tmp/err" &&
+        $CC $CFLAGS_GEN -c -o "$tmp/$p.o" "$tmp/$p.c" 2>"$tmp/cc" && pass ||
+        fail "--prefix $p with forces: $(cat "$tmp/err" "$tmp/cc" | head -n 2)"
+done
+
 # a mechanism's name that would end a C comment early
 sed 's|^name: .*|name: "ends a comment */ early"|' mechanisms/fourbar.yaml >"$tmp/comment.yaml"
 build "$tmp/comment" "$tmp/comment.yaml"
