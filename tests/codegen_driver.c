@@ -25,7 +25,7 @@
 
 #include "gen.h"
 
-enum { MAX_COLS = 512, MAX_ROWS = 200000, LINE = 1 << 16 };
+enum { MAX_COLS = 4096, MAX_ROWS = 200000, LINE = 1 << 18 };
 
 static char line[LINE];
 static int col_of[MAX_COLS];  /* REF column -> generated column, or -1 */
