@@ -428,10 +428,9 @@ static void emit_known(const codegen *g, FILE *f)
 static void emit_power(const codegen *g, FILE *f)
 {
     const mech_model *m = g->m;
-    char gx[40], gy[40], lref[40];
+    char gx[40], gy[40];
     num(gx, sizeof gx, m->gravity[0]);
     num(gy, sizeof gy, m->gravity[1]);
-    num(lref, sizeof lref, g->sp.lref);
     fprintf(f, "/* P_driver + P_loads + P_gravity - P_friction - dT/dt relative to the sum of\n"
                " * the terms' magnitudes (src/forces.c power_residual) */\n"
                "static double force_power(cg_state *s, const cg_frame *F, double qd, double drive,\n"
@@ -480,7 +479,6 @@ static void emit_power(const codegen *g, FILE *f)
                     m->springs[i].kind == MECH_SPRING_TORSION ? "turning" : "linear");
         fprintf(f, "        ext += total;\n    }\n");
     }
-    (void)lref;
     fprintf(f, "    double r = pd + ext - pfric - kin;\n"
                "    return scale > 0.0 ? r / scale : 0.0;\n}\n\n");
 }
