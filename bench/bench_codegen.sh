@@ -3,71 +3,79 @@
 # solvers written by hand for one mechanism (bench/bench_hand.c) and the
 # interpreter, in instructions per driver step counted by callgrind (no
 # noise), and the generated code's time per step. Positions, velocities and
-# accelerations of the same outputs, the file's 361 steps, tolerance 1e-12.
+# accelerations of the same outputs, tolerance 1e-12; the last row adds the
+# conveyor's joint reactions and driver torque (friction off on all three
+# sides: bench-hand's force solver has no friction).
 #
-#   hand: bench-hand under callgrind, one profile per table row
-#         (--dump-after=row): the row's instructions less the interpreter's
-#         (mech_solve, mech_table_free), over its 31 sweeps
-#   interp: mech_solve's instructions in the same profile, per step (set-up
-#         included: the analysis is built by each call)
-#   gen:  bench/bench_codegen.c under callgrind, one sweep (bench_sweep)
+# Each count is a sweep of 3600 steps over the file's range minus one of
+# 360, over 3240 (set-up excluded, as bench/bench_ratio.sh):
+#   hand:   bench-hand --count NAME hand N [forces], inside hand_sweep
+#           (the Newton solvers written by hand; the four-bar's too)
+#   interp: bench-hand --count NAME interp N [forces], inside mech_solve
+#   gen:    bench/bench_codegen.c --once N, inside bench_sweep (predictor,
+#           Newton, rates, the output columns and, with forces, the
+#           kinetostatics and the power balance)
 # Target (issue 21): gen / hand <= 1.2. Not a test: prints a table.
 # Run from the repository root after building BUILD/mech and BUILD/bench-hand:
+#   make BUILD=build/bench OPT='-O2 -DNDEBUG' build/bench/bench-hand build/bench/mech
 #   MECH=build/bench/mech BUILD=build/bench sh bench/bench_codegen.sh
 MECH=${MECH:-build/bench/mech}
 BUILD=${BUILD:-build/bench}
+HAND=${HAND:-$BUILD/bench-hand}
 CC=${CC:-cc}
 out=$BUILD/codegen
 mkdir -p "$out" || exit 2
-reps=31
-steps=361
 
 echo "generated code (mech codegen) against the hand-written solvers: instructions per"
-echo "driver step (callgrind), positions + velocities + accelerations, tol 1e-12;"
-echo "ratio = generated / hand-written (target <= 1.2); us/step: the generated code's"
-echo "median (and min) of 31 sweeps"
-if ! command -v valgrind >/dev/null; then
-    echo "  (valgrind is not installed: no instruction counts)"
-else
-    rm -f "$out"/hand.out*
-    valgrind --tool=callgrind --toggle-collect=row --dump-after=row \
-        --callgrind-out-file="$out/hand.out" "$BUILD/bench-hand" mechanisms >/dev/null 2>"$out/hand.err" \
-        || { echo "bench-hand under callgrind failed: $(tail -n 3 "$out/hand.err")"; exit 1; }
-fi
+echo "driver step (callgrind, 3600 - 360 steps), positions + velocities + accelerations,"
+echo "tol 1e-12; ratio = generated / hand-written (target <= 1.2); us/step: the generated"
+echo "code's median (and min) of 31 sweeps of the file's steps"
+have_vg=1
+command -v valgrind >/dev/null || { have_vg=0; echo "  (valgrind is not installed: no instruction counts)"; }
 
-# inclusive FILE FUNCTION: the inclusive instruction count of FUNCTION in a profile
-inclusive() {
-    callgrind_annotate --inclusive=yes "$1" 2>/dev/null |
-        awk -v f="$2" '$3 ~ ("^[^ ]*:" f "$") { gsub(",", "", $1); s += $1 } END { print s + 0 }'
+# count FN PROGRAM ARGS...: instructions inside function FN
+count() {
+    fn=$1
+    shift
+    valgrind --tool=callgrind --toggle-collect="$fn" --callgrind-out-file=/dev/null "$@" \
+        2>&1 >/dev/null | awk '/Collected/ { print $4 }'
+}
+# per_step FN PROGRAM ARGS-BEFORE-N -- ARGS-AFTER-N: (count(3600) - count(360)) / 3240
+per_step() {
+    fn=$1 prog=$2 name=$3 side=$4 extra=$5
+    if [ "$prog" = hand ]; then
+        a=$(count "$fn" "$HAND" --count "$name" "$side" 3600 $extra)
+        b=$(count "$fn" "$HAND" --count "$name" "$side" 360 $extra)
+    else
+        a=$(count "$fn" "$prog" --once 3600)
+        b=$(count "$fn" "$prog" --once 360)
+    fi
+    [ -n "$a" ] && [ -n "$b" ] && echo $(( (a - b) / 3240 )) || echo "?"
 }
 
-printf "%-10s %9s %9s %9s %7s %9s %9s %8s\n" mechanism interp hand generated ratio "us/step" "(min)" "it/step"
-dump=1
-for m in fourbar stirling conveyor; do
-    gen=$out/$m
+printf "%-16s %9s %9s %9s %7s %9s %9s %8s\n" mechanism interp hand generated ratio "us/step" "(min)" "it/step"
+for row in fourbar stirling conveyor conveyor+forces; do
+    m=${row%+forces} forces= opts=--no-forces
+    [ "$row" != "$m" ] && forces=forces opts="--forces --friction off"
+    gen=$out/$row
     mkdir -p "$gen"
-    if ! "$MECH" codegen "mechanisms/$m.yaml" -o "$gen/gen.c" --header "$gen/gen.h" --prefix gen ||
+    if ! "$MECH" codegen "mechanisms/$m.yaml" -o "$gen/gen.c" --header "$gen/gen.h" --prefix gen $opts ||
        ! $CC -std=c11 -Wall -Wextra -Werror -O2 -DNDEBUG -I"$gen" -o "$gen/bench" "$gen/gen.c" bench/bench_codegen.c -lm; then
-        echo "$m: cannot generate or compile"
+        echo "$row: cannot generate or compile"
         exit 1
     fi
-    timing=$("$gen/bench") || { echo "$m: the generated solver failed"; exit 1; }
+    timing=$("$gen/bench") || { echo "$row: the generated solver failed"; exit 1; }
     set -- $timing  # steps S us/step M (min N) iterations/step I
     us=$4 usmin=${6%)} it=$8
     interp=- hand=- gen_i=- ratio=-
-    if command -v valgrind >/dev/null; then
-        prof=$out/hand.out.$dump
-        total=$(grep '^totals:' "$prof" | awk '{ print $2 }')
-        solve=$(inclusive "$prof" mech_solve)
-        tfree=$(inclusive "$prof" mech_table_free)
-        hand=$(( (total - solve - tfree) / (reps * steps) ))
-        interp=$(( solve / (reps * steps) ))
-        rm -f "$gen/cg.out"
-        valgrind --tool=callgrind --toggle-collect="bench_sweep*" --callgrind-out-file="$gen/cg.out" \
-            "$gen/bench" --once >/dev/null 2>&1
-        gen_i=$(( $(grep '^totals:' "$gen/cg.out" | awk '{ print $2 }') / steps ))
-        ratio=$(awk -v g="$gen_i" -v h="$hand" 'BEGIN { printf "%.2f", g / h }')
+    if [ $have_vg = 1 ]; then
+        hand=$(per_step hand_sweep hand "$m" hand "$forces")
+        interp=$(per_step mech_solve hand "$m" interp "$forces")
+        gen_i=$(per_step "bench_sweep*" "$gen/bench")
+        ratio=$(awk -v g="$gen_i" -v h="$hand" 'BEGIN { printf "%.2f", (h > 0 ? g / h : 0) }')
     fi
-    printf "%-10s %9s %9s %9s %7s %9s %9s %8s\n" "$m" "$interp" "$hand" "$gen_i" "$ratio" "$us" "$usmin" "$it"
-    dump=$((dump + 2))  # bench-hand: each mechanism at tol 1e-12, then 1e-15
+    printf "%-16s %9s %9s %9s %7s %9s %9s %8s\n" "$row" "$interp" "$hand" "$gen_i" "$ratio" "$us" "$usmin" "$it"
 done
+echo "(conveyor+forces: the hand-written solver assembles the 15 x 15 Newton-Euler system"
+echo "densely and factors it whole; the generated code fills the blocks of its block"
+echo "triangular form (1 + 2 + 12) and also outputs every reaction and the power balance)"

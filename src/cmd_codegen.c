@@ -12,6 +12,7 @@
 
 const char cmd_codegen_help[] =
     "usage: mech codegen FILE -o NAME.c [--header NAME.h] [--prefix P] [--all]\n"
+    "                    [--forces | --no-forces] [--friction on|off|both]\n"
     "\n"
     "Write a standalone C11 source that solves this one mechanism: straight-line\n"
     "code for its loop equations, Jacobian and rate right-hand sides, dense LU of\n"
@@ -19,7 +20,9 @@ const char cmd_codegen_help[] =
     "singularity and branch checks of 'mech solve'. It needs only the C library\n"
     "and libm, and allocates nothing. P_solve(&state, q, qd, qdd) solves one driver\n"
     "position from the guess in state.x into positions, velocities and\n"
-    "accelerations of the unknowns and the file's output columns (docs/codegen.md).\n"
+    "accelerations of the unknowns and the file's output columns (docs/codegen.md);\n"
+    "with forces, also the joint reactions, the driver torque or force, joint\n"
+    "friction, springs and the power balance, as 'mech solve --forces'.\n"
     "\n"
     "options:\n"
     "  -o, --output NAME.c  the source (written to a temporary file and renamed when\n"
@@ -31,6 +34,10 @@ const char cmd_codegen_help[] =
     "                       default: the base name of NAME.c (of FILE with -o -),\n"
     "                       letters, digits and '_' kept, other characters made '_'\n"
     "  --all                solve every unknown, also those no output needs\n"
+    "  --forces             also the kinetostatics (as 'outputs: {forces: true}');\n"
+    "                       --no-forces: kinematics only (default: as the file says)\n"
+    "  --friction MODE      on: the joints' friction coefficients (default); off:\n"
+    "                       frictionless; both: also the frictionless columns\n"
     "  -h, --help           show this help\n"
     "\n"
     "exit status: 0 written, 2 invalid file or usage (or a mechanism the generator\n"
@@ -51,7 +58,7 @@ static void prefix_from(const char *path, char *buf, size_t size)
 
 typedef struct codegen_args {
     const char *file, *out, *header, *prefix;
-    int all;
+    int all, forces, friction;
 } codegen_args;
 
 static int parse(int argc, char **argv, codegen_args *a)
@@ -67,6 +74,21 @@ static int parse(int argc, char **argv, codegen_args *a)
             a->prefix = argv[++i];
         else if (strcmp(arg, "--all") == 0)
             a->all = 1;
+        else if (strcmp(arg, "--forces") == 0)
+            a->forces = 1;
+        else if (strcmp(arg, "--no-forces") == 0)
+            a->forces = -1;
+        else if (strcmp(arg, "--friction") == 0 && has_value) {
+            const char *v = argv[++i];
+            if (strcmp(v, "on") == 0)
+                a->friction = MECH_FRICTION_ON;
+            else if (strcmp(v, "off") == 0)
+                a->friction = MECH_FRICTION_OFF;
+            else if (strcmp(v, "both") == 0)
+                a->friction = MECH_FRICTION_BOTH;
+            else
+                return cmd_usage_error("codegen", "--friction is on, off or both, not '%s'", v);
+        }
         else if (arg[0] == '-' && arg[1] != '\0')
             return cmd_usage_error("codegen", "unknown option or missing value '%s'", arg);
         else if (a->file)
@@ -129,7 +151,8 @@ int cmd_codegen(int argc, char **argv)
     code = cmd_load_checked(a.file, &m);
     if (code != MECH_EXIT_OK)
         return code;
-    codegen_options o = {a.prefix ? a.prefix : prefix, a.header ? include : NULL, a.all};
+    codegen_options o = {a.prefix ? a.prefix : prefix, a.header ? include : NULL, a.all,
+                         a.forces, a.friction};
     codegen g;
     mech_diag d;
     mech_diag_init(&d);

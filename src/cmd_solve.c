@@ -15,7 +15,7 @@ const char cmd_solve_help[] =
     "                  [--sensitivity NAME,...] [--tolerances]\n"
     "                  [--forces] [--friction on|off|both]\n"
     "                  [--diagnostics] [--stats] [--speed-fluctuation CS]\n"
-    "                  [--verbose] [--all]\n"
+    "                  [--verbose] [--all] [--jit]\n"
     "                  [--within-assembly] [--range assembly]\n"
     "\n"
     "Solve positions, velocities and accelerations of the mechanism at every\n"
@@ -71,6 +71,10 @@ const char cmd_solve_help[] =
     "                      coefficient of speed fluctuation CS (0 < CS < 1, e.g.\n"
     "                      0.02; w the driver speed) printed with the figures\n"
     "                      above; implies --forces\n"
+    "  --jit               solve with the code 'mech codegen' writes, compiled by\n"
+    "                      $CC (else cc) and loaded; the same table; without a\n"
+    "                      compiler, or where it cannot, the interpreter solves\n"
+    "                      (a note says why; docs/codegen.md)\n"
     "  --verbose           say which blocks of equations are solved and why\n"
     "  -q, --quiet         no progress report (long runs show one on standard error:\n"
     "                      a bar on a terminal, else a line every 5 s)\n"
@@ -100,6 +104,7 @@ typedef struct solve_args {
     int steps, stats, verbose, quiet;
     double speed_fluctuation;    /* --speed-fluctuation: Cs, 0 when not given */
     int within;                  /* --within-assembly or --range assembly */
+    int jit;                     /* --jit: the generated code, compiled and loaded */
     mech_outputs selected;       /* --outputs, parsed (opt.outputs points here) */
     mech_solve_options opt;
 } solve_args;
@@ -262,6 +267,8 @@ static int parse_args(int argc, char **argv, solve_args *a)
             a->within = 1;
         else if (strcmp(arg, "--forces") == 0)
             a->opt.forces = 1;
+        else if (strcmp(arg, "--jit") == 0)
+            a->jit = 1;
         else if (arg[0] == '-' && arg[1] != '\0')
             return cmd_usage_error("solve", "unknown option '%s'", arg);
         else if (a->file)
@@ -436,7 +443,7 @@ static int solve_loaded(solve_args *pa, mech_model *m)
     cmd_progress_init(&pr, "solve", "rows", a.quiet);
     a.opt.progress = cmd_progress_callback;
     a.opt.progress_ctx = &pr;
-    int rc = mech_solve(m, &a.opt, &t, &st, &d);
+    int rc = a.jit ? cmd_jit_solve(m, &a.opt, &t, &st, &d) : mech_solve(m, &a.opt, &t, &st, &d);
     cmd_progress_done(&pr);
     mech_diag_print(&d, stderr);
     mech_diag_free(&d);

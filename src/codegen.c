@@ -102,6 +102,9 @@ static int plan_solver(codegen *g, mech_diag *d)
     mech_solve_options_default(&o);
     o.all_blocks = g->opt.all_blocks;
     o.forces = -1;
+    g->want_forces = g->opt.forces > 0 || (g->opt.forces == 0 && g->m->outputs.forces);
+    if (g->want_forces)  /* reactions need every link's acceleration (sweep.c) */
+        o.all_blocks = 1;
     int rc = solver_plan_init(&g->sp, g->m, &o, d);
     if (rc != MECH_OK)
         return rc;
@@ -142,7 +145,10 @@ int codegen_init(codegen *g, const mech_model *m, const codegen_options *o, mech
     int rc = plan_solver(g, d);
     if (rc != MECH_OK)
         goto fail;
-    column_request rq = {&m->outputs, MECH_WANT_ALL, 0, 0, 0};
+    if (g->want_forces && (rc = codegen_forces_plan(g, d)) != MECH_OK)
+        goto fail;
+    int friction = !g->want_forces || !g->fp.friction ? 0 : g->fp.want_frictionless ? 2 : 1;
+    column_request rq = {&m->outputs, MECH_WANT_ALL, g->want_forces, friction, 0};
     rc = MECH_ENOMEM;
     if (columns_build(&g->cols, m, &rq) != MECH_OK || activate_points(g) < 0 ||
         make_identifiers(g) < 0)
@@ -169,6 +175,8 @@ void codegen_free(codegen *g)
     free(g->driver_only);
     free(g->unk_col);
     columns_free(&g->cols);
+    if (g->fp_ready)
+        forces_plan_free(&g->fp);
     blocklu_plan_free(&g->bp);
     solver_plan_free(&g->sp);
     memset(g, 0, sizeof *g);
@@ -218,6 +226,7 @@ static void emit_enums(const codegen *g, FILE *f)
                "singular: rcond < %g */\n"
                "    %s_BRANCH = 3       /* solved, but branch condition `branch` of the file "
                "does not hold */\n};\n\n", g->lower, P, P, P, sp->opt.min_rcond, P);
+    codegen_forces_enums(g, f);
     fprintf(f, "/* The unknowns: indices into x, xd, xdd, xq, xqq (link angles in rad, "
                "slider\n * displacements in m). */\nenum {\n");
     for (int k = 0; k < sp->ns; k++) {
@@ -292,11 +301,12 @@ static void emit_state(const codegen *g, FILE *f)
             "    double xe[%d], f[%d], ft[%d], dx[%d], xt[%d], r[%d], y[%d], w[%d], cs[%d];\n"
             "    double colnorm[%d], hx[%d], hy[%d], hz[%d];\n"
             "    double keep[%d], Jv[%d], Ax[%d], lu[%d];\n"
-            "    int piv[%d], swap_parity;\n"
-            "} %s_state;\n\n",
+            "    int piv[%d], swap_parity;\n",
             g->lower, g->lower, g->lower, nx, g->upper, nx, nx, nx, nx, g->cols.ncols, g->upper,
             g->upper, g->lower, g->lower, g->lower, nx, nx, nx, nx, nx, nx, nx, nx, nx, nx, nx, nx, nx, nx, nx, nk,
-            nz, nz, nd, nx, g->lower);
+            nz, nz, nd, nx);
+    codegen_forces_state(g, f);
+    fprintf(f, "} %s_state;\n\n", g->lower);
 }
 
 static void emit_prototypes(const codegen *g, FILE *f)
@@ -505,6 +515,7 @@ static void emit_solve(const codegen *g, FILE *f)
             "    s->branch = kinematics(s, q, qd, qdd, s->first);\n"
             "    if (s->branch >= 0)\n        return CG_BRANCH;\n"
             "    s->first = 0;\n"
+            "%s"
             "    return CG_OK;\n}\n\n"
             "void %s_predict(%s_state *s, double q)\n{\n"
             "    if (s->nsolved == 0)\n        return;\n"
@@ -513,7 +524,8 @@ static void emit_solve(const codegen *g, FILE *f)
             "    for (int i = 0; i < NX; i++) {\n"
             "        double xqqq = prev ? (s->xqq[i] - s->xqq_prev[i]) / dq : 0.0;\n"
             "        s->x[i] = s->xc[i] + h * (s->xq[i] + h * (0.5 * s->xqq[i] + h * xqqq / 6.0));\n"
-            "    }\n}\n", p, p, p, p);
+            "    }\n}\n", p, p, g->want_forces ? "    if (s->force_status != 0)\n"
+                                             "        return s->force_status;\n" : "", p, p);
 }
 
 int codegen_emit_source(FILE *f, const void *ctx)
@@ -534,11 +546,14 @@ int codegen_emit_source(FILE *f, const void *ctx)
                "#define CG_OK %s_OK\n#define CG_NO_ASSEMBLY %s_NO_ASSEMBLY\n"
                "#define CG_SINGULAR %s_SINGULAR\n#define CG_BRANCH %s_BRANCH\n\n",
             g->lower, g->upper, g->upper, g->upper, g->upper);
+    if (g->want_forces)
+        fprintf(f, "#define CG_FORCE_SINGULAR %s_FORCE_SINGULAR\n"
+                   "#define CG_FRICTION_STUCK %s_FRICTION_STUCK\n\n", g->upper, g->upper);
     if (emit_pattern(g, f) < 0 || codegen_expr_emit(g, f) < 0)
         return -1;
     for (int i = 0; codegen_runtime[i]; i++)
         fprintf(f, "%s\n", codegen_runtime[i]);
-    if (codegen_kin_emit(g, f) < 0)
+    if (codegen_forces_emit(g, f) < 0 || codegen_kin_emit(g, f) < 0)
         return -1;
     emit_names(g, f);
     emit_init(g, f);

@@ -23,6 +23,8 @@ typedef struct codegen_options {
     const char *header;      /* the header's name as #included by the source, or NULL:
                                 the source declares everything itself */
     int all_blocks;          /* 1: solve every unknown, not only those the outputs need */
+    int forces;              /* 1: the kinetostatics too, -1: not, 0: as the file's outputs say */
+    int friction;            /* MECH_FRICTION_ON, _OFF or _BOTH (with forces) */
 } codegen_options;
 
 typedef struct codegen {
@@ -42,6 +44,10 @@ typedef struct codegen {
     int nkeep;
     int *driver_only;        /* [DAG nodes] 1: depends on the driver q alone, 0 not, -1 unknown */
     int *unk_col;            /* [n] solved column of each unknown of the system, -1: not solved */
+    /* forces (codegen_forces.c) */
+    int want_forces;         /* the joint reactions are generated too */
+    int fp_ready;            /* fp was initialised (to free) */
+    forces_plan fp;          /* the interpreter's force system: columns, pattern, its blocks */
 } codegen;
 
 /* Analyse m for code generation: MECH_OK, or MECH_EINPUT (redundant
@@ -67,6 +73,21 @@ int codegen_expr_emit(const codegen *g, FILE *f);
 int codegen_kin_emit(const codegen *g, FILE *f);
 /* codegen_runtime.c: the fixed solver text, one line each, NULL-terminated. */
 extern const char *const codegen_runtime[];
+
+/* ---- codegen_forces.c: the kinetostatics ---------------------------------- */
+
+/* The interpreter's force plan for g (g->want_forces); MECH_OK or an error in d. */
+int codegen_forces_plan(codegen *g, mech_diag *d);
+/* Header: the force enum (P_NF, the force statuses); the state's force fields. */
+void codegen_forces_enums(const codegen *g, FILE *f);
+void codegen_forces_state(const codegen *g, FILE *f);
+/* Source: the force tables and functions, then the fixed force solve; 0 or -1. */
+int codegen_forces_emit(const codegen *g, FILE *f);
+/* The statement that fills output column c from the forces; 0 when c is not
+ * a force column. */
+int codegen_forces_column(const codegen *g, FILE *f, int c);
+/* codegen_force_runtime.c: the fixed force solve text, NULL-terminated. */
+extern const char *const codegen_force_runtime[];
 
 /* "1.5", "(-2)", as a C double literal that reads back to v. */
 void codegen_number(char *buf, size_t size, double v);

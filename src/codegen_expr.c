@@ -332,8 +332,7 @@ static void emit_columns(const codegen *g, FILE *f)
             kin_var(g, g->sp.tree.slide_var[cd->obj], cd->comp, v, sizeof v);
             fprintf(f, "    s->out[%d] = %s;\n", c, v);
             break;
-        default:  /* codegen_init asks for kinematic columns only */
-            fprintf(f, "    s->out[%d] = NAN;\n", c);
+        default:  /* the forces' columns: after the branch conditions */
             break;
         }
     }
@@ -399,6 +398,13 @@ int codegen_kin_emit(const codegen *g, FILE *f)
     emit_columns(g, f);
     for (int b = 0; b < m->nbranches; b++)
         emit_branch(g, f, b);
+    if (g->want_forces) {  /* the kinetostatics (codegen_forces.c), then their columns */
+        fprintf(f, "    s->force_status = kinetostatics(s, F, qd);\n"
+                   "    if (s->force_status == 0) {\n");
+        for (int c = 0; c < g->cols.ncols; c++)
+            codegen_forces_column(g, f, c);
+        fprintf(f, "    }\n");
+    }
     fprintf(f, "    return -1;\n}\n\n");
     free(angle);
     return 0;

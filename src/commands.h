@@ -91,6 +91,10 @@ extern const char cmd_report_help[];
 int cmd_report(int argc, char **argv);
 extern const char cmd_codegen_help[];
 int cmd_codegen(int argc, char **argv);
+/* `mech solve --jit` (cmd_codegen_jit.c): mech_solve through the generated
+ * code, compiled and loaded; the interpreter, with a note, where it cannot. */
+int cmd_jit_solve(const mech_model *m, const mech_solve_options *o, mech_table *t,
+                  mech_solve_stats *st, mech_diag *d);
 /* `mech merge -o OUT SHARD...` (cmd_merge.c): shards of a sweep or batch. */
 extern const char cmd_merge_help[];
 int cmd_merge(int argc, char **argv);

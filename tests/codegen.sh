@@ -90,6 +90,119 @@ fi
     2>/dev/null && sed 's/again\.h/gen.h/' "$tmp/again.c" | cmp -s - "$tmp/stirling/gen.c" \
     && pass || fail "codegen of stirling.yaml twice: the sources differ"
 
+# ---- forces (docs/codegen.md "Forces") ----
+# forces NAME FILE [OPTIONS]: generate with OPTIONS (forces on), solve with
+# the same options, and require every column - the kinematics, each joint's
+# reaction, the driver's torque or force, the power balance, the friction
+# power and iterations, the springs - to agree within 1e-12 of its column's
+# largest magnitude over the whole sweep (today: bit for bit, worst 0)
+forces() {
+    fname=$1 ffile=$2
+    shift 2
+    fdir=$tmp/forces-$fname
+    build "$fdir" "$ffile" --forces "$@" || return
+    grep -q 'GEN_NF = ' "$fdir/gen.h" && pass || fail "$fname: no force system in gen.h"
+    if ! "$MECH" solve "$ffile" -q --forces "$@" -o "$fdir/ref.csv" 2>"$fdir/err"; then
+        fail "mech solve --forces $ffile $*: $(head -n 1 "$fdir/err")"
+        return
+    fi
+    head -n 1 "$fdir/ref.csv" | grep -q 'power\.residual' && pass || fail "$fname: no forces in the reference"
+    if "$fdir/drv" "$fdir/ref.csv" 1e-12 >"$fdir/out" 2>"$fdir/err"; then
+        pass
+        echo "  forces $fname: $(cat "$fdir/out")"
+    else
+        fail "forces $fname: the generated solver against mech solve --forces $*: $(cat "$fdir/out" "$fdir/err" | head -n 2)"
+    fi
+}
+# every shipped file with masses: the conveyor (pin friction on, off, and
+# both sets), the four-bar (a crank with a mass), the slider-crank with
+# springs and a damper; the Stirling engine has no masses (every reaction 0)
+forces conveyor mechanisms/conveyor.yaml
+forces conveyor-off mechanisms/conveyor.yaml --friction off
+forces conveyor-both mechanisms/conveyor.yaml --friction both
+forces fourbar mechanisms/fourbar.yaml
+forces springs mechanisms/spring-slider-crank.yaml --friction both
+forces stirling mechanisms/stirling.yaml
+# slider friction (locked and free sliders, a moving guide, a slider driver),
+# pin friction on both links of each pin, the frictionless set beside them
+for f in incline-block oscillating-cylinder-friction slider-crank-guide-friction \
+        slider-crank-pin-friction oscillating-cylinder-guide; do
+    forces "$f" "tests/truths/$f.yaml" --friction both
+done
+# a hand calculation: the block of tests/truths/incline-block.yaml (m = 2 kg,
+# guide at b = 30 deg, mu = 0.25) pushed at constant speed up the incline
+# needs F = m g (sin b + mu cos b) and bears N = m g cos b; let down at
+# constant speed, friction acts up the slope: F = m g (sin b - mu cos b)
+# (the smoothed sign of the speed is within 5e-13 of 1 at 0.4 m/s)
+for way in up down; do
+    speed=0.4
+    [ $way = down ] && speed=-0.4
+    sed "s|speed: 0.4 m/s|speed: $speed m/s|" tests/truths/incline-block.yaml >"$tmp/incline-$way.yaml"
+    build "$tmp/incline" "$tmp/incline-$way.yaml" >/dev/null &&
+        "$tmp/incline/drv" --at 0.3 >"$tmp/incline/at" 2>&1
+    awk -v way=$way '
+        $1 == "status" { st = $2 } $1 == "driver.force" { F = $2 } $1 == "x.N" { N = $2 }
+        END {
+            b = 30 * atan2(0, -1) / 180; m = 2; g = 9.81; mu = 0.25
+            Fw = m * g * (sin(b) + (way == "up" ? 1 : -1) * mu * cos(b)); Nw = m * g * cos(b)
+            dF = F - Fw; dN = N - Nw
+            if (st != 0 || dF > 1e-12 * m * g || -dF > 1e-12 * m * g || dN > 1e-12 * m * g || -dN > 1e-12 * m * g) {
+                printf "status %s, F %.17g (hand %.17g), N %.17g (hand %.17g)\n", st, F, Fw, N, Nw; exit 1
+            } }' "$tmp/incline/at" >"$tmp/incline/diff" && pass \
+        || fail "incline block pushed $way: $(cat "$tmp/incline/diff")"
+done
+run "bad --friction" 2 "$MECH" codegen mechanisms/conveyor.yaml -o "$tmp/x.c" --friction half &&
+    has_line "$tmp/err" "on, off or both" "bad --friction"
+# --no-forces: the conveyor's kinematics alone
+"$MECH" codegen mechanisms/conveyor.yaml --no-forces -o "$tmp/nf.c" --prefix nf 2>/dev/null &&
+    ! grep -q 'NF_NF\|kinetostatics' "$tmp/nf.c" && pass || fail "--no-forces: forces generated"
+rm -f "$tmp/x.c"
+
+# ---- mech solve --jit ----
+# the generated code compiled (through a compiler that logs its runs) and
+# loaded: the same CSV as the interpreter's, byte for byte, and no note
+mkdir -p "$tmp/jt"
+printf '#!/bin/sh\necho run >>"%s/cc.log"\nexec %s "$@"\n' "$tmp" "$CC" >"$tmp/cc-log"
+chmod +x "$tmp/cc-log"
+for file in mechanisms/*.yaml; do
+    base=$(basename "$file" .yaml)
+    for opts in "" --forces; do
+        rm -f "$tmp/cc.log"
+        "$MECH" solve "$file" -q $opts -o "$tmp/interp.csv" 2>/dev/null
+        if TMPDIR=$tmp/jt CC=$tmp/cc-log "$MECH" solve "$file" -q --jit $opts -o "$tmp/jit.csv" \
+                2>"$tmp/jit.err" && cmp -s "$tmp/interp.csv" "$tmp/jit.csv" && [ -s "$tmp/cc.log" ] &&
+                ! grep -q 'note: --jit' "$tmp/jit.err"; then
+            pass
+        else
+            fail "solve --jit $opts $base: not the interpreter's table, or not compiled: $(head -n 2 "$tmp/jit.err")"
+        fi
+    done
+done
+[ -z "$(ls "$tmp/jt")" ] && pass || fail "solve --jit left files in TMPDIR: $(ls "$tmp/jt")"
+# where it cannot: the interpreter, the same table and exit status, a note
+# jit_fallback LABEL WHY FILE [OPTIONS]
+jit_fallback() {
+    label=$1 why=$2 file=$3
+    shift 3
+    "$MECH" solve "$file" -q "$@" -o "$tmp/interp.csv" 2>/dev/null
+    want=$?
+    TMPDIR=$tmp/jt "$MECH" solve "$file" -q --jit "$@" -o "$tmp/jit.csv" 2>"$tmp/jit.err"
+    got=$?
+    if [ "$got" = "$want" ] && cmp -s "$tmp/interp.csv" "$tmp/jit.csv" &&
+            grep -q "note: --jit.*$why" "$tmp/jit.err"; then
+        pass
+    else
+        fail "solve --jit, $label: exit $got (interpreter $want), or another table, or no note '$why': $(head -n 1 "$tmp/jit.err")"
+    fi
+}
+CC=false jit_fallback "compiler fails" "no C compiler ran" mechanisms/fourbar.yaml
+CC=$tmp/no-such-cc jit_fallback "no compiler" "no C compiler ran" mechanisms/fourbar.yaml
+jit_fallback "step halving" "another step than the interpreter" tests/truths/fourbar-coarse.yaml
+jit_fallback "a gap" "found no assembly at row 111" tests/hard/non-grashof-crank.yaml
+jit_fallback "--tol" "does not follow --tol" mechanisms/fourbar.yaml --tol 1e-13
+jit_fallback "--diagnostics" "does not follow --diagnostics" mechanisms/fourbar.yaml --diagnostics
+jit_fallback "redundant constraints" "redundant constraints" tests/hard/redundant-parallelogram.yaml
+
 # ---- status codes: one position from the file's guesses, or given ones ----
 # at: FILE Q [X...]: the driver's first line for that position
 at() {
@@ -133,6 +246,13 @@ for p in cg block linear newton; do
     "$MECH" codegen mechanisms/stirling.yaml -o "$tmp/$p.c" --prefix $p 2>"$tmp/err" &&
         $CC $CFLAGS_GEN -c -o "$tmp/$p.o" "$tmp/$p.c" 2>"$tmp/cc" && pass ||
         fail "--prefix $p: $(cat "$tmp/err" "$tmp/cc" | head -n 2)"
+done
+
+# with forces: prefixes that meet the force code's own names
+for p in force friction kinetostatics smooth fv; do
+    "$MECH" codegen mechanisms/conveyor.yaml --friction both -o "$tmp/$p.c" --prefix $p 2>"$tmp/err" &&
+        $CC $CFLAGS_GEN -c -o "$tmp/$p.o" "$tmp/$p.c" 2>"$tmp/cc" && pass ||
+        fail "--prefix $p with forces: $(cat "$tmp/err" "$tmp/cc" | head -n 2)"
 done
 
 # a mechanism's name that would end a C comment early
