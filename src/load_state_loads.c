@@ -65,6 +65,21 @@ static size_t ident_len(const char *s)
     return n;
 }
 
+/* With laws of time (`sweep: {time}`, MECH_DRIVE_TIME) a load may read the
+ * time as `t`, as the drivers' laws do: the word `t` is then the time, never
+ * the tonne. Where the first standalone word `t` starts in s, or NULL. */
+static const char *time_word(const loader *ld, const char *s)
+{
+    if (!ld->m->has_driver || ld->m->driver.kind != MECH_DRIVE_TIME)
+        return NULL;
+    for (const char *c = s; *c; c++) {
+        int before = c > s && (isalnum((unsigned char)c[-1]) || c[-1] == '_' || c[-1] == '.');
+        if (*c == 't' && !before && !(isalnum((unsigned char)c[1]) || c[1] == '_'))
+            return c;
+    }
+    return NULL;
+}
+
 static const char *skip_space(const char *s)
 {
     while (*s == ' ' || *s == '\t')
@@ -226,6 +241,15 @@ static sval dotted(sparser *sp, const char *at, size_t n, const char *mem, size_
             return fail_val();
         }
         quantity q = dm->q;
+        if (m->driver.kind == MECH_DRIVE_TIME) {  /* the sweep variable is the time */
+            if (dm->kind != SLIN_DRIVER) {
+                sfail(sp, mem, "with laws of time the driver's value is the time t and has no "
+                               "'%.*s': read the driven links' or sliders' rates instead",
+                      (int)mlen, mem);
+                return fail_val();
+            }
+            q = Q_TIME;
+        }
         if (m->driver.kind == MECH_DRIVE_SLIDER)
             q = dm->kind == SLIN_DRIVER ? Q_LENGTH
                 : dm->kind == SLIN_DRIVER_SPEED ? Q_SPEED : Q_ACCELERATION;
@@ -410,12 +434,25 @@ static sval parse_number(sparser *sp)
         return (sval){constant(sp, v), NONE, 1};
     double scale;
     dim d;
-    const char *uend;
-    if (!unit_parse(u, &scale, &d, &uend)) {
+    const char *uend, *tw = time_word(sp->ld, u);
+    char unit[128];
+    if (tw) {  /* the unit ends before `t` and the operator in front of it */
+        size_t len = (size_t)(tw - u);
+        while (len > 0 && (u[len - 1] == ' ' || u[len - 1] == '\t' || u[len - 1] == '*' ||
+                           u[len - 1] == '/'))
+            len--;
+        if (len >= sizeof unit)
+            len = sizeof unit - 1;
+        memcpy(unit, u, len);
+        unit[len] = '\0';
+    }
+    if (tw && unit[0] == '\0')
+        return (sval){constant(sp, v), NONE, 1};  /* `2 * t`: a bare number */
+    if (!unit_parse(tw ? unit : u, &scale, &d, &uend)) {
         sfail(sp, u, "unknown unit '%.*s'", (int)ident_len(u), u);
         return fail_val();
     }
-    sp->p = uend;
+    sp->p = tw ? u + (uend - unit) : uend;
     return (sval){constant(sp, v * scale), d, 0};
 }
 
@@ -450,6 +487,10 @@ static sval parse_atom(sparser *sp)
         if (*after == '(') {
             sp->p = after + 1;
             return call(sp, at, n, at);
+        }
+        if (n == 1 && time_word(sp->ld, at) == at) {  /* the time of laws of time */
+            sp->uses_state = 1;
+            return input(sp, SLIN_DRIVER, 0, Q_TIME);
         }
         if (n == 2 && memcmp(at, "pi", 2) == 0)
             return (sval){constant(sp, PI), quantity_get(Q_ANGLE)->d, 0};
@@ -582,7 +623,8 @@ static int component(loader *ld, const ynode *n, quantity q, const char *what)
     char msg[256];
     size_t pos;
     double v;
-    if (quantity_eval(n->text, q, &ld->env, &v, msg, sizeof msg, &pos) == 0) {
+    if (!time_word(ld, n->text) &&
+        quantity_eval(n->text, q, &ld->env, &v, msg, sizeof msg, &pos) == 0) {
         int r = sl_const(s, v);
         if (r < 0)
             load_err(ld, n, "out of memory");
@@ -636,6 +678,8 @@ int load_state_wanted(loader *ld, const ynode *n)
         if (items[i]->kind != YNODE_SCALAR)
             return 0;
         expr_param val;
+        if (time_word(ld, items[i]->text))  /* the time of laws of time */
+            return 1;
         if (quantity_eval_param(items[i]->text, &ld->env, &val, msg, sizeof msg, &pos) != 0 &&
             !load_uses_bad_param(ld, items[i]->text))
             return 1;

@@ -89,4 +89,24 @@ if run "solve the differential" 0 "$MECH" solve "$D" -o "$tmp/d.csv"; then
     [ "$(wc -l <"$tmp/d.csv")" -eq 402 ] && pass || fail "differential: $(wc -l <"$tmp/d.csv") lines"
 fi
 
+# a load that reads the time t of laws of time (docs/format.md 10.2): a
+# torque T = 0.5 N*m/s * t on arm1; by virtual work the drivers' power
+# changes by -T * omega_arm1 against the same file without it, every row
+sed 's|^outputs:|loads:\n  - {torque: "0.5 N*m/s * t", link: arm1}\noutputs:|' "$F" >"$tmp/tload.yaml"
+if run "solve with a load of t" 0 "$MECH" solve "$tmp/tload.yaml" -o "$tmp/tl.csv" &&
+   run "solve without it" 0 "$MECH" solve "$F" -o "$tmp/t0.csv"; then
+    worst=$(paste -d, "$tmp/tl.csv" "$tmp/t0.csv" | awk -F, 'NR > 1 {
+        n = 49  # columns per file: t .. power.residual
+        dp = ($47 - $(n + 47)) * $21 + ($48 - $(n + 48)) * $30   # the drivers power, change
+        want = -0.5 * $1 * $24                                    # -T omega_arm1
+        e = dp - want; if (e < 0) e = -e
+        sc = want < 0 ? -want : want; if (sc < 1e-3) sc = 1e-3
+        if (e / sc > worst) worst = e / sc
+    } END { printf "%.3g\n", worst }')
+    awk -v w="$worst" 'BEGIN { exit !(w < 1e-9) }' && pass ||
+        fail "load of t: drivers' power change off by $worst (relative) from -T omega"
+fi
+run "a load of t with the driver's speed" 2 "$MECH" check "$(sed 's|0.5 N\*m/s \* t|1 N*m * driver.speed|' "$tmp/tload.yaml" >"$tmp/tsp.yaml"; echo "$tmp/tsp.yaml")" &&
+    has_line "$tmp/err" "the driver's value is the time t and has no 'speed'" "driver.speed with laws of time: message"
+
 summary
