@@ -226,47 +226,6 @@ static int ground_components(mech_system *s, const loop_term *t, double dx, doub
     return 1;
 }
 
-void sys_named_body(mech_system *s, const loop_term *t, ex *x, ex *y)
-{
-    expr_ctx *c = &s->ex;
-    const mech_link *l = &s->model->links[t->link];
-    double dx = l->points[t->p1].x - l->points[t->p0].x;
-    double dy = l->points[t->p1].y - l->points[t->p0].y;
-    double r = hypot(dx, dy), a = atan2(dy, dx);
-    int np = s->params->nparams;
-    if (t->link == 0 && ground_components(s, t, dx, dy, x, y))
-        return;
-    double *dr = xcalloc((size_t)np + 1, sizeof *dr), *da = xcalloc((size_t)np + 1, sizeof *da);
-    if (!dr || !da) {
-        free(dr);
-        free(da);
-        c->failed = 1;
-        *x = *y = c->zero;
-        return;
-    }
-    body_gradient(s, t, dx, dy, dr, da);
-    int r_varies = 0, a_varies = 0;
-    for (int k = 0; k < np; k++) {
-        r_varies |= dr[k] != 0.0;
-        a_varies |= da[k] != 0.0;
-    }
-    ex len = r_varies ? named_leaf(s, t, 0, r, dr) : expr_const(c, r);
-    ex ang;
-    if (a_varies) {
-        ang = expr_add(c, s->link_angle[t->link], named_leaf(s, t, 1, a, da));
-    } else {
-        if (a == PI_ || a == -PI_) {  /* as the numeric system: -r (cos, sin)(theta) */
-            len = expr_neg(c, len);
-            a = 0.0;
-        }
-        ang = expr_add(c, s->link_angle[t->link], expr_const(c, a));
-    }
-    free(dr);
-    free(da);
-    *x = expr_mul(c, len, expr_cos(c, ang));
-    *y = expr_mul(c, len, expr_sin(c, ang));
-}
-
 /* Parameters beyond this many are not named (one load of the file each);
  * nor are they when the file cannot be read again (a model from a string). */
 enum { MAX_NAMED_PARAMS = 200 };
@@ -321,9 +280,11 @@ static ex register_leaf(mech_system *s, const loop_term *t, int is_angle)
 
 /* As the numeric system's body vector r (cos, sin)(theta + a), with r
  * and a leaves when they depend on one of the parameters (a nonzero
- * derivative at the model's values; variant_regs.c checks every variant's
- * other numbers against these and re-analyses a variant where they moved). */
-void sys_register_body(mech_system *s, const loop_term *t, ex *x, ex *y)
+ * derivative at the model's values): named leaves (SYS_NAMED: the
+ * parameter or |AB|, <AB) or register leaves (SYS_REGISTERS: variant_regs.c
+ * checks every variant's other numbers against these and re-analyses a
+ * variant where they moved). */
+static void body_with_leaves(mech_system *s, const loop_term *t, int registers, ex *x, ex *y)
 {
     expr_ctx *c = &s->ex;
     const mech_link *l = &s->model->links[t->link];
@@ -331,6 +292,8 @@ void sys_register_body(mech_system *s, const loop_term *t, ex *x, ex *y)
     double dy = l->points[t->p1].y - l->points[t->p0].y;
     double r = hypot(dx, dy), a = atan2(dy, dx);
     int np = s->params->nparams;
+    if (!registers && t->link == 0 && ground_components(s, t, dx, dy, x, y))
+        return;
     double *dr = xcalloc((size_t)np + 1, sizeof *dr), *da = xcalloc((size_t)np + 1, sizeof *da);
     if (!dr || !da) {
         free(dr);
@@ -345,12 +308,12 @@ void sys_register_body(mech_system *s, const loop_term *t, ex *x, ex *y)
         r_varies |= dr[k] != 0.0;
         a_varies |= da[k] != 0.0;
     }
-    free(dr);
-    free(da);
-    ex len = r_varies ? register_leaf(s, t, 0) : expr_const(c, r);
+    ex len = !r_varies ? expr_const(c, r)
+             : registers ? register_leaf(s, t, 0) : named_leaf(s, t, 0, r, dr);
     ex ang;
     if (a_varies) {
-        ang = expr_add(c, s->link_angle[t->link], register_leaf(s, t, 1));
+        ang = expr_add(c, s->link_angle[t->link],
+                       registers ? register_leaf(s, t, 1) : named_leaf(s, t, 1, a, da));
     } else {
         if (a == PI_ || a == -PI_) {  /* as the numeric system: -r (cos, sin)(theta) */
             len = expr_neg(c, len);
@@ -358,6 +321,18 @@ void sys_register_body(mech_system *s, const loop_term *t, ex *x, ex *y)
         }
         ang = expr_add(c, s->link_angle[t->link], expr_const(c, a));
     }
+    free(dr);
+    free(da);
     *x = expr_mul(c, len, expr_cos(c, ang));
     *y = expr_mul(c, len, expr_sin(c, ang));
+}
+
+void sys_named_body(mech_system *s, const loop_term *t, ex *x, ex *y)
+{
+    body_with_leaves(s, t, 0, x, y);
+}
+
+void sys_register_body(mech_system *s, const loop_term *t, ex *x, ex *y)
+{
+    body_with_leaves(s, t, 1, x, y);
 }
