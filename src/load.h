@@ -103,6 +103,13 @@ int load_find_point_or_report(loader *ld, const ynode *n, const char *what);
 int load_slider_by_name(loader *ld, const ynode *n, const char *what);
 void load_carriers_of(const loader *ld, int id, int *first, int *end);
 int load_point_in_link(const loader *ld, int li, int id);
+/* The links that may carry end k (point id, written pnode) of a two-point
+ * element (a spring, a load along a line): links[k] when the file gives
+ * `links` (it must carry the point; `what` names it in the message), else
+ * every carrier of the point, at most max, into cand. Their count, or -1
+ * when reported. */
+int load_end_candidates(loader *ld, const ynode *links, int k, int id, const ynode *pnode,
+                        const char *what, int *cand, int max);
 
 /* ---- load_links.c: units, parameters, ground, links, their points and mass. */
 void load_units(loader *ld, const ynode *map);

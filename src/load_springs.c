@@ -17,28 +17,6 @@
 
 enum { MAX_SPRINGS = 100000 };
 
-/* The link carrying end k of a linear spring: links[k] when given (it must
- * carry the point), else every carrier is a candidate (cand[], n). */
-static int end_candidates(loader *ld, const ynode *links, int k, int id, const ynode *pnode,
-                          int *cand, int max)
-{
-    if (links) {
-        int li = load_find_link_or_report(ld, links->items[k], "spring link");
-        if (li < 0)
-            return -1;
-        if (load_point_in_link(ld, li, id) < 0)
-            return load_err(ld, pnode, "link '%s' has no point '%s'", ld->m->links[li].name,
-                            pnode->text), -1;
-        cand[0] = li;
-        return 1;
-    }
-    int first, end, n = 0;
-    load_carriers_of(ld, id, &first, &end);
-    for (int c = first; c < end && n < max; c++)
-        cand[n++] = ld->carrier_link[c];
-    return n;
-}
-
 /* The two ends of a linear spring: links and points. A point on several
  * links (a pin) attaches to the first carrier in file order that differs
  * from the other end's link. */
@@ -56,7 +34,7 @@ static int spring_ends(loader *ld, const ynode *map, mech_spring *s)
     int id[2], cand[2][8], n[2];
     for (int k = 0; k < 2; k++) {
         id[k] = load_find_point_or_report(ld, btw->items[k], "spring end");
-        n[k] = id[k] < 0 ? -1 : end_candidates(ld, links, k, id[k], btw->items[k], cand[k], 8);
+        n[k] = id[k] < 0 ? -1 : load_end_candidates(ld, links, k, id[k], btw->items[k], "spring link", cand[k], 8);
     }
     if (n[0] <= 0 || n[1] <= 0)
         return 0;

@@ -709,28 +709,6 @@ void load_state_load(loader *ld, const ynode *map, const ynode *value, int link,
 
 /* ---- a force along a line ------------------------------------------ */
 
-/* The carriers of end k: links[k] when given (it must carry the point),
- * else every link with the point, in file order. */
-static int line_end_links(loader *ld, const ynode *links, int k, int id, const ynode *pnode,
-                          int *cand, int max)
-{
-    if (links) {
-        int li = load_find_link_or_report(ld, links->items[k], "loaded link");
-        if (li < 0)
-            return -1;
-        if (load_point_in_link(ld, li, id) < 0)
-            return load_err(ld, pnode, "link '%s' has no point '%s'", ld->m->links[li].name,
-                            pnode->text), -1;
-        cand[0] = li;
-        return 1;
-    }
-    int first, end, n = 0;
-    load_carriers_of(ld, id, &first, &end);
-    for (int c = first; c < end && n < max; c++)
-        cand[n++] = ld->carrier_link[c];
-    return n;
-}
-
 void load_state_line(loader *ld, const ynode *map)
 {
     static const char *const not_here[] = {"torque", "distributed", "link", "at", "from", "to",
@@ -759,7 +737,7 @@ void load_state_line(loader *ld, const ynode *map)
     int id[2], cand[2][8], n[2];
     for (int k = 0; k < 2; k++) {
         id[k] = load_find_point_or_report(ld, btw->items[k], "load end");
-        n[k] = id[k] < 0 ? -1 : line_end_links(ld, links, k, id[k], btw->items[k], cand[k], 8);
+        n[k] = id[k] < 0 ? -1 : load_end_candidates(ld, links, k, id[k], btw->items[k], "loaded link", cand[k], 8);
     }
     int reg = component(ld, f, Q_FORCE, "force");
     if (n[0] <= 0 || n[1] <= 0 || reg < 0)

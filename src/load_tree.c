@@ -408,3 +408,22 @@ int load_slider_by_name(loader *ld, const ynode *n, const char *what)
     return -1;
 }
 
+int load_end_candidates(loader *ld, const ynode *links, int k, int id, const ynode *pnode,
+                        const char *what, int *cand, int max)
+{
+    if (links) {
+        int li = load_find_link_or_report(ld, links->items[k], what);
+        if (li < 0)
+            return -1;
+        if (load_point_in_link(ld, li, id) < 0)
+            return load_err(ld, pnode, "link '%s' has no point '%s'", ld->m->links[li].name,
+                            pnode->text), -1;
+        cand[0] = li;
+        return 1;
+    }
+    int first, end, n = 0;
+    load_carriers_of(ld, id, &first, &end);
+    for (int c = first; c < end && n < max; c++)
+        cand[n++] = ld->carrier_link[c];
+    return n;
+}

@@ -15,11 +15,24 @@
 
 static const double PI = 3.14159265358979323846;
 
-static void end_motion(const solver *sv, int l, int i, double *p, double *v)
+void springs_point_motion(const solver *sv, int l, int i, double p[2], double v[2])
 {
     const mech_point *pt = &sv->p->m->links[l].points[i];
     double r[2] = {pt->x, pt->y}, a[2];
     kin_on_link(&sv->ks, l, r, p, v, a);
+}
+
+void springs_line(const solver *sv, const int link[2], const int point[2], double p[2][2],
+                  double v[2][2], double u[2], double *length, double *rate)
+{
+    springs_point_motion(sv, link[0], point[0], p[0], v[0]);
+    springs_point_motion(sv, link[1], point[1], p[1], v[1]);
+    double d[2] = {p[1][0] - p[0][0], p[1][1] - p[0][1]};
+    *length = hypot(d[0], d[1]);
+    /* coincident ends: no direction; the force is then taken along x */
+    u[0] = *length > 0.0 ? d[0] / *length : 1.0;
+    u[1] = *length > 0.0 ? d[1] / *length : 0.0;
+    *rate = u[0] * (v[1][0] - v[0][0]) + u[1] * (v[1][1] - v[0][1]);
 }
 
 void springs_eval(const mech_spring *s, const solver *sv, spring_state *st)
@@ -32,21 +45,12 @@ void springs_eval(const mech_spring *s, const solver *sv, spring_state *st)
         st->force = s->preload + s->stiffness * dev + s->damping * st->rate;
         return;
     }
-    end_motion(sv, s->link[0], s->point[0], st->p[0], st->v[0]);
-    end_motion(sv, s->link[1], s->point[1], st->p[1], st->v[1]);
-    double d[2] = {st->p[1][0] - st->p[0][0], st->p[1][1] - st->p[0][1]};
-    st->length = hypot(d[0], d[1]);
-    /* coincident ends: no direction; the force is then taken along x */
-    st->u[0] = st->length > 0.0 ? d[0] / st->length : 1.0;
-    st->u[1] = st->length > 0.0 ? d[1] / st->length : 0.0;
-    st->rate = st->u[0] * (st->v[1][0] - st->v[0][0]) + st->u[1] * (st->v[1][1] - st->v[0][1]);
+    springs_line(sv, s->link, s->point, st->p, st->v, st->u, &st->length, &st->rate);
     st->force = s->preload + s->stiffness * (st->length - s->free) + s->damping * st->rate;
 }
 
-/* A known load (force f at p, moment t) on link l, moved to the right-hand
- * side of its three rows. */
-static void add_load(double *rhs, const double *g, int l, const double *p, const double *f,
-                     double t)
+void springs_add_known_load(double *rhs, const double *g, int l, const double *p,
+                            const double *f, double t)
 {
     if (l == 0)
         return;
@@ -65,14 +69,14 @@ void springs_add_loads(const mech_model *m, const solver *sv, const double *g, d
         spring_state st;
         springs_eval(s, sv, &st);
         if (s->kind == MECH_SPRING_TORSION) {
-            add_load(rhs, g, s->link[0], none, none, -st.force);
-            add_load(rhs, g, s->link[1], none, none, st.force);
+            springs_add_known_load(rhs, g, s->link[0], none, none, -st.force);
+            springs_add_known_load(rhs, g, s->link[1], none, none, st.force);
             continue;
         }
         double f[2] = {st.force * st.u[0], st.force * st.u[1]};  /* on end 0, toward end 1 */
         double fb[2] = {-f[0], -f[1]};
-        add_load(rhs, g, s->link[0], st.p[0], f, 0.0);
-        add_load(rhs, g, s->link[1], st.p[1], fb, 0.0);
+        springs_add_known_load(rhs, g, s->link[0], st.p[0], f, 0.0);
+        springs_add_known_load(rhs, g, s->link[1], st.p[1], fb, 0.0);
     }
 }
 

@@ -18,6 +18,19 @@ typedef struct spring_state {
 
 void springs_eval(const mech_spring *s, const solver *sv, spring_state *st);
 
+/* What springs and the loads along a line (state_loads.c) share: point i of
+ * link l at the published position (p, v: ground frame); the line from
+ * point[0] of link[0] to point[1] of link[1] (ends p, v, unit vector u from
+ * end 0 to end 1, along x when they coincide, length and its rate); a known
+ * load (force f at p, moment t) on link l moved to the right-hand side of
+ * its three Newton-Euler rows (centre g[2 l], g[2 l + 1]; nothing for the
+ * ground). */
+void springs_point_motion(const solver *sv, int l, int i, double p[2], double v[2]);
+void springs_line(const solver *sv, const int link[2], const int point[2], double p[2][2],
+                  double v[2][2], double u[2], double *length, double *rate);
+void springs_add_known_load(double *rhs, const double *g, int l, const double *p,
+                            const double *f, double t);
+
 /* Move every spring's loads on the moving links to the right-hand side of
  * the Newton-Euler rows (3 per moving link: x, y, moment about the centre
  * g[2 l], g[2 l + 1]). */

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "springs.h"
 #include "state_loads.h"
 
 state_loads *state_loads_new(void) { return xcalloc(1, sizeof(state_loads)); }
@@ -182,38 +183,11 @@ void state_loads_eval(const state_loads *s, const solver *sv, double *reg)
     }
 }
 
-static void point_motion(const solver *sv, int l, int i, double *p, double *v);
-
 void state_loads_line(const sl_load *l, const solver *sv, double p[2][2], double v[2][2],
                       double u[2], double *length, double *rate)
 {
-    point_motion(sv, l->link, l->point, p[0], v[0]);
-    point_motion(sv, l->link2, l->point2, p[1], v[1]);
-    double d[2] = {p[1][0] - p[0][0], p[1][1] - p[0][1]};
-    *length = hypot(d[0], d[1]);
-    u[0] = *length > 0.0 ? d[0] / *length : 1.0;
-    u[1] = *length > 0.0 ? d[1] / *length : 0.0;
-    *rate = u[0] * (v[1][0] - v[0][0]) + u[1] * (v[1][1] - v[0][1]);
-}
-
-/* A known load (force f at p, moment t) on link l, on its three rows. */
-static void add_load(double *rhs, const double *g, int l, const double *p, const double *f,
-                     double t)
-{
-    if (l == 0)
-        return;
-    double r[2] = {p[0] - g[2 * l], p[1] - g[2 * l + 1]};
-    double *row = rhs + 3 * (l - 1);
-    row[0] -= f[0];
-    row[1] -= f[1];
-    row[2] -= r[0] * f[1] - r[1] * f[0] + t;
-}
-
-static void point_motion(const solver *sv, int l, int i, double *p, double *v)
-{
-    const mech_point *pt = &sv->p->m->links[l].points[i];
-    double r[2] = {pt->x, pt->y}, a[2];
-    kin_on_link(&sv->ks, l, r, p, v, a);
+    const int link[2] = {l->link, l->link2}, point[2] = {l->point, l->point2};
+    springs_line(sv, link, point, p, v, u, length, rate);
 }
 
 void state_loads_add(const state_loads *s, const solver *sv, const double *reg, const double *g,
@@ -225,17 +199,17 @@ void state_loads_add(const state_loads *s, const solver *sv, const double *reg, 
     for (int i = 0; i < s->nloads; i++) {
         const sl_load *l = &s->loads[i];
         if (l->torque == 1) {
-            add_load(rhs, g, l->link, none, none, reg[l->reg[0]]);
+            springs_add_known_load(rhs, g, l->link, none, none, reg[l->reg[0]]);
         } else if (l->torque == 2) {
             double p[2][2], v[2][2], u[2], len, rate, t = reg[l->reg[0]];
             state_loads_line(l, sv, p, v, u, &len, &rate);
             double f[2] = {t * u[0], t * u[1]}, fb[2] = {-f[0], -f[1]};
-            add_load(rhs, g, l->link, p[0], f, 0.0);
-            add_load(rhs, g, l->link2, p[1], fb, 0.0);
+            springs_add_known_load(rhs, g, l->link, p[0], f, 0.0);
+            springs_add_known_load(rhs, g, l->link2, p[1], fb, 0.0);
         } else {
             double f[2] = {reg[l->reg[0]], reg[l->reg[1]]}, p[2], v[2];
-            point_motion(sv, l->link, l->point, p, v);
-            add_load(rhs, g, l->link, p, f, 0.0);
+            springs_point_motion(sv, l->link, l->point, p, v);
+            springs_add_known_load(rhs, g, l->link, p, f, 0.0);
         }
     }
 }
@@ -266,7 +240,7 @@ double state_loads_power(const state_loads *s, const solver *sv, const double *r
             *scale += fabs(t) * linear;
         } else {
             double f[2] = {reg[l->reg[0]], reg[l->reg[1]]}, p[2], v[2];
-            point_motion(sv, l->link, l->point, p, v);
+            springs_point_motion(sv, l->link, l->point, p, v);
             pw = f[0] * v[0] + f[1] * v[1];
             *scale += hypot(f[0], f[1]) * linear;
         }
