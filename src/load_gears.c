@@ -308,8 +308,11 @@ static void load_one_gear(loader *ld, const ynode *map, mech_gear *g, name_map *
         g->name = NULL;
         return;
     }
-    if (name_map_put(names, g->name, ld->m->ngears) < 0)
+    if (name_map_put(names, g->name, ld->m->ngears) < 0) {
+        free(g->name);  /* not counted in ngears: freed here, not with the model */
+        g->name = NULL;
         return (void)load_err(ld, map, "out of memory");
+    }
     ld->m->ngears++;
 }
 

@@ -366,6 +366,8 @@ static int load_points(loader *ld, mech_link *l, const ynode *map)
         p->mark = k->mark;
         if (!p->name || p->id < 0 || name_map_put(&index, p->name, l->npoints) < 0) {
             load_err(ld, k, "out of memory");
+            free(p->name);  /* not counted in npoints: freed here, not with the link */
+            p->name = NULL;
             break;
         }
         l->npoints++;
