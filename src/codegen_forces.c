@@ -16,16 +16,46 @@
 #include <string.h>
 
 #include "codegen.h"
+#include "drivers.h"
+#include "state_loads.h"
 
 static const double PI = 3.14159265358979323846;
 
 /* ---- analysis ------------------------------------------------------------- */
+
+/* What the force code cannot be generated for yet: an error at the
+ * feature's place in the file (docs/codegen.md, "Limits"). */
+static int codegen_forces_refuse(const codegen *g, mech_diag *d)
+{
+    const mech_model *m = g->m;
+    const char *tail = "not supported by the code generator yet (--no-forces generates the "
+                       "kinematics)";
+    if (m->ngears > 0)
+        return diag_error(d, m->file, m->gears[0].mark,
+                          "codegen: the forces of gear pair '%s' (its tooth force and the "
+                          "separating force): %s", m->gears[0].name, tail);
+    if (drivers_rows(m) > 0)
+        return diag_error(d, m->file, m->motions[0].mark,
+                          "codegen: the forces of several drivers (`drivers:`, driver '%s' "
+                          "first): %s", drivers_name(m, 0), tail);
+    if (m->state_loads && m->state_loads->nloads > 0) {
+        char what[160];
+        state_loads_describe(m, 0, what, sizeof what);
+        return diag_error(d, m->file, m->state_loads->loads[0].mark,
+                          "codegen: the forces of a load that depends on the motion (%s): %s",
+                          what, tail);
+    }
+    return MECH_OK;
+}
 
 int codegen_forces_plan(codegen *g, mech_diag *d)
 {
     const mech_model *m = g->m;
     int rc = forces_plan_init(&g->fp, &g->sp, g->opt.friction, d);
     g->fp_ready = 1;
+    if (rc != MECH_OK)
+        return rc;
+    rc = codegen_forces_refuse(g, d);
     if (rc != MECH_OK)
         return rc;
     if (g->fp.lp.use_klu)
