@@ -34,10 +34,6 @@ static int codegen_forces_refuse(const codegen *g, mech_diag *d)
         return diag_error(d, m->file, m->gears[0].mark,
                           "codegen: the forces of gear pair '%s' (its tooth force and the "
                           "separating force): %s", m->gears[0].name, tail);
-    if (drivers_rows(m) > 0)
-        return diag_error(d, m->file, m->motions[0].mark,
-                          "codegen: the forces of several drivers (`drivers:`, driver '%s' "
-                          "first): %s", drivers_name(m, 0), tail);
     if (m->state_loads && m->state_loads->nloads > 0) {
         char what[160];
         state_loads_describe(m, 0, what, sizeof what);
@@ -244,14 +240,21 @@ static int emit_column_entries(const codegen *g, FILE *f, int c, int *rows)
     const forces_plan *fp = &g->fp;
     const mech_model *m = g->m;
     int n = 0;
-    if (fp->joint[c] < 0 && m->driver.kind == MECH_DRIVE_ANGLE) {
-        if (m->driver.index != 0) {
+    /* a driver's column: joint -1 (the `driver:`) or -1 - k (law k of `drivers:`) */
+    mech_drive_kind dkind = m->driver.kind;
+    int dindex = m->driver.index;
+    if (fp->joint[c] < 0 && drivers_rows(m) > 0) {
+        dkind = m->motions[-1 - fp->joint[c]].kind;
+        dindex = m->motions[-1 - fp->joint[c]].index;
+    }
+    if (fp->joint[c] < 0 && dkind == MECH_DRIVE_ANGLE) {
+        if (dindex != 0) {
             fprintf(f, "        e[0] = 1.0;\n");
-            rows[n++] = 3 * (m->driver.index - 1) + 2;
+            rows[n++] = 3 * (dindex - 1) + 2;
         }
         return n;
     }
-    const mech_joint *jt = &m->joints[fp->joint[c] >= 0 ? fp->joint[c] : m->driver.index];
+    const mech_joint *jt = &m->joints[fp->joint[c] >= 0 ? fp->joint[c] : dindex];
     int a, b, link[2];
     joint_links(jt, &a, &b);
     link[0] = a, link[1] = b;
@@ -454,6 +457,47 @@ static void emit_known(const codegen *g, FILE *f)
     fprintf(f, "}\n\n");
 }
 
+/* The rate of the coordinate slider joint j drives: its unknown's
+ * velocity, the driver's speed, or 0 (forces.c drive_power, relative_speed). */
+static void slider_rate(const codegen *g, int j, char *buf, size_t size)
+{
+    int var = g->sp.tree.slide_var[j];
+    snprintf(buf, size, "0.0");
+    if (var == g->sp.n)  /* the driving slider: its speed */
+        snprintf(buf, size, "s->fqd");
+    else if (var >= 0 && var < g->sp.n && g->unk_col[var] >= 0)
+        snprintf(buf, size, "s->xd[%d]", g->unk_col[var]);
+}
+
+/* The drivers' power for reactions y (forces.c drive_power): the driver's
+ * load times its speed, or the sum over the laws of each load times the
+ * rate of its coordinate. */
+static void emit_drive_power(const codegen *g, FILE *f)
+{
+    const forces_plan *fp = &g->fp;
+    const mech_model *m = g->m;
+    int first = fp->ncols - fp->ndrive;
+    fprintf(f, "/* The drivers' power for the reactions y (src/forces.c drive_power) */\n"
+               "static double force_drive_power(const cg_state *s, const cg_frame *F, "
+               "const double *y,\n                                double qd)\n{\n"
+               "    (void)s, (void)F, (void)qd;\n");
+    if (drivers_rows(m) == 0) {
+        fprintf(f, "    return y[%d] * qd;\n}\n\n", first);
+        return;
+    }
+    fprintf(f, "    double p = 0.0;\n");
+    for (int k = 0; k < fp->ndrive; k++) {
+        const mech_motion *mo = &m->motions[k];
+        char rate[48];
+        if (mo->kind == MECH_DRIVE_ANGLE)
+            snprintf(rate, sizeof rate, "F[%d].om", mo->index);
+        else
+            slider_rate(g, mo->index, rate, sizeof rate);
+        fprintf(f, "    p += y[%d] * %s;\n", first + k, rate);
+    }
+    fprintf(f, "    return p;\n}\n\n");
+}
+
 /* The power balance (forces.c power_residual, springs.c springs_power). */
 static void emit_power(const codegen *g, FILE *f)
 {
@@ -463,10 +507,10 @@ static void emit_power(const codegen *g, FILE *f)
     num(gy, sizeof gy, m->gravity[1]);
     fprintf(f, "/* P_driver + P_loads + P_gravity - P_friction - dT/dt relative to the sum of\n"
                " * the terms' magnitudes (src/forces.c power_residual) */\n"
-               "static double force_power(cg_state *s, const cg_frame *F, double qd, double drive,\n"
+               "static double force_power(cg_state *s, const cg_frame *F, double qd, double pd,\n"
                "                          double pfric)\n{\n"
-               "    double pd = drive * qd, kin = 0.0, ext = 0.0, scale = fabs(pd) + fabs(pfric);\n"
-               "    (void)s, (void)F;\n");
+               "    double kin = 0.0, ext = 0.0, scale = fabs(pd) + fabs(pfric);\n"
+               "    (void)s, (void)F, (void)qd;\n");
     for (int l = 1; l < m->nlinks; l++) {
         const mech_link *k = &m->links[l];
         if (!k->has_mass)
@@ -550,12 +594,8 @@ static void emit_friction(const codegen *g, FILE *f)
                 fprintf(f, "        fr[%d] -= mf;\n", 3 * (b - 1) + 2);
             fprintf(f, "        power += mf * rel;\n");
         } else {
-            int var = g->sp.tree.slide_var[j];
-            char rel[40] = "0.0", pt[96];
-            if (var == g->sp.n)  /* the driving slider: its speed */
-                snprintf(rel, sizeof rel, "s->fqd");
-            else if (var >= 0 && var < g->sp.n && g->unk_col[var] >= 0)
-                snprintf(rel, sizeof rel, "s->xd[%d]", g->unk_col[var]);
+            char rel[48], pt[96];
+            slider_rate(g, j, rel, sizeof rel);
             point_xy(m, jt->link[0], jt->point[0], pt, sizeof pt);
             fprintf(f, "        double rel = %s;\n"
                        "        double ff = %s * fabs(y[%d]) * smooth_sign(rel, eps * LREF);\n",
@@ -585,6 +625,7 @@ int codegen_forces_emit(const codegen *g, FILE *f)
     if (emit_matrix(g, f) < 0)
         return -1;
     emit_known(g, f);
+    emit_drive_power(g, f);
     emit_power(g, f);
     emit_friction(g, f);
     for (int i = 0; codegen_force_runtime[i]; i++)
@@ -625,8 +666,8 @@ int codegen_forces_column(const codegen *g, FILE *f, int c)
         }
         return 1;
     }
-    case SRC_DRIVE_LOAD:
-        fprintf(f, "        s->out[%d] = %s[NF - 1];\n", c, y);
+    case SRC_DRIVE_LOAD:  /* driver obj of the last ndrive columns */
+        fprintf(f, "        s->out[%d] = %s[%d];\n", c, y, fp->ncols - fp->ndrive + cd->obj);
         return 1;
     case SRC_POWER_RESIDUAL:
         fprintf(f, "        s->out[%d] = s->power_residual%s;\n", c, cd->set ? "" : "0");
