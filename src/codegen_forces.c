@@ -17,7 +17,6 @@
 
 #include "codegen.h"
 #include "drivers.h"
-#include "state_loads.h"
 
 static const double PI = 3.14159265358979323846;
 
@@ -34,14 +33,7 @@ static int codegen_forces_refuse(const codegen *g, mech_diag *d)
         return diag_error(d, m->file, m->gears[0].mark,
                           "codegen: the forces of gear pair '%s' (its tooth force and the "
                           "separating force): %s", m->gears[0].name, tail);
-    if (m->state_loads && m->state_loads->nloads > 0) {
-        char what[160];
-        state_loads_describe(m, 0, what, sizeof what);
-        return diag_error(d, m->file, m->state_loads->loads[0].mark,
-                          "codegen: the forces of a load that depends on the motion (%s): %s",
-                          what, tail);
-    }
-    return MECH_OK;
+    return codegen_sl_check(g, d);
 }
 
 int codegen_forces_plan(codegen *g, mech_diag *d)
@@ -136,6 +128,7 @@ void codegen_forces_state(const codegen *g, FILE *f)
             n, n, g->upper, g->upper, b->nv > 0 ? b->nv : 1, n, n, n, n, n,
             b->nblocks > 0 ? b->nblocks : 1, n, n, n, n, 3 * n, 3 * n, 2 * nl, 2 * nl, 2 * nl,
             9 * ns, n);
+    codegen_sl_state(g, f);
 }
 
 /* ---- the tables and the per-mechanism functions ------------------------------- */
@@ -454,6 +447,7 @@ static void emit_known(const codegen *g, FILE *f)
         }
         fprintf(f, "    }\n");
     }
+    codegen_sl_known(g, f);
     fprintf(f, "}\n\n");
 }
 
@@ -553,6 +547,7 @@ static void emit_power(const codegen *g, FILE *f)
                     m->springs[i].kind == MECH_SPRING_TORSION ? "turning" : "linear");
         fprintf(f, "        ext += total;\n    }\n");
     }
+    codegen_sl_power(g, f);
     fprintf(f, "    double r = pd + ext - pfric - kin;\n"
                "    return scale > 0.0 ? r / scale : 0.0;\n}\n\n");
 }
@@ -623,6 +618,8 @@ int codegen_forces_emit(const codegen *g, FILE *f)
         return -1;
     emit_motion(g, f);
     if (emit_matrix(g, f) < 0)
+        return -1;
+    if (codegen_sl_emit(g, f) < 0)
         return -1;
     emit_known(g, f);
     emit_drive_power(g, f);
