@@ -22,20 +22,6 @@ static const double PI = 3.14159265358979323846;
 
 /* ---- analysis ------------------------------------------------------------- */
 
-/* What the force code cannot be generated for yet: an error at the
- * feature's place in the file (docs/codegen.md, "Limits"). */
-static int codegen_forces_refuse(const codegen *g, mech_diag *d)
-{
-    const mech_model *m = g->m;
-    const char *tail = "not supported by the code generator yet (--no-forces generates the "
-                       "kinematics)";
-    if (m->ngears > 0)
-        return diag_error(d, m->file, m->gears[0].mark,
-                          "codegen: the forces of gear pair '%s' (its tooth force and the "
-                          "separating force): %s", m->gears[0].name, tail);
-    return codegen_sl_check(g, d);
-}
-
 int codegen_forces_plan(codegen *g, mech_diag *d)
 {
     const mech_model *m = g->m;
@@ -43,7 +29,7 @@ int codegen_forces_plan(codegen *g, mech_diag *d)
     g->fp_ready = 1;
     if (rc != MECH_OK)
         return rc;
-    rc = codegen_forces_refuse(g, d);
+    rc = codegen_sl_check(g, d);
     if (rc != MECH_OK)
         return rc;
     if (g->fp.lp.use_klu)
@@ -159,10 +145,11 @@ static int emit_tables(const codegen *g, FILE *f)
                "#define FORCE_FRICTION %d  /* joint friction applied */\n"
                "#define FORCE_BOTH %d      /* the frictionless forces solved too */\n"
                "#define DRIVER_SLIDER %d   /* the driver is a slider (its eps is in m/s) */\n"
+               "#define FORCE_GEARS %d     /* gear pairs: their separating forces solved */\n"
                "#define FRICTION_TOL 1e-12\n#define FRICTION_MAX_ITER 100\n"
                "#define ANDERSON_DEPTH 3\n\n",
             n, b->nblocks, b->ndense, fp->friction, fp->want_frictionless,
-            g->m->driver.kind == MECH_DRIVE_SLIDER);
+            g->m->driver.kind == MECH_DRIVE_SLIDER, g->m->ngears > 0);
     table(f, "fperm_row", b->P, n);
     table(f, "fperm_col", Q, n);
     table(f, "fblock_start", b->R, b->nblocks + 1);
@@ -226,6 +213,99 @@ static void emit_motion(const codegen *g, FILE *f)
     fprintf(f, "}\n\n");
 }
 
+static void emit_load_force(FILE *f, int l, const char *rhs, const char *p, const char *fx,
+                            const char *fy, const char *indent);
+
+/* double p[2], t[2], r[2] = gear pair i's pitch point, tangent and
+ * separating direction at the position of the frames F (gears.c
+ * gears_contact, place). */
+static void emit_gear_contact(const codegen *g, FILE *f, int i, const char *in)
+{
+    const mech_model *m = g->m;
+    const mech_gear *gr = &m->gears[i];
+    char pa[96], rad[40], sep[40];
+    point_xy(m, gr->arm, gr->arm_pivot[0], pa, sizeof pa);
+    num(rad, sizeof rad, gr->radius[0]);
+    fprintf(f, "%sdouble p[2], t[2], r[2], a[2], n[2], av[2], aa[2];\n"
+               "%son_link(&F[%d], %s, a, av, aa);\n", in, in, gr->arm, pa);
+    if (gr->kind == MECH_GEAR_RACK) {
+        const mech_joint *jt = &m->joints[gr->rack];
+        char ang[40], sd[40], msd[40];
+        num(ang, sizeof ang, jt->angle);
+        num(sd, sizeof sd, (double)gr->side);
+        num(msd, sizeof msd, (double)-gr->side);
+        fprintf(f, "%s{\n%s    double ang = F[%d].th + %s;\n"
+                   "%s    n[0] = %s * sin(ang);\n%s    n[1] = %s * cos(ang);\n%s}\n",
+                in, in, jt->link[1], ang, in, sd, in, msd, in);
+    } else {
+        char pb[96];
+        point_xy(m, gr->arm, gr->arm_pivot[1], pb, sizeof pb);
+        fprintf(f, "%s{\n%s    double b[2], bv[2], ba[2];\n"
+                   "%s    on_link(&F[%d], %s, b, bv, ba);\n"
+                   "%s    double d = hypot(b[0] - a[0], b[1] - a[1]);\n"
+                   "%s    n[0] = (b[0] - a[0]) / d;\n%s    n[1] = (b[1] - a[1]) / d;\n",
+                in, in, in, gr->arm, pb, in, in, in);
+        if (gr->internal && gr->radius[0] < gr->radius[1])  /* a inside the ring b */
+            fprintf(f, "%s    n[0] = -n[0];\n%s    n[1] = -n[1];\n", in, in);
+        fprintf(f, "%s}\n", in);
+    }
+    double sg = gr->kind == MECH_GEAR_PAIR && gr->internal && gr->radius[0] > gr->radius[1]
+                    ? -1.0 : 1.0;
+    num(sep, sizeof sep, sg);
+    fprintf(f, "%sp[0] = a[0] + %s * n[0];\n%sp[1] = a[1] + %s * n[1];\n"
+               "%st[0] = -n[1];\n%st[1] = n[0];\n"
+               "%sr[0] = %s * n[0];\n%sr[1] = %s * n[1];\n"
+               "%s(void)t, (void)r;\n",
+            in, rad, in, rad, in, in, in, sep, in, sep, in);
+}
+
+/* The separating part of each tooth force for reactions y, on rhs
+ * (forces.c gear_separation): |F| tan(pressure angle) along r. */
+static void emit_gear_separation(const codegen *g, FILE *f)
+{
+    const forces_plan *fp = &g->fp;
+    const mech_model *m = g->m;
+    fprintf(f, "/* The teeth's separating forces |F| tan(pressure angle) for the reactions y\n"
+               " * (src/forces.c gear_separation) */\n"
+               "static void force_gear_separation(cg_state *s, const cg_frame *F, const double *y,\n"
+               "                                  double *rhs)\n{\n"
+               "    (void)s, (void)F, (void)y, (void)rhs;\n");
+    for (int i = 0; i < m->ngears; i++) {
+        const mech_gear *gr = &m->gears[i];
+        char tn[40];
+        num(tn, sizeof tn, tan(gr->pressure_angle));  /* the interpreter's libm value */
+        fprintf(f, "    {   /* gear pair %d */\n", i);
+        emit_gear_contact(g, f, i, "        ");
+        fprintf(f, "        double k = fabs(y[%d]) * %s;\n"
+                   "        double fb[2] = {k * r[0], k * r[1]}, fa[2] = {-fb[0], -fb[1]};\n"
+                   "        (void)fa, (void)fb;\n", fp->gcol + i, tn);
+        emit_load_force(f, gr->link[1], "rhs", "p", "fb[0]", "fb[1]", "        ");
+        emit_load_force(f, gr->link[0], "rhs", "p", "fa[0]", "fa[1]", "        ");
+        fprintf(f, "    }\n");
+    }
+    fprintf(f, "}\n\n");
+}
+
+/* e[] of a force along d at p: on link a (+), its opposite on b (forces.c
+ * push_force); the number of entries. */
+static int emit_pushes(FILE *f, int a, int b, int *rows)
+{
+    int n = 0, link[2] = {a, b};
+    for (int k = 0; k < 2; k++) {
+        if (link[k] == 0)
+            continue;
+        const char *sg = k ? "(-1.0)" : "1.0";
+        int l = link[k];
+        fprintf(f, "        {\n            double r0 = p[0] - s->cg[%d], r1 = p[1] - s->cg[%d];\n"
+                   "            e[%d] = %s * d[0];\n            e[%d] = %s * d[1];\n"
+                   "            e[%d] = %s * (r0 * d[1] - r1 * d[0]);\n        }\n",
+                2 * l, 2 * l + 1, n, sg, n + 1, sg, n + 2, sg);
+        rows[n] = 3 * (l - 1), rows[n + 1] = rows[n] + 1, rows[n + 2] = rows[n] + 2;
+        n += 3;
+    }
+    return n;
+}
+
 /* The entries of force column c as C: e[0..n-1], n returned (forces.c
  * column_entries, push_force, push_moment), and the rows they go to. */
 static int emit_column_entries(const codegen *g, FILE *f, int c, int *rows)
@@ -251,6 +331,12 @@ static int emit_column_entries(const codegen *g, FILE *f, int c, int *rows)
     int a, b, link[2];
     joint_links(jt, &a, &b);
     link[0] = a, link[1] = b;
+    if (fp->kind[c] == FC_GEAR) {  /* the tooth force: on link[1], its opposite on link[0] */
+        const mech_gear *gr = &m->gears[fp->joint[c]];
+        emit_gear_contact(g, f, fp->joint[c], "        ");
+        fprintf(f, "        double d[2] = {t[0], t[1]};\n");
+        return emit_pushes(f, gr->link[1], gr->link[0], rows);
+    }
     if (fp->kind[c] == FC_MOMENT) {
         for (int k = 0; k < 2; k++)
             if (link[k] != 0) {
@@ -276,19 +362,7 @@ static int emit_column_entries(const codegen *g, FILE *f, int c, int *rows)
         break;
     default: break;
     }
-    for (int k = 0; k < 2; k++) {
-        if (link[k] == 0)
-            continue;
-        const char *sg = k ? "(-1.0)" : "1.0";
-        int l = link[k];
-        fprintf(f, "        {\n            double r0 = p[0] - s->cg[%d], r1 = p[1] - s->cg[%d];\n"
-                   "            e[%d] = %s * d[0];\n            e[%d] = %s * d[1];\n"
-                   "            e[%d] = %s * (r0 * d[1] - r1 * d[0]);\n        }\n",
-                2 * l, 2 * l + 1, n, sg, n + 1, sg, n + 2, sg);
-        rows[n] = 3 * (l - 1), rows[n + 1] = rows[n] + 1, rows[n + 2] = rows[n] + 2;
-        n += 3;
-    }
-    return n;
+    return emit_pushes(f, a, b, rows);
 }
 
 /* The force matrix, column by column, equilibrated, straight into the
@@ -625,6 +699,7 @@ int codegen_forces_emit(const codegen *g, FILE *f)
     emit_drive_power(g, f);
     emit_power(g, f);
     emit_friction(g, f);
+    emit_gear_separation(g, f);
     for (int i = 0; codegen_force_runtime[i]; i++)
         fprintf(f, "%s\n", codegen_force_runtime[i]);
     return ferror(f) ? -1 : 0;
@@ -666,6 +741,12 @@ int codegen_forces_column(const codegen *g, FILE *f, int c)
     case SRC_DRIVE_LOAD:  /* driver obj of the last ndrive columns */
         fprintf(f, "        s->out[%d] = %s[%d];\n", c, y, fp->ncols - fp->ndrive + cd->obj);
         return 1;
+    case SRC_GEAR: {  /* the tooth force along the line of action (forces.c forces_gear) */
+        char cs[40];
+        num(cs, sizeof cs, cos(m->gears[cd->obj].pressure_angle));  /* the interpreter's libm */
+        fprintf(f, "        s->out[%d] = s->fy[%d] / %s;\n", c, fp->gcol + cd->obj, cs);
+        return 1;
+    }
     case SRC_POWER_RESIDUAL:
         fprintf(f, "        s->out[%d] = s->power_residual%s;\n", c, cd->set ? "" : "0");
         return 1;
