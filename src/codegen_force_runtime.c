@@ -4,9 +4,11 @@
  * and forces_solve's sequence, as text. It mirrors src/forces.c and
  * src/blocklu.c; change them together. The generated file defines before it
  * the macros and tables it uses (NF, NFB, NFDENSE, FORCE_FRICTION, FORCE_BOTH,
- * DRIVER_SLIDER, fperm_row, fperm_col, fblock_start, fblock_at, fabove_start,
- * fabove_row) and the functions force_motion, force_matrix, force_known,
- * force_power and (with friction) force_friction (src/codegen_forces.c). */
+ * DRIVER_SLIDER, FORCE_GEARS, fperm_row, fperm_col, fblock_start, fblock_at,
+ * fabove_start, fabove_row) and the functions force_motion, force_state_loads,
+ * force_matrix, force_known, force_drive_power, force_power,
+ * force_gear_separation and (with friction) force_friction
+ * (src/codegen_forces.c, src/codegen_state_loads.c). */
 #include "codegen.h"
 
 const char *const codegen_force_runtime[] = {

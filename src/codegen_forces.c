@@ -1,7 +1,9 @@
 /* src/codegen_forces.c: the kinetostatics of `mech codegen` (codegen.h,
- * docs/codegen.md section "Forces"): the joint reactions, the driver's
- * torque or force, joint friction, springs and the power balance, written
- * as C that mirrors src/forces.c and src/springs.c operation for operation.
+ * docs/codegen.md section "Forces"): the joint reactions, the gear pairs'
+ * tooth forces and their separating part, each driver's torque or force,
+ * joint friction, springs, the loads that depend on the motion
+ * (codegen_state_loads.c) and the power balance, written as C that mirrors
+ * src/forces.c, src/gears.c and src/springs.c operation for operation.
  *
  * The force system's pattern, columns and block triangular form are the
  * interpreter's own (forces_plan_init, its linsys plan's blocklu analysis):
@@ -81,8 +83,9 @@ void codegen_forces_enums(const codegen *g, FILE *f)
 {
     if (!g->want_forces)
         return;
-    fprintf(f, "/* The force system: its unknowns (joint reactions, then the driver's torque\n"
-               " * or force, the last), and what %s_solve returns when the forces fail. */\n"
+    fprintf(f, "/* The force system: its unknowns (joint reactions, the gear pairs' tooth\n"
+               " * forces, then each driver's torque or force, the last), and what %s_solve\n"
+               " * returns when the forces fail. */\n"
                "enum { %s_NF = %d, %s_FORCE_SINGULAR = 4, %s_FRICTION_STUCK = 5 };\n\n",
             g->lower, g->upper, g->fp.ncols, g->upper, g->upper);
 }
@@ -96,7 +99,8 @@ void codegen_forces_state(const codegen *g, FILE *f)
     int n = fp->ncols, nl = g->m->nlinks, ns = g->m->nsprings > 0 ? g->m->nsprings : 1;
     fprintf(f,
             "    /* forces (docs/forces.md): the force system's unknowns in the order of\n"
-            "       src/forces.c (Fx, Fy per revolute, N (M) per slider, the driver last) */\n"
+            "       src/forces.c (Fx, Fy per revolute, N (M) per slider, the tooth force\n"
+            "       per gear pair, the drivers last) */\n"
             "    double fy[%d];    /* with friction (when the file has it) */\n"
             "    double fy0[%d];   /* frictionless (with --friction both, or at the first\n"
             "                         position of a friction iteration) */\n"
