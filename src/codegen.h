@@ -89,6 +89,18 @@ int codegen_forces_column(const codegen *g, FILE *f, int c);
 /* codegen_force_runtime.c: the fixed force solve text, NULL-terminated. */
 extern const char *const codegen_force_runtime[];
 
+/* ---- codegen_state_loads.c: the loads that depend on the motion ---------- */
+
+/* MECH_OK, or MECH_EINPUT for an input or operation the emitter does not know. */
+int codegen_sl_check(const codegen *g, mech_diag *d);
+/* The state's register file (nothing without such loads). */
+void codegen_sl_state(const codegen *g, FILE *f);
+/* force_state_loads(s, F, q, qd, qdd): the register program; 0 or -1. */
+int codegen_sl_emit(const codegen *g, FILE *f);
+/* Statements inside force_known (rhs) and force_power (ext, scale, qd). */
+void codegen_sl_known(const codegen *g, FILE *f);
+void codegen_sl_power(const codegen *g, FILE *f);
+
 /* "1.5", "(-2)", as a C double literal that reads back to v. */
 void codegen_number(char *buf, size_t size, double v);
 

@@ -399,7 +399,7 @@ int codegen_kin_emit(const codegen *g, FILE *f)
     for (int b = 0; b < m->nbranches; b++)
         emit_branch(g, f, b);
     if (g->want_forces) {  /* the kinetostatics (codegen_forces.c), then their columns */
-        fprintf(f, "    s->force_status = kinetostatics(s, F, qd);\n"
+        fprintf(f, "    s->force_status = kinetostatics(s, F, q, qd, qdd);\n"
                    "    if (s->force_status == 0) {\n");
         for (int c = 0; c < g->cols.ncols; c++)
             codegen_forces_column(g, f, c);

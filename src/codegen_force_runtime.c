@@ -4,9 +4,11 @@
  * and forces_solve's sequence, as text. It mirrors src/forces.c and
  * src/blocklu.c; change them together. The generated file defines before it
  * the macros and tables it uses (NF, NFB, NFDENSE, FORCE_FRICTION, FORCE_BOTH,
- * DRIVER_SLIDER, fperm_row, fperm_col, fblock_start, fblock_at, fabove_start,
- * fabove_row) and the functions force_motion, force_matrix, force_known,
- * force_power and (with friction) force_friction (src/codegen_forces.c). */
+ * DRIVER_SLIDER, FORCE_GEARS, fperm_row, fperm_col, fblock_start, fblock_at,
+ * fabove_start, fabove_row) and the functions force_motion, force_state_loads,
+ * force_matrix, force_known, force_drive_power, force_power,
+ * force_gear_separation and (with friction) force_friction
+ * (src/codegen_forces.c, src/codegen_state_loads.c). */
 #include "codegen.h"
 
 const char *const codegen_force_runtime[] = {
@@ -174,6 +176,7 @@ const char *const codegen_force_runtime[] = {
     "        force_friction(s, F, s->fy, eps);",
     "        for (int i = 0; i < NF; i++)",
     "            s->ffric[i] += s->fb[i];",
+    "        force_gear_separation(s, F, s->fy, s->ffric);",
     "        force_apply(s, s->ffric, g);",
     "        double res = 0.0, big = 0.0;",
     "        for (int i = 0; i < NF; i++) {",
@@ -226,10 +229,11 @@ const char *const codegen_force_runtime[] = {
     "/* The joint reactions, the driver's torque or force, friction and the",
     " * power balance at the solved position (src/forces.c forces_solve): 0,",
     " * CG_FORCE_SINGULAR or CG_FRICTION_STUCK. */",
-    "static int kinetostatics(cg_state *s, const cg_frame *F, double qd)",
+    "static int kinetostatics(cg_state *s, const cg_frame *F, double q, double qd, double qdd)",
     "{",
     "    s->fqd = qd;",
     "    force_motion(s, F);",
+    "    force_state_loads(s, F, q, qd, qdd);",
     "    force_known(s, F, s->fb);",
     "    force_matrix(s, F);",
     "    if (force_factor(s) < 0) {",
@@ -245,7 +249,13 @@ const char *const codegen_force_runtime[] = {
     "    s->power_residual0 = 0.0;",
     "    if (!FORCE_FRICTION || FORCE_BOTH || !s->fprev) {",
     "        force_apply(s, s->fb, s->fy0);",
-    "        s->power_residual0 = force_power(s, F, qd, s->fy0[NF - 1], 0.0);",
+    "        if (FORCE_GEARS) {  /* the teeth's separating forces, from their tangential ones */",
+    "            for (int i = 0; i < NF; i++)",
+    "                s->ffric[i] = s->fb[i];",
+    "            force_gear_separation(s, F, s->fy0, s->ffric);",
+    "            force_apply(s, s->ffric, s->fy0);",
+    "        }",
+    "        s->power_residual0 = force_power(s, F, qd, force_drive_power(s, F, s->fy0, qd), 0.0);",
     "        for (int i = 0; i < NF; i++)",
     "            s->fy[i] = s->fy0[i];",
     "    }",
@@ -260,8 +270,8 @@ const char *const codegen_force_runtime[] = {
     "        friction_iterate(s, F, 1e-6 * (w > 0.0 ? w : 1.0));",
     "    }",
     "#endif",
-    "    s->drive_power = s->fy[NF - 1] * qd;",
-    "    s->power_residual = force_power(s, F, qd, s->fy[NF - 1], s->friction_power);",
+    "    s->drive_power = force_drive_power(s, F, s->fy, qd);",
+    "    s->power_residual = force_power(s, F, qd, s->drive_power, s->friction_power);",
     "    return s->friction_iterations < 0 ? CG_FRICTION_STUCK : 0;",
     "}",
     NULL};

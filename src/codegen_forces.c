@@ -1,7 +1,9 @@
 /* src/codegen_forces.c: the kinetostatics of `mech codegen` (codegen.h,
- * docs/codegen.md section "Forces"): the joint reactions, the driver's
- * torque or force, joint friction, springs and the power balance, written
- * as C that mirrors src/forces.c and src/springs.c operation for operation.
+ * docs/codegen.md section "Forces"): the joint reactions, the gear pairs'
+ * tooth forces and their separating part, each driver's torque or force,
+ * joint friction, springs, the loads that depend on the motion
+ * (codegen_state_loads.c) and the power balance, written as C that mirrors
+ * src/forces.c, src/gears.c and src/springs.c operation for operation.
  *
  * The force system's pattern, columns and block triangular form are the
  * interpreter's own (forces_plan_init, its linsys plan's blocklu analysis):
@@ -16,6 +18,7 @@
 #include <string.h>
 
 #include "codegen.h"
+#include "drivers.h"
 
 static const double PI = 3.14159265358979323846;
 
@@ -26,6 +29,9 @@ int codegen_forces_plan(codegen *g, mech_diag *d)
     const mech_model *m = g->m;
     int rc = forces_plan_init(&g->fp, &g->sp, g->opt.friction, d);
     g->fp_ready = 1;
+    if (rc != MECH_OK)
+        return rc;
+    rc = codegen_sl_check(g, d);
     if (rc != MECH_OK)
         return rc;
     if (g->fp.lp.use_klu)
@@ -77,8 +83,9 @@ void codegen_forces_enums(const codegen *g, FILE *f)
 {
     if (!g->want_forces)
         return;
-    fprintf(f, "/* The force system: its unknowns (joint reactions, then the driver's torque\n"
-               " * or force, the last), and what %s_solve returns when the forces fail. */\n"
+    fprintf(f, "/* The force system: its unknowns (joint reactions, the gear pairs' tooth\n"
+               " * forces, then each driver's torque or force, the last), and what %s_solve\n"
+               " * returns when the forces fail. */\n"
                "enum { %s_NF = %d, %s_FORCE_SINGULAR = 4, %s_FRICTION_STUCK = 5 };\n\n",
             g->lower, g->upper, g->fp.ncols, g->upper, g->upper);
 }
@@ -92,7 +99,8 @@ void codegen_forces_state(const codegen *g, FILE *f)
     int n = fp->ncols, nl = g->m->nlinks, ns = g->m->nsprings > 0 ? g->m->nsprings : 1;
     fprintf(f,
             "    /* forces (docs/forces.md): the force system's unknowns in the order of\n"
-            "       src/forces.c (Fx, Fy per revolute, N (M) per slider, the driver last) */\n"
+            "       src/forces.c (Fx, Fy per revolute, N (M) per slider, the tooth force\n"
+            "       per gear pair, the drivers last) */\n"
             "    double fy[%d];    /* with friction (when the file has it) */\n"
             "    double fy0[%d];   /* frictionless (with --friction both, or at the first\n"
             "                         position of a friction iteration) */\n"
@@ -110,6 +118,7 @@ void codegen_forces_state(const codegen *g, FILE *f)
             n, n, g->upper, g->upper, b->nv > 0 ? b->nv : 1, n, n, n, n, n,
             b->nblocks > 0 ? b->nblocks : 1, n, n, n, n, 3 * n, 3 * n, 2 * nl, 2 * nl, 2 * nl,
             9 * ns, n);
+    codegen_sl_state(g, f);
 }
 
 /* ---- the tables and the per-mechanism functions ------------------------------- */
@@ -140,10 +149,11 @@ static int emit_tables(const codegen *g, FILE *f)
                "#define FORCE_FRICTION %d  /* joint friction applied */\n"
                "#define FORCE_BOTH %d      /* the frictionless forces solved too */\n"
                "#define DRIVER_SLIDER %d   /* the driver is a slider (its eps is in m/s) */\n"
+               "#define FORCE_GEARS %d     /* gear pairs: their separating forces solved */\n"
                "#define FRICTION_TOL 1e-12\n#define FRICTION_MAX_ITER 100\n"
                "#define ANDERSON_DEPTH 3\n\n",
             n, b->nblocks, b->ndense, fp->friction, fp->want_frictionless,
-            g->m->driver.kind == MECH_DRIVE_SLIDER);
+            g->m->driver.kind == MECH_DRIVE_SLIDER, g->m->ngears > 0);
     table(f, "fperm_row", b->P, n);
     table(f, "fperm_col", Q, n);
     table(f, "fblock_start", b->R, b->nblocks + 1);
@@ -207,6 +217,99 @@ static void emit_motion(const codegen *g, FILE *f)
     fprintf(f, "}\n\n");
 }
 
+static void emit_load_force(FILE *f, int l, const char *rhs, const char *p, const char *fx,
+                            const char *fy, const char *indent);
+
+/* double p[2], t[2], r[2] = gear pair i's pitch point, tangent and
+ * separating direction at the position of the frames F (gears.c
+ * gears_contact, place). */
+static void emit_gear_contact(const codegen *g, FILE *f, int i, const char *in)
+{
+    const mech_model *m = g->m;
+    const mech_gear *gr = &m->gears[i];
+    char pa[96], rad[40], sep[40];
+    point_xy(m, gr->arm, gr->arm_pivot[0], pa, sizeof pa);
+    num(rad, sizeof rad, gr->radius[0]);
+    fprintf(f, "%sdouble p[2], t[2], r[2], a[2], n[2], av[2], aa[2];\n"
+               "%son_link(&F[%d], %s, a, av, aa);\n", in, in, gr->arm, pa);
+    if (gr->kind == MECH_GEAR_RACK) {
+        const mech_joint *jt = &m->joints[gr->rack];
+        char ang[40], sd[40], msd[40];
+        num(ang, sizeof ang, jt->angle);
+        num(sd, sizeof sd, (double)gr->side);
+        num(msd, sizeof msd, (double)-gr->side);
+        fprintf(f, "%s{\n%s    double ang = F[%d].th + %s;\n"
+                   "%s    n[0] = %s * sin(ang);\n%s    n[1] = %s * cos(ang);\n%s}\n",
+                in, in, jt->link[1], ang, in, sd, in, msd, in);
+    } else {
+        char pb[96];
+        point_xy(m, gr->arm, gr->arm_pivot[1], pb, sizeof pb);
+        fprintf(f, "%s{\n%s    double b[2], bv[2], ba[2];\n"
+                   "%s    on_link(&F[%d], %s, b, bv, ba);\n"
+                   "%s    double d = hypot(b[0] - a[0], b[1] - a[1]);\n"
+                   "%s    n[0] = (b[0] - a[0]) / d;\n%s    n[1] = (b[1] - a[1]) / d;\n",
+                in, in, in, gr->arm, pb, in, in, in);
+        if (gr->internal && gr->radius[0] < gr->radius[1])  /* a inside the ring b */
+            fprintf(f, "%s    n[0] = -n[0];\n%s    n[1] = -n[1];\n", in, in);
+        fprintf(f, "%s}\n", in);
+    }
+    double sg = gr->kind == MECH_GEAR_PAIR && gr->internal && gr->radius[0] > gr->radius[1]
+                    ? -1.0 : 1.0;
+    num(sep, sizeof sep, sg);
+    fprintf(f, "%sp[0] = a[0] + %s * n[0];\n%sp[1] = a[1] + %s * n[1];\n"
+               "%st[0] = -n[1];\n%st[1] = n[0];\n"
+               "%sr[0] = %s * n[0];\n%sr[1] = %s * n[1];\n"
+               "%s(void)t, (void)r;\n",
+            in, rad, in, rad, in, in, in, sep, in, sep, in);
+}
+
+/* The separating part of each tooth force for reactions y, on rhs
+ * (forces.c gear_separation): |F| tan(pressure angle) along r. */
+static void emit_gear_separation(const codegen *g, FILE *f)
+{
+    const forces_plan *fp = &g->fp;
+    const mech_model *m = g->m;
+    fprintf(f, "/* The teeth's separating forces |F| tan(pressure angle) for the reactions y\n"
+               " * (src/forces.c gear_separation) */\n"
+               "static void force_gear_separation(cg_state *s, const cg_frame *F, const double *y,\n"
+               "                                  double *rhs)\n{\n"
+               "    (void)s, (void)F, (void)y, (void)rhs;\n");
+    for (int i = 0; i < m->ngears; i++) {
+        const mech_gear *gr = &m->gears[i];
+        char tn[40];
+        num(tn, sizeof tn, tan(gr->pressure_angle));  /* the interpreter's libm value */
+        fprintf(f, "    {   /* gear pair %d */\n", i);
+        emit_gear_contact(g, f, i, "        ");
+        fprintf(f, "        double k = fabs(y[%d]) * %s;\n"
+                   "        double fb[2] = {k * r[0], k * r[1]}, fa[2] = {-fb[0], -fb[1]};\n"
+                   "        (void)fa, (void)fb;\n", fp->gcol + i, tn);
+        emit_load_force(f, gr->link[1], "rhs", "p", "fb[0]", "fb[1]", "        ");
+        emit_load_force(f, gr->link[0], "rhs", "p", "fa[0]", "fa[1]", "        ");
+        fprintf(f, "    }\n");
+    }
+    fprintf(f, "}\n\n");
+}
+
+/* e[] of a force along d at p: on link a (+), its opposite on b (forces.c
+ * push_force); the number of entries. */
+static int emit_pushes(FILE *f, int a, int b, int *rows)
+{
+    int n = 0, link[2] = {a, b};
+    for (int k = 0; k < 2; k++) {
+        if (link[k] == 0)
+            continue;
+        const char *sg = k ? "(-1.0)" : "1.0";
+        int l = link[k];
+        fprintf(f, "        {\n            double r0 = p[0] - s->cg[%d], r1 = p[1] - s->cg[%d];\n"
+                   "            e[%d] = %s * d[0];\n            e[%d] = %s * d[1];\n"
+                   "            e[%d] = %s * (r0 * d[1] - r1 * d[0]);\n        }\n",
+                2 * l, 2 * l + 1, n, sg, n + 1, sg, n + 2, sg);
+        rows[n] = 3 * (l - 1), rows[n + 1] = rows[n] + 1, rows[n + 2] = rows[n] + 2;
+        n += 3;
+    }
+    return n;
+}
+
 /* The entries of force column c as C: e[0..n-1], n returned (forces.c
  * column_entries, push_force, push_moment), and the rows they go to. */
 static int emit_column_entries(const codegen *g, FILE *f, int c, int *rows)
@@ -214,17 +317,30 @@ static int emit_column_entries(const codegen *g, FILE *f, int c, int *rows)
     const forces_plan *fp = &g->fp;
     const mech_model *m = g->m;
     int n = 0;
-    if (fp->joint[c] < 0 && m->driver.kind == MECH_DRIVE_ANGLE) {
-        if (m->driver.index != 0) {
+    /* a driver's column: joint -1 (the `driver:`) or -1 - k (law k of `drivers:`) */
+    mech_drive_kind dkind = m->driver.kind;
+    int dindex = m->driver.index;
+    if (fp->joint[c] < 0 && drivers_rows(m) > 0) {
+        dkind = m->motions[-1 - fp->joint[c]].kind;
+        dindex = m->motions[-1 - fp->joint[c]].index;
+    }
+    if (fp->joint[c] < 0 && dkind == MECH_DRIVE_ANGLE) {
+        if (dindex != 0) {
             fprintf(f, "        e[0] = 1.0;\n");
-            rows[n++] = 3 * (m->driver.index - 1) + 2;
+            rows[n++] = 3 * (dindex - 1) + 2;
         }
         return n;
     }
-    const mech_joint *jt = &m->joints[fp->joint[c] >= 0 ? fp->joint[c] : m->driver.index];
+    const mech_joint *jt = &m->joints[fp->joint[c] >= 0 ? fp->joint[c] : dindex];
     int a, b, link[2];
     joint_links(jt, &a, &b);
     link[0] = a, link[1] = b;
+    if (fp->kind[c] == FC_GEAR) {  /* the tooth force: on link[1], its opposite on link[0] */
+        const mech_gear *gr = &m->gears[fp->joint[c]];
+        emit_gear_contact(g, f, fp->joint[c], "        ");
+        fprintf(f, "        double d[2] = {t[0], t[1]};\n");
+        return emit_pushes(f, gr->link[1], gr->link[0], rows);
+    }
     if (fp->kind[c] == FC_MOMENT) {
         for (int k = 0; k < 2; k++)
             if (link[k] != 0) {
@@ -250,19 +366,7 @@ static int emit_column_entries(const codegen *g, FILE *f, int c, int *rows)
         break;
     default: break;
     }
-    for (int k = 0; k < 2; k++) {
-        if (link[k] == 0)
-            continue;
-        const char *sg = k ? "(-1.0)" : "1.0";
-        int l = link[k];
-        fprintf(f, "        {\n            double r0 = p[0] - s->cg[%d], r1 = p[1] - s->cg[%d];\n"
-                   "            e[%d] = %s * d[0];\n            e[%d] = %s * d[1];\n"
-                   "            e[%d] = %s * (r0 * d[1] - r1 * d[0]);\n        }\n",
-                2 * l, 2 * l + 1, n, sg, n + 1, sg, n + 2, sg);
-        rows[n] = 3 * (l - 1), rows[n + 1] = rows[n] + 1, rows[n + 2] = rows[n] + 2;
-        n += 3;
-    }
-    return n;
+    return emit_pushes(f, a, b, rows);
 }
 
 /* The force matrix, column by column, equilibrated, straight into the
@@ -421,7 +525,49 @@ static void emit_known(const codegen *g, FILE *f)
         }
         fprintf(f, "    }\n");
     }
+    codegen_sl_known(g, f);
     fprintf(f, "}\n\n");
+}
+
+/* The rate of the coordinate slider joint j drives: its unknown's
+ * velocity, the driver's speed, or 0 (forces.c drive_power, relative_speed). */
+static void slider_rate(const codegen *g, int j, char *buf, size_t size)
+{
+    int var = g->sp.tree.slide_var[j];
+    snprintf(buf, size, "0.0");
+    if (var == g->sp.n)  /* the driving slider: its speed */
+        snprintf(buf, size, "s->fqd");
+    else if (var >= 0 && var < g->sp.n && g->unk_col[var] >= 0)
+        snprintf(buf, size, "s->xd[%d]", g->unk_col[var]);
+}
+
+/* The drivers' power for reactions y (forces.c drive_power): the driver's
+ * load times its speed, or the sum over the laws of each load times the
+ * rate of its coordinate. */
+static void emit_drive_power(const codegen *g, FILE *f)
+{
+    const forces_plan *fp = &g->fp;
+    const mech_model *m = g->m;
+    int first = fp->ncols - fp->ndrive;
+    fprintf(f, "/* The drivers' power for the reactions y (src/forces.c drive_power) */\n"
+               "static double force_drive_power(const cg_state *s, const cg_frame *F, "
+               "const double *y,\n                                double qd)\n{\n"
+               "    (void)s, (void)F, (void)qd;\n");
+    if (drivers_rows(m) == 0) {
+        fprintf(f, "    return y[%d] * qd;\n}\n\n", first);
+        return;
+    }
+    fprintf(f, "    double p = 0.0;\n");
+    for (int k = 0; k < fp->ndrive; k++) {
+        const mech_motion *mo = &m->motions[k];
+        char rate[48];
+        if (mo->kind == MECH_DRIVE_ANGLE)
+            snprintf(rate, sizeof rate, "F[%d].om", mo->index);
+        else
+            slider_rate(g, mo->index, rate, sizeof rate);
+        fprintf(f, "    p += y[%d] * %s;\n", first + k, rate);
+    }
+    fprintf(f, "    return p;\n}\n\n");
 }
 
 /* The power balance (forces.c power_residual, springs.c springs_power). */
@@ -433,10 +579,10 @@ static void emit_power(const codegen *g, FILE *f)
     num(gy, sizeof gy, m->gravity[1]);
     fprintf(f, "/* P_driver + P_loads + P_gravity - P_friction - dT/dt relative to the sum of\n"
                " * the terms' magnitudes (src/forces.c power_residual) */\n"
-               "static double force_power(cg_state *s, const cg_frame *F, double qd, double drive,\n"
+               "static double force_power(cg_state *s, const cg_frame *F, double qd, double pd,\n"
                "                          double pfric)\n{\n"
-               "    double pd = drive * qd, kin = 0.0, ext = 0.0, scale = fabs(pd) + fabs(pfric);\n"
-               "    (void)s, (void)F;\n");
+               "    double kin = 0.0, ext = 0.0, scale = fabs(pd) + fabs(pfric);\n"
+               "    (void)s, (void)F, (void)qd;\n");
     for (int l = 1; l < m->nlinks; l++) {
         const mech_link *k = &m->links[l];
         if (!k->has_mass)
@@ -479,6 +625,7 @@ static void emit_power(const codegen *g, FILE *f)
                     m->springs[i].kind == MECH_SPRING_TORSION ? "turning" : "linear");
         fprintf(f, "        ext += total;\n    }\n");
     }
+    codegen_sl_power(g, f);
     fprintf(f, "    double r = pd + ext - pfric - kin;\n"
                "    return scale > 0.0 ? r / scale : 0.0;\n}\n\n");
 }
@@ -520,12 +667,8 @@ static void emit_friction(const codegen *g, FILE *f)
                 fprintf(f, "        fr[%d] -= mf;\n", 3 * (b - 1) + 2);
             fprintf(f, "        power += mf * rel;\n");
         } else {
-            int var = g->sp.tree.slide_var[j];
-            char rel[40] = "0.0", pt[96];
-            if (var == g->sp.n)  /* the driving slider: its speed */
-                snprintf(rel, sizeof rel, "s->fqd");
-            else if (var >= 0 && var < g->sp.n && g->unk_col[var] >= 0)
-                snprintf(rel, sizeof rel, "s->xd[%d]", g->unk_col[var]);
+            char rel[48], pt[96];
+            slider_rate(g, j, rel, sizeof rel);
             point_xy(m, jt->link[0], jt->point[0], pt, sizeof pt);
             fprintf(f, "        double rel = %s;\n"
                        "        double ff = %s * fabs(y[%d]) * smooth_sign(rel, eps * LREF);\n",
@@ -554,9 +697,13 @@ int codegen_forces_emit(const codegen *g, FILE *f)
     emit_motion(g, f);
     if (emit_matrix(g, f) < 0)
         return -1;
+    if (codegen_sl_emit(g, f) < 0)
+        return -1;
     emit_known(g, f);
+    emit_drive_power(g, f);
     emit_power(g, f);
     emit_friction(g, f);
+    emit_gear_separation(g, f);
     for (int i = 0; codegen_force_runtime[i]; i++)
         fprintf(f, "%s\n", codegen_force_runtime[i]);
     return ferror(f) ? -1 : 0;
@@ -595,9 +742,15 @@ int codegen_forces_column(const codegen *g, FILE *f, int c)
         }
         return 1;
     }
-    case SRC_DRIVE_LOAD:
-        fprintf(f, "        s->out[%d] = %s[NF - 1];\n", c, y);
+    case SRC_DRIVE_LOAD:  /* driver obj of the last ndrive columns */
+        fprintf(f, "        s->out[%d] = %s[%d];\n", c, y, fp->ncols - fp->ndrive + cd->obj);
         return 1;
+    case SRC_GEAR: {  /* the tooth force along the line of action (forces.c forces_gear) */
+        char cs[40];
+        num(cs, sizeof cs, cos(m->gears[cd->obj].pressure_angle));  /* the interpreter's libm */
+        fprintf(f, "        s->out[%d] = s->fy[%d] / %s;\n", c, fp->gcol + cd->obj, cs);
+        return 1;
+    }
     case SRC_POWER_RESIDUAL:
         fprintf(f, "        s->out[%d] = s->power_residual%s;\n", c, cd->set ? "" : "0");
         return 1;
