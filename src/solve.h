@@ -86,6 +86,10 @@ typedef struct solver {
 int solver_plan_init(solver_plan *sp, const mech_model *m, const mech_solve_options *o,
                      mech_diag *d);
 void solver_plan_free(solver_plan *sp);
+/* plan_compact.c: free what only the set-up needed (the system's DAG,
+ * symbolic rows and tape, LaTeX names, the tape's node map and roots); the
+ * plan still solves, but codegen and sys_eval_* can no longer use it. */
+void solver_plan_compact(solver_plan *sp);
 
 /* A numeric state for the plan (allocates everything a step needs). */
 int solver_init(solver *sv, const solver_plan *sp);

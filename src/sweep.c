@@ -127,6 +127,7 @@ static int build_plans(mech_analysis *a, mech_diag *d)
     }
     if (rc != MECH_OK)
         return rc;
+    solver_plan_compact(&a->sp);  /* the sweep needs only the compiled plan */
     column_request rq = {&a->outputs, a->sp.level, a->want_forces, friction_columns(a),
                          a->opt.diagnostics};
     if (columns_build(&a->cols, m, &rq) != MECH_OK)
