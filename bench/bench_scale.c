@@ -17,8 +17,9 @@
  *               cost grows as N^3, N = 10 000 would take ~1000 times longer)
  *
  * A child that takes longer than 150 s is stopped and reported.
- * Usage: bench-scale [SVGDIR]; bench-scale --yaml N > chain.yaml writes the
- * chain of N loops (to run `mech solve` on it, or profile). Not a test. */
+ * Usage: bench-scale [SVGDIR]; bench-scale --only N measures one N; bench-scale
+ * --yaml N > chain.yaml writes the chain of N loops (to run `mech solve` on
+ * it, or profile). Not a test. */
 #include <math.h>
 #include <signal.h>
 #include <stdarg.h>
@@ -31,6 +32,9 @@
 #include <unistd.h>
 
 #include <klu.h>
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 
 #include "bench_util.h"
 #include "mech.h"
@@ -45,7 +49,7 @@ enum { NN = 5, DENSE_MAX = 1000, STEPS = 10, TIMEOUT = 150 };
 
 typedef struct result {
     int ok, n, nnz, rows;
-    double load, setup, us_step, cpu_us_step, it_step, min_rcond, rss_mb, klu_factor_us, klu_re_us, dense_us;
+    double load, setup, us_step, cpu_us_step, it_step, min_rcond, rss_mb, sweep_mb, heap_mb, klu_factor_us, klu_re_us, dense_us;
     char msg[256];
 } result;
 
@@ -131,6 +135,35 @@ static char *chain_text(int n, size_t *len)
 
 /* ---- one N, in the child --------------------------------------------------- */
 
+/* Resident memory now (not the peak), MB: /proc/self/statm's second field
+ * (Linux); NAN elsewhere. */
+static double rss_now_mb(void)
+{
+    FILE *f = fopen("/proc/self/statm", "r");
+    long size = 0, res = -1;
+    if (f) {
+        if (fscanf(f, "%ld %ld", &size, &res) != 2)
+            res = -1;
+        fclose(f);
+    }
+    return res < 0 ? NAN : (double)res * (double)sysconf(_SC_PAGESIZE) / (1024.0 * 1024.0);
+}
+
+/* mech_solve's progress callback (after the last row, while the analysis
+ * and the sweep's state are alive): the resident memory of the sweep, once
+ * the set-up has given back what only it needed */
+static void on_progress(void *ctx, int done, int total)
+{
+    (void)done, (void)total;
+    double *mb = ctx, now = rss_now_mb();
+    if (!(*mb >= now))
+        *mb = now;
+#ifdef __GLIBC__
+    struct mallinfo2 mi = mallinfo2();
+    mb[1] = (double)(mi.uordblks + mi.hblkhd) / (1024.0 * 1024.0);
+#endif
+}
+
 static void measure(int N, result *r)
 {
     size_t len;
@@ -166,6 +199,9 @@ static void measure(int N, result *r)
             if (!twice)
                 o.to = 0.5 * (o.from + o.to);
             o.steps = STEPS * (1 + twice);
+            double sweep_mb[2] = {NAN, NAN};
+            o.progress = on_progress;
+            o.progress_ctx = sweep_mb;
             mech_table t = {0};
             double c0 = bench_cpu();
             if (mech_solve(m, &o, &t, &st, &d) != MECH_OK) {
@@ -175,6 +211,8 @@ static void measure(int N, result *r)
             }
             cpu[twice] = fmin(cpu[twice], bench_cpu() - c0);
             mech_table_free(&t);
+            if (twice && (k == 0 || sweep_mb[0] < r->sweep_mb))
+                r->sweep_mb = sweep_mb[0], r->heap_mb = sweep_mb[1];
             if (twice && st.seconds < best)
                 best = st.seconds, r->setup = st.setup_seconds, full = st;
         }
@@ -295,8 +333,41 @@ static double slope(const int *x, const double *y, int n)
     return k < 2 ? NAN : (k * sxy - sx * sy) / (k * sxx - sx * sx);
 }
 
+static void print_header(void)
+{
+    printf("%7s %7s %8s %8s %8s %10s %10s %7s %9s %8s %8s %11s %11s %12s %8s\n", "N", "unknowns",
+           "nnz", "load s", "setup s", "us/step", "CPU us/st", "it/step", "min rcond", "peak MB",
+           "sweep MB", "KLU fact us", "KLU re+sol", "dense LU us", "dense/KLU");
+}
+
+static void print_row(int N, result *r)
+{
+    if (!r->ok) {
+        printf("%7d  not measured: %s\n", N, r->msg);
+        r->us_step = r->rss_mb = r->sweep_mb = r->klu_re_us = r->load = r->cpu_us_step = NAN;
+        r->dense_us = NAN;
+        return;
+    }
+    printf("%7d %7d %8d %8.3f %8.3f %10.1f %10.1f %7.2f %9.2e %8.1f %8.1f %11.1f %11.1f %12.1f "
+           "%8.1f\n", N, r->n, r->nnz, r->load, r->setup, r->us_step, r->cpu_us_step, r->it_step,
+           r->min_rcond, r->rss_mb, r->sweep_mb, r->klu_factor_us, r->klu_re_us, r->dense_us,
+           r->dense_us / r->klu_re_us);
+    fflush(stdout);
+}
+
 int main(int argc, char **argv)
 {
+    if (argc > 2 && strcmp(argv[1], "--only") == 0) {  /* one N (to profile or compare) */
+        int N = atoi(argv[2]);
+        result r = run_child(N);
+        print_header();
+        print_row(N, &r);
+        if (r.ok)
+            printf("per loop: CPU %.3f us per step, sweep resident %.2f KiB (heap in use %.2f KiB), "
+                   "peak %.2f KiB\n", r.cpu_us_step / N, r.sweep_mb * 1024.0 / N,
+                   r.heap_mb * 1024.0 / N, r.rss_mb * 1024.0 / N);
+        return r.ok ? 0 : 1;
+    }
     if (argc > 2 && strcmp(argv[1], "--yaml") == 0) {
         size_t len;
         char *text = chain_text(atoi(argv[2]), &len);
@@ -309,23 +380,10 @@ int main(int argc, char **argv)
     result r[NN];
     printf("scaling: chains of N four-bar loops (2N unknowns), %d driver steps (2.5 deg); each N in its own\n"
            "process; KLU and dense: one factorisation + solve of the same 2N x 2N Jacobian\n", 2 * STEPS);
-    printf("%7s %7s %8s %8s %8s %10s %10s %7s %9s %8s %11s %11s %12s %8s\n", "N", "unknowns",
-           "nnz", "load s", "setup s", "us/step", "CPU us/st", "it/step", "min rcond", "RSS MB", "KLU fact us",
-           "KLU re+sol", "dense LU us", "dense/KLU");
+    print_header();
     for (int i = 0; i < NN; i++) {
         r[i] = run_child(Ns[i]);
-        if (!r[i].ok) {
-            printf("%7d  not measured: %s\n", Ns[i], r[i].msg);
-            r[i].us_step = r[i].rss_mb = r[i].klu_re_us = r[i].load = r[i].cpu_us_step = NAN;
-            r[i].dense_us = NAN;
-            continue;
-        }
-        printf("%7d %7d %8d %8.3f %8.3f %10.1f %10.1f %7.2f %9.2e %8.1f %11.1f %11.1f %12.1f "
-               "%8.1f\n", Ns[i], r[i].n, r[i].nnz, r[i].load, r[i].setup, r[i].us_step,
-               r[i].cpu_us_step, r[i].it_step,
-               r[i].min_rcond, r[i].rss_mb, r[i].klu_factor_us, r[i].klu_re_us, r[i].dense_us,
-               r[i].dense_us / r[i].klu_re_us);
-        fflush(stdout);
+        print_row(Ns[i], &r[i]);
     }
     double y[7][NN];
     for (int i = 0; i < NN; i++) {

@@ -141,11 +141,12 @@ int kin_state_init(kin_state *st, const mech_model *m)
     st->al = xcalloc(nl, sizeof *st->al);
     st->c = xcalloc(nl, sizeof *st->c);
     st->s = xcalloc(nl, sizeof *st->s);
+    st->cth = xcalloc(nl, sizeof *st->cth);
     st->o = xcalloc(2 * nl, sizeof *st->o);
     st->vo = xcalloc(2 * nl, sizeof *st->vo);
     st->ao = xcalloc(2 * nl, sizeof *st->ao);
     st->guide = xcalloc(3 * (size_t)m->njoints + 1, sizeof *st->guide);
-    if (!st->th || !st->om || !st->al || !st->c || !st->s || !st->o || !st->vo || !st->ao ||
+    if (!st->th || !st->om || !st->al || !st->c || !st->s || !st->cth || !st->o || !st->vo || !st->ao ||
         !st->guide) {
         kin_state_free(st);
         return MECH_ENOMEM;
@@ -164,6 +165,7 @@ void kin_state_free(kin_state *st)
     free(st->al);
     free(st->c);
     free(st->s);
+    free(st->cth);
     free(st->o);
     free(st->vo);
     free(st->ao);
@@ -173,11 +175,11 @@ void kin_state_free(kin_state *st)
 
 static double var_value(const double *v, int var) { return v && var >= 0 ? v[var] : 0.0; }
 
-/* Point r of link l: position, and rates when the link's rates are known. */
-static inline void on_link(const kin_state *st, int l, const double *r, double *p, double *v,
-                           double *a)
+/* Point r of link l (cos c, sin s of its angle): position, and rates when
+ * the link's rates are known. */
+static inline void on_link_cs(const kin_state *st, int l, double c, double s, const double *r,
+                              double *p, double *v, double *a)
 {
-    double c = st->c[l], s = st->s[l];
     double rx = c * r[0] - s * r[1], ry = s * r[0] + c * r[1];  /* R r */
     double w = st->om[l], al = st->al[l];
     p[0] = st->o[2 * l] + rx;
@@ -192,9 +194,41 @@ static inline void on_link(const kin_state *st, int l, const double *r, double *
     }
 }
 
+/* ... with the cached cos and sin (links placed by kin_update: fresh) */
+static inline void on_link(const kin_state *st, int l, const double *r, double *p, double *v,
+                           double *a)
+{
+    on_link_cs(st, l, st->c[l], st->s[l], r, p, v, a);
+}
+
+/* Refresh link l's cos and sin when its angle has changed since they were
+ * computed (the same values the cache held when every link was refreshed at
+ * every update; a NaN angle is recomputed every time, as before). */
+static inline void fresh_cs(kin_state *st, int l)
+{
+    double th = st->th[l];
+    if (th != st->cth[l]) {
+        st->cth[l] = th;
+        st->c[l] = cos(th);  /* once per link and angle: on_link is hot */
+        st->s[l] = sin(th);
+    }
+}
+
+/* ... for any link, also one kin_update did not place (diagnostics): with
+ * the cos and sin of its current angle, without writing the cache */
+static void on_any_link(const kin_state *st, int l, const double *r, double *p, double *v,
+                        double *a)
+{
+    double th = st->th[l];
+    if (th == st->cth[l])
+        on_link(st, l, r, p, v, a);
+    else
+        on_link_cs(st, l, cos(th), sin(th), r, p, v, a);
+}
+
 void kin_on_link(const kin_state *st, int l, const double *r, double *p, double *v, double *a)
 {
-    on_link(st, l, r, p, v, a);
+    on_any_link(st, l, r, p, v, a);
 }
 
 /* Place link l so that its point r is at p (with rates v, a). */
@@ -276,18 +310,18 @@ void kin_update(const kin_tree *t, kin_state *st, const double *pos, const doubl
     /* angles first: a guide's angle may be needed before its frame */
     for (int k = 0; k < t->span->norder; k++) {
         int l = t->span->order[k], var = t->angle_var[l];
-        double th = var_value(pos, var);
-        if (th != st->th[l]) {  /* c, s belong to th: a link that did not turn keeps them */
-            st->th[l] = th;
-            st->c[l] = cos(th);  /* once per link and angle: on_link is hot */
-            st->s[l] = sin(th);
-        }
+        st->th[l] = var_value(pos, var);  /* c, s: only where needed, below */
         st->om[l] = var_value(vel, var);
         st->al[l] = var_value(acc, var);
     }
-    for (int k = 0; k < t->span->norder; k++)
-        if (t->active[t->span->order[k]])
-            place_link(t, st, t->span->order[k], pos, vel, acc);
+    for (int k = 0; k < t->span->norder; k++) {
+        int l = t->span->order[k];
+        if (t->active[l]) {  /* its frame: its own and its parent's cos and sin */
+            fresh_cs(st, t->span->parent_link[l]);
+            fresh_cs(st, l);
+            place_link(t, st, l, pos, vel, acc);
+        }
+    }
 }
 
 void kin_point(const kin_tree *t, const kin_state *st, int name_id, double *p, double *v,
@@ -299,6 +333,6 @@ void kin_point(const kin_tree *t, const kin_state *st, int name_id, double *p, d
         p[0] = p[1] = NAN;
         l = 0;
     }
-    on_link(st, l, point_xy(t->model, l, t->point_index[name_id], rbuf), p, v ? v : vb,
+    on_any_link(st, l, point_xy(t->model, l, t->point_index[name_id], rbuf), p, v ? v : vb,
             a ? a : ab);
 }

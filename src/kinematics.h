@@ -28,8 +28,11 @@ typedef struct kin_tree {
 /* Positions, velocities and accelerations of every active link frame. */
 typedef struct kin_state {
     double *th, *om, *al;   /* [nlinks] angle, angular velocity, angular acceleration */
-    double *c, *s;          /* [nlinks] cos and sin of th (ground: 1, 0); kept while th
-                               does not change */
+    double *c, *s;          /* [nlinks] cos and sin of cth (ground: 1, 0): computed for
+                               the links kin_update places (and their parents) when th
+                               has changed; kin_point and kin_on_link use cos and sin of
+                               th itself when cth is stale */
+    double *cth;            /* [nlinks] the angle c and s belong to */
     double *o, *vo, *ao;    /* [2 nlinks] frame origin and its rates */
     double *guide;          /* [3 njoints] a slider's guide angle, its cos and sin, kept
                                while the angle does not change (a ground guide: always) */
