@@ -38,6 +38,7 @@
 
 #include "bench_util.h"
 #include "mech.h"
+#include "solve.h"
 #include "system.h"
 
 /* LAPACK (Fortran calling convention) */
@@ -49,7 +50,8 @@ enum { NN = 5, DENSE_MAX = 1000, STEPS = 10, TIMEOUT = 150 };
 
 typedef struct result {
     int ok, n, nnz, rows;
-    double load, setup, us_step, cpu_us_step, it_step, min_rcond, rss_mb, sweep_mb, heap_mb, klu_factor_us, klu_re_us, dense_us;
+    double load, setup, us_step, cpu_us_step, it_step, min_rcond, rss_mb, sweep_mb, heap_mb,
+        kib_model, kib_analysis, kib_state, kib_tape, ins_loop, reg_loop, klu_factor_us, klu_re_us, dense_us;
     char msg[256];
 } result;
 
@@ -149,6 +151,18 @@ static double rss_now_mb(void)
     return res < 0 ? NAN : (double)res * (double)sysconf(_SC_PAGESIZE) / (1024.0 * 1024.0);
 }
 
+/* Heap in use now, MB (glibc's mallinfo2: small blocks and mmapped ones);
+ * NAN elsewhere. */
+static double heap_now_mb(void)
+{
+#ifdef __GLIBC__
+    struct mallinfo2 mi = mallinfo2();
+    return (double)(mi.uordblks + mi.hblkhd) / (1024.0 * 1024.0);
+#else
+    return NAN;
+#endif
+}
+
 /* mech_solve's progress callback (after the last row, while the analysis
  * and the sweep's state are alive): the resident memory of the sweep, once
  * the set-up has given back what only it needed */
@@ -158,10 +172,41 @@ static void on_progress(void *ctx, int done, int total)
     double *mb = ctx, now = rss_now_mb();
     if (!(*mb >= now))
         *mb = now;
-#ifdef __GLIBC__
-    struct mallinfo2 mi = mallinfo2();
-    mb[1] = (double)(mi.uordblks + mi.hblkhd) / (1024.0 * 1024.0);
-#endif
+    mb[1] = heap_now_mb();
+}
+
+/* Where the heap of a sweep goes, KiB per loop (the cause column of target
+ * 2): the model (measured at load), the analysis (mech_analysis_new: plan,
+ * tape, pattern, columns, after solver_plan_compact), the sweep's state and
+ * table (heap in use during mech_analysis_solve, less the analysis); and the
+ * solver tape's share of the analysis (program and constants' image, from
+ * its own solver_plan_init). */
+static void heap_breakdown(const mech_model *m, int N, result *r, mech_diag *d)
+{
+    mech_solve_options o;
+    mech_solve_options_default(&o);
+    double h0 = heap_now_mb(), mb[2] = {NAN, NAN};
+    o.progress = on_progress;  /* copied by the analysis */
+    o.progress_ctx = mb;
+    mech_analysis *a = NULL;
+    if (mech_analysis_new(m, &o, &a, d) != MECH_OK)
+        return;
+    double h1 = heap_now_mb();
+    mech_table t = {0};
+    mech_analysis_solve(a, NULL, 0, &t, NULL, d);
+    mech_table_free(&t);
+    mech_analysis_free(&a);
+    r->kib_analysis = (h1 - h0) * 1024.0 / N;
+    r->kib_state = (mb[1] - h1) * 1024.0 / N;
+    solver_plan sp;
+    mech_solve_options_default(&o);
+    if (solver_plan_init(&sp, m, &o, d) == MECH_OK) {
+        r->kib_tape = ((double)sp.tp.nins * sizeof(tape_ins) + (double)sp.tp.nreg * sizeof(double)) /
+                      1024.0 / N;
+        r->ins_loop = (double)sp.tp.nins / N;
+        r->reg_loop = (double)sp.tp.nreg / N;
+    }
+    solver_plan_free(&sp);
 }
 
 static void measure(int N, result *r)
@@ -172,6 +217,7 @@ static void measure(int N, result *r)
     mech_diag_init(&d);
     mech_model *m = NULL;
     mech_summary sum;
+    double h0 = heap_now_mb() - (double)len / (1024.0 * 1024.0);  /* the text is freed below */
     double t0 = bench_now();
     if (mech_load_string(text, len, "chain.yaml", &m, &d) != MECH_OK ||
         mech_check(m, &sum, &d) != MECH_OK) {
@@ -180,6 +226,7 @@ static void measure(int N, result *r)
     }
     r->load = bench_now() - t0;
     free(text);
+    r->kib_model = (heap_now_mb() - h0) * 1024.0 / N;
     /* the sweep: the best of up to 5 runs (fewer for large N); wall time per
        step from mech_solve's stats of 2*STEPS steps over the file's range
        (row 0 included), CPU time per step from the difference between that
@@ -283,6 +330,7 @@ static void measure(int N, result *r)
     }
     free(x), free(f), free(J), free(b);
     mech_system_free(&s);
+    heap_breakdown(m, N, r, &d);
     mech_model_free(&m);
     mech_diag_free(&d);
     r->ok = 1;
@@ -366,6 +414,10 @@ int main(int argc, char **argv)
             printf("per loop: CPU %.3f us per step, sweep resident %.2f KiB (heap in use %.2f KiB), "
                    "peak %.2f KiB\n", r.cpu_us_step / N, r.sweep_mb * 1024.0 / N,
                    r.heap_mb * 1024.0 / N, r.rss_mb * 1024.0 / N);
+        if (r.ok)
+            printf("heap per loop: model %.2f KiB, analysis %.2f KiB (solver tape %.2f KiB: %.1f "
+                   "instructions, %.1f registers), sweep state and table %.2f KiB\n",
+                   r.kib_model, r.kib_analysis, r.kib_tape, r.ins_loop, r.reg_loop, r.kib_state);
         return r.ok ? 0 : 1;
     }
     if (argc > 2 && strcmp(argv[1], "--yaml") == 0) {

@@ -13,14 +13,25 @@
  * the plan's roots in the DAG, `mech equations` and the sensitivities build
  * their own systems. */
 #include <stdlib.h>
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 
 #include "solve.h"
+
+/* Set-up memory freed above which the allocator is asked to give the free
+ * pages back to the system (glibc keeps freed small blocks in its heap; a
+ * chain of 10^4 loops: 2 KiB per loop resident for nothing). Below it the
+ * trim's walk over the heap is not worth its time. */
+enum { TRIM_BYTES = 8 << 20 };
 
 void solver_plan_compact(solver_plan *sp)
 {
     mech_system *s = sp->sys;
     if (!s)
         return;
+    size_t freed = s->ex.cap * sizeof(expr_node) + s->ex.tcap * sizeof(int) +
+                   (size_t)s->tp.nins * sizeof(tape_ins) + 2 * (size_t)s->tp.nreg * sizeof(double);
     expr_free(&s->ex);  /* every ex below indexes it: all go */
     void *sym[] = {s->f, s->Jx, s->fq, s->vel, s->acc, s->link_angle, s->slide, s->reg};
     for (size_t k = 0; k < sizeof sym / sizeof sym[0]; k++)
@@ -41,4 +52,10 @@ void solver_plan_compact(solver_plan *sp)
     free(sp->vroot);
     free(sp->aroot);
     sp->proot = sp->vroot = sp->aroot = NULL;
+#ifdef __GLIBC__
+    if (freed >= TRIM_BYTES)
+        malloc_trim(0);
+#else
+    (void)freed;
+#endif
 }
