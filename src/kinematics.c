@@ -145,7 +145,11 @@ int kin_state_init(kin_state *st, const mech_model *m)
     st->o = xcalloc(2 * nl, sizeof *st->o);
     st->vo = xcalloc(2 * nl, sizeof *st->vo);
     st->ao = xcalloc(2 * nl, sizeof *st->ao);
-    st->guide = xcalloc(3 * (size_t)m->njoints + 1, sizeof *st->guide);
+    int nguide = 0;  /* joints up to the last slider: a chain of pins needs none */
+    for (int j = 0; j < m->njoints; j++)
+        if (m->joints[j].kind == MECH_JOINT_SLIDER)
+            nguide = j + 1;
+    st->guide = xcalloc(3 * (size_t)nguide + 1, sizeof *st->guide);
     if (!st->th || !st->om || !st->al || !st->c || !st->s || !st->cth || !st->o || !st->vo || !st->ao ||
         !st->guide) {
         kin_state_free(st);
@@ -153,7 +157,7 @@ int kin_state_init(kin_state *st, const mech_model *m)
     }
     for (size_t l = 0; l < nl; l++)
         st->c[l] = 1.0;  /* angle 0 until updated; the ground stays so */
-    for (int j = 0; j < m->njoints; j++)
+    for (int j = 0; j < nguide; j++)
         st->guide[3 * j] = NAN;  /* no direction yet */
     return MECH_OK;
 }

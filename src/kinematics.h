@@ -34,8 +34,9 @@ typedef struct kin_state {
                                th itself when cth is stale */
     double *cth;            /* [nlinks] the angle c and s belong to */
     double *o, *vo, *ao;    /* [2 nlinks] frame origin and its rates */
-    double *guide;          /* [3 njoints] a slider's guide angle, its cos and sin, kept
-                               while the angle does not change (a ground guide: always) */
+    double *guide;          /* [3 (last slider joint + 1)] a slider's guide angle, its cos
+                               and sin, kept while the angle does not change (a ground
+                               guide: always) */
 } kin_state;
 
 int kin_tree_build(kin_tree *t, const mech_system *s);

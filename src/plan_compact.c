@@ -5,8 +5,8 @@
  * Jacobian and rate expressions, the system's own tape and registers)
  * and compiles from it the solver's tape; from then on the sweep reads
  * only the solver's tape (by the registers in preg/vreg/areg/xreg), the
- * pattern, the spanning tree and a few tables of the system (unknown kinds
- * and names, link_var, joint_var, loops). On a chain of N four-bars the
+ * pattern, the spanning tree and a few tables of the system (unknown kinds,
+ * the names of the unknowns and the driver, link_var, joint_var, loops). On a chain of N four-bars the
  * parts freed here are about 4 KiB per loop of the 7.7 KiB resident.
  *
  * Only the sweep's analysis (mech_analysis_new) calls this: codegen walks
@@ -39,15 +39,29 @@ void solver_plan_compact(solver_plan *sp)
     s->f = s->Jx = s->fq = s->vel = s->acc = s->link_angle = s->slide = NULL;
     s->reg = NULL;
     tape_free(&s->tp);  /* the system's tape: sys_eval_* are not used by the sweep */
-    if (s->latex)       /* LaTeX names are for `mech equations` (its own system) */
-        for (int v = 0; v < s->nnames; v++) {
+    free(s->Jp);        /* the whole Jacobian's pattern: the plan has its solved part */
+    free(s->Ji);
+    s->Jp = s->Ji = NULL;
+    /* LaTeX names are for `mech equations` (its own system); the messages
+       name unknowns (and the driver), never the rates */
+    for (int v = 0; v < s->nnames; v++) {
+        if (s->latex) {
             free(s->latex[v]);
             s->latex[v] = NULL;
         }
+        if (s->names && v > s->n) {
+            free(s->names[v]);
+            s->names[v] = NULL;
+        }
+    }
     /* the solver's tape: DAG node -> register was for set-up (the roots'
        registers are in preg, vreg, areg) */
     free(sp->tp.node_reg);
     sp->tp.node_reg = NULL;
+    if (!sp->aug) {  /* square: the values' image is all zeros */
+        free(sp->Ax0);
+        sp->Ax0 = NULL;
+    }
     free(sp->proot);
     free(sp->vroot);
     free(sp->aroot);
