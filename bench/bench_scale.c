@@ -51,7 +51,7 @@ enum { NN = 5, DENSE_MAX = 1000, STEPS = 10, TIMEOUT = 150 };
 typedef struct result {
     int ok, n, nnz, rows;
     double load, setup, us_step, cpu_us_step, it_step, min_rcond, rss_mb, sweep_mb, heap_mb,
-        kib_model, kib_analysis, kib_state, kib_tape, ins_loop, reg_loop, klu_factor_us, klu_re_us, dense_us;
+        kib_model, kib_analysis, kib_state, kib_tape, ins_loop, reg_loop, const_loop, klu_factor_us, klu_re_us, dense_us;
     char msg[256];
 } result;
 
@@ -201,10 +201,12 @@ static void heap_breakdown(const mech_model *m, int N, result *r, mech_diag *d)
     solver_plan sp;
     mech_solve_options_default(&o);
     if (solver_plan_init(&sp, m, &o, d) == MECH_OK) {
-        r->kib_tape = ((double)sp.tp.nins * sizeof(tape_ins) + (double)sp.tp.nreg * sizeof(double)) /
+        r->kib_tape = ((double)sp.tp.nins * sizeof(tape_ins) +
+                       (double)sp.tp.nconst * (sizeof(int) + sizeof(double))) /
                       1024.0 / N;
         r->ins_loop = (double)sp.tp.nins / N;
         r->reg_loop = (double)sp.tp.nreg / N;
+        r->const_loop = (double)sp.tp.nconst / N;
     }
     solver_plan_free(&sp);
 }
@@ -416,8 +418,9 @@ int main(int argc, char **argv)
                    r.heap_mb * 1024.0 / N, r.rss_mb * 1024.0 / N);
         if (r.ok)
             printf("heap per loop: model %.2f KiB, analysis %.2f KiB (solver tape %.2f KiB: %.1f "
-                   "instructions, %.1f registers), sweep state and table %.2f KiB\n",
-                   r.kib_model, r.kib_analysis, r.kib_tape, r.ins_loop, r.reg_loop, r.kib_state);
+                   "instructions, %.1f constants; %.1f registers per state), sweep state and "
+                   "table %.2f KiB\n", r.kib_model, r.kib_analysis, r.kib_tape, r.ins_loop,
+                   r.const_loop, r.reg_loop, r.kib_state);
         return r.ok ? 0 : 1;
     }
     if (argc > 2 && strcmp(argv[1], "--yaml") == 0) {
