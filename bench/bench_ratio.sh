@@ -20,30 +20,33 @@ if ! command -v valgrind >/dev/null 2>&1; then
 fi
 TMP=$(mktemp -d "${TMPDIR:-/tmp}/bench_ratio.XXXXXX") || exit 1
 trap 'rm -rf "$TMP"' EXIT INT TERM
-# instructions in function $1 for: bench-hand --count ARGS... (the profile
-# kept in $TMP/profile when $PROFILE is set)
-count() {
+# instructions in function $1 for the command ARGS... (its profile kept in
+# $TMP/profile.$PROFILE when $PROFILE is set)
+collect() {
     fn=$1; shift
     out=/dev/null
-    [ -n "$PROFILE" ] && out=$TMP/profile
+    [ -n "$PROFILE" ] && out=$TMP/profile.$PROFILE
     valgrind --tool=callgrind --toggle-collect="$fn" --callgrind-out-file="$out" \
-        "$HAND" --count "$@" 2>&1 >/dev/null | awk '/Collected/ { print $4 }'
+        "$@" 2>&1 >/dev/null | awk '/Collected/ { print $4 }'
 }
 per_step() {  # fn, name, side [forces]
     fn=$1; shift
-    a=$(count "$fn" "$1" "$2" 3600 $3)
-    b=$(PROFILE= count "$fn" "$1" "$2" 360 $3)
+    a=$(PROFILE=${PROFILE:+a} collect "$fn" "$HAND" --count "$1" "$2" 3600 $3)
+    b=$(PROFILE=${PROFILE:+b} collect "$fn" "$HAND" --count "$1" "$2" 360 $3)
     [ -n "$a" ] && [ -n "$b" ] || { echo "?"; return; }
     echo $(( (a - b) / 3240 ))
 }
-# The cause, from $TMP/profile (3600 steps): self instructions by kind of
-# work, the three largest as "kind share% (instructions per step)".
+# The cause, from the profiles $TMP/profile.a and .b (the long and the short
+# sweep): self instructions by kind of work, the difference over $1 (steps,
+# or steps times loops), the three largest as "kind share% (instructions)".
 cause() {
-    [ -s "$TMP/profile" ] || { echo "(no profile)"; return; }
-    callgrind_annotate "$TMP/profile" 2>/dev/null | awk '
-    /^ *[0-9,]+ +\( *[0-9.]+%\) / {
-        n = $1; gsub(",", "", n); f = $0; sub(/^ *[0-9,]+ +\( *[0-9.]+%\) +/, "", f)
-        if (f ~ /PROGRAM TOTALS/) { total = n; next }
+    [ -s "$TMP/profile.a" ] && [ -s "$TMP/profile.b" ] || { echo "(no profile)"; return; }
+    { callgrind_annotate "$TMP/profile.a" 2>/dev/null | sed 's/^/a /'
+      callgrind_annotate "$TMP/profile.b" 2>/dev/null | sed 's/^/b /'; } | awk -v per="$1" '
+    /^[ab] +[0-9,]+ +\( *[0-9.]+%\) / {
+        w = $1 == "a" ? 1 : -1; sub(/^[ab] /, "")
+        n = $1; gsub(",", "", n); n *= w; f = $0; sub(/^ *[0-9,]+ +\( *[0-9.]+%\) +/, "", f)
+        if (f ~ /PROGRAM TOTALS/) { total += n; next }
         k = "other"
         if (f ~ /run_range|tape_run/) k = "tape dispatch"
         else if (f ~ /sincos|s_sin|s_cos|fenv_private|__sin|__cos/) k = "sin/cos"
@@ -61,7 +64,7 @@ cause() {
             best = ""; for (k in s) if (best == "" || s[k] > s[best]) best = k
             if (best == "") break
             out = out sprintf("%s%s %d%% (%d)", out == "" ? "" : ", ", best,
-                              100 * s[best] / total + 0.5, s[best] / 3600 + 0.5)
+                              100 * s[best] / total + 0.5, s[best] / per + 0.5)
             delete s[best]
         }
         print out }'
@@ -75,18 +78,34 @@ row() {  # name, interpreter, hand-written
 echo "issue 21, target 1: instructions per driver step (callgrind, 3600 - 360 steps over the"
 echo "file's range; positions, velocities, accelerations; tol 1e-12), interpreter (mech_solve)"
 echo "against the hand-written Newton solver (bench-hand); target: ratio <= $TARGET. Cause: the"
-echo "interpreter's own profile of the 3600-step run, largest kinds of work (share, instr/step)"
+echo "interpreter's own profile (3600 - 360 steps), largest kinds of work (share, instr/step)"
 printf '%-20s %11s %11s %6s  %-7s  %s\n' mechanism interpreter hand-written ratio target cause
 for name in fourbar offset-slider-crank conveyor stirling; do
-    i=$(PROFILE=1 per_step mech_solve "$name" interp) c=$(cause)
+    i=$(PROFILE=1 per_step mech_solve "$name" interp) c=$(cause 3240)
     h=$(PROFILE= per_step hand_sweep "$name" hand)
     row "$name" "$i" "$h" "$c"
 done
-i=$(PROFILE=1 per_step mech_solve conveyor interp forces) c=$(cause)
+i=$(PROFILE=1 per_step mech_solve conveyor interp forces) c=$(cause 3240)
 h=$(PROFILE= per_step hand_sweep conveyor hand forces)
 row conveyor+forces "$i" "$h" "$c"
 echo "(conveyor+forces: joint reactions and driver torque, friction off; the hand-written"
 echo "force solver assembles the 15 x 15 Newton-Euler system densely and factors it by dense LU)"
 echo "(the interpreter does the hand-written solver's Newton work, 1.0 iterations and two"
-echo "factorisations per step; the excess is spread over the general code path's kinds of work,"
-echo "none above about a fifth: docs/performance.md, \"Why target 1 is not met\")"
+echo "factorisations per step; the excess is spread over the general code path's kinds of"
+echo "work: docs/performance.md, \"Why target 1 is not met\")"
+# Target 2's instruction profile: a chain of 10 000 four-bars (bench-scale
+# --yaml), mech solve 12 against 4 steps of 2.5 deg inside
+# mech_analysis_solve (set-up, row 0 and the state's allocation cancel);
+# bench-scale's table gives the time and memory against the targets.
+BIN=$(dirname "$HAND")
+if [ -x "$BIN/mech" ] && [ -x "$BIN/bench-scale" ] && "$BIN/bench-scale" --yaml 10000 > "$TMP/chain.yaml"; then
+    a=$(PROFILE=a collect mech_analysis_solve "$BIN/mech" solve "$TMP/chain.yaml" --from 60 --to 90 \
+        --steps 12 -o "$TMP/chain.csv")
+    b=$(PROFILE=b collect mech_analysis_solve "$BIN/mech" solve "$TMP/chain.yaml" --from 60 --to 70 \
+        --steps 4 -o "$TMP/chain.csv")
+    if [ -n "$a" ] && [ -n "$b" ]; then
+        echo "issue 21, target 2 (instructions): chain of 10 000 four-bars, mech solve, per loop and"
+        echo "step (callgrind, 12 - 4 steps of 2.5 deg): $(( (a - b) / 80000 )) instructions; largest"
+        echo "kinds: $(cause 80000)"
+    fi
+fi

@@ -218,16 +218,34 @@ static inline void fresh_cs(kin_state *st, int l)
     }
 }
 
-/* ... for any link, also one kin_update did not place (diagnostics): with
- * the cos and sin of its current angle, without writing the cache */
-static void on_any_link(const kin_state *st, int l, const double *r, double *p, double *v,
-                        double *a)
+/* cos and sin of th, out of line: the rare stale case below */
+static void stale_cs(double th, double *c, double *s)
+{
+    *c = cos(th);
+    *s = sin(th);
+}
+
+/* cos and sin of link l's current angle: the cache's, or for a link whose
+ * cache is stale (one kin_update did not place: diagnostics) computed
+ * without writing it */
+static inline void link_cs(const kin_state *st, int l, double *c, double *s)
 {
     double th = st->th[l];
-    if (th == st->cth[l])
-        on_link(st, l, r, p, v, a);
-    else
-        on_link_cs(st, l, cos(th), sin(th), r, p, v, a);
+    if (th == st->cth[l]) {
+        *c = st->c[l];
+        *s = st->s[l];
+    } else {
+        stale_cs(th, c, s);
+    }
+}
+
+/* ... of any link */
+static inline void on_any_link(const kin_state *st, int l, const double *r, double *p,
+                               double *v, double *a)
+{
+    double c, s;
+    link_cs(st, l, &c, &s);
+    on_link_cs(st, l, c, s, r, p, v, a);
 }
 
 void kin_on_link(const kin_state *st, int l, const double *r, double *p, double *v, double *a)
@@ -328,6 +346,12 @@ void kin_update(const kin_tree *t, kin_state *st, const double *pos, const doubl
     }
 }
 
+void kin_refresh_all(const kin_tree *t, kin_state *st)
+{
+    for (int l = 0; l < t->model->nlinks; l++)
+        fresh_cs(st, l);
+}
+
 void kin_point(const kin_tree *t, const kin_state *st, int name_id, double *p, double *v,
                double *a)
 {
@@ -337,6 +361,6 @@ void kin_point(const kin_tree *t, const kin_state *st, int name_id, double *p, d
         p[0] = p[1] = NAN;
         l = 0;
     }
-    on_any_link(st, l, point_xy(t->model, l, t->point_index[name_id], rbuf), p, v ? v : vb,
+    on_link(st, l, point_xy(t->model, l, t->point_index[name_id], rbuf), p, v ? v : vb,
             a ? a : ab);
 }

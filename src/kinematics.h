@@ -30,8 +30,9 @@ typedef struct kin_state {
     double *th, *om, *al;   /* [nlinks] angle, angular velocity, angular acceleration */
     double *c, *s;          /* [nlinks] cos and sin of cth (ground: 1, 0): computed for
                                the links kin_update places (and their parents) when th
-                               has changed; kin_point and kin_on_link use cos and sin of
-                               th itself when cth is stale */
+                               has changed, for every link by kin_refresh_all;
+                               kin_on_link uses cos and sin of th itself when cth is
+                               stale */
     double *cth;            /* [nlinks] the angle c and s belong to */
     double *o, *vo, *ao;    /* [2 nlinks] frame origin and its rates */
     double *guide;          /* [3 (last slider joint + 1)] a slider's guide angle, its cos
@@ -56,7 +57,12 @@ void kin_update(const kin_tree *t, kin_state *st, const double *pos, const doubl
                 const double *acc);
 
 /* Position p[2], velocity v[2], acceleration a[2] of a point name (v or a may
- * be NULL when not computed). */
+ * be NULL when not computed): of a point on a link kin_update placed (the
+ * outputs' and branches'), or after kin_refresh_all. */
+/* cos and sin of every link's angle (kin_update keeps only those of the
+ * links it places and their parents): before kin_point on any link
+ * (diagnostics). The frames of links not placed stay as they were. */
+void kin_refresh_all(const kin_tree *t, kin_state *st);
 void kin_point(const kin_tree *t, const kin_state *st, int name_id, double *p, double *v,
                double *a);
 

@@ -26,15 +26,20 @@ typedef enum {
     TOP_ADDADD  /* r[d] = r[a] + r[b] + r[c] */
 } tape_op;
 
-/* 16 bytes: the operation and the destination share a word (large systems
- * stream the program from memory every evaluation) */
+/* An instruction as compiling, hoisting and fusing edit it. */
 typedef struct tape_ins {
-    unsigned op : 4;    /* tape_op (TOP_DROPPED: removed while fusing) */
-    unsigned d : 28;    /* so at most TAPE_MAX_REGS registers */
-    int a, b, c;        /* c: the third operand of a superinstruction */
+    int op;             /* tape_op (TOP_DROPPED: removed while fusing) */
+    int d, a, b, c;     /* c: the third operand of a superinstruction */
 } tape_ins;
 
-enum { TOP_DROPPED = 15, TAPE_MAX_REGS = (1 << 28) - 1 };
+/* ... and as the tape keeps and runs it: the operation in a byte array
+ * beside (17 bytes an instruction, not 20: large systems stream the program
+ * from memory every evaluation; the dispatch reads a byte, no unpacking). */
+typedef struct tape_code {
+    int d, a, b, c;
+} tape_code;
+
+enum { TOP_DROPPED = 15 };
 
 enum { TAPE_MAX_PHASES = 4 };
 
@@ -45,7 +50,10 @@ typedef struct tape {
     int nconst;         /* registers holding a nonzero constant (the others start 0) */
     int *const_reg;     /* [nconst] their registers */
     double *const_val;  /* [nconst] their values */
-    tape_ins *ins;      /* [nins] instructions, grouped by phase */
+    unsigned char *op;  /* [nins] each instruction's tape_op, grouped by phase */
+    tape_code *code;    /* [nins] its registers */
+    tape_ins *ins;      /* the editing form: NULL but inside tape_compile, tape_hoist,
+                           tape_fuse */
     int nins;
     int phase_start[TAPE_MAX_PHASES + 1]; /* phase k: phase_start[k] .. phase_start[k+1]-1 */
     int phase_split[TAPE_MAX_PHASES];     /* phase k's instructions before this one depend
