@@ -73,8 +73,9 @@ int kin_tree_build(kin_tree *t, const mech_system *s)
     t->point_link = xcalloc(np, sizeof *t->point_link);
     t->point_index = xcalloc(np, sizeof *t->point_index);
     t->active = xcalloc(nl, sizeof *t->active);
+    t->keep_cs = xcalloc(nl, sizeof *t->keep_cs);
     t->attach = xcalloc(4 * nl, sizeof *t->attach);
-    if (!t->angle_var || !t->slide_var || !t->point_link || !t->point_index || !t->active ||
+    if (!t->angle_var || !t->slide_var || !t->point_link || !t->point_index || !t->active || !t->keep_cs ||
         !t->attach) {
         kin_tree_free(t);
         return MECH_ENOMEM;
@@ -96,6 +97,7 @@ void kin_tree_free(kin_tree *t)
     free(t->point_link);
     free(t->point_index);
     free(t->active);
+    free(t->keep_cs);
     free(t->attach);
     memset(t, 0, sizeof *t);
 }
@@ -218,39 +220,9 @@ static inline void fresh_cs(kin_state *st, int l)
     }
 }
 
-/* cos and sin of th, out of line: the rare stale case below */
-static void stale_cs(double th, double *c, double *s)
-{
-    *c = cos(th);
-    *s = sin(th);
-}
-
-/* cos and sin of link l's current angle: the cache's, or for a link whose
- * cache is stale (one kin_update did not place: diagnostics) computed
- * without writing it */
-static inline void link_cs(const kin_state *st, int l, double *c, double *s)
-{
-    double th = st->th[l];
-    if (th == st->cth[l]) {
-        *c = st->c[l];
-        *s = st->s[l];
-    } else {
-        stale_cs(th, c, s);
-    }
-}
-
-/* ... of any link */
-static inline void on_any_link(const kin_state *st, int l, const double *r, double *p,
-                               double *v, double *a)
-{
-    double c, s;
-    link_cs(st, l, &c, &s);
-    on_link_cs(st, l, c, s, r, p, v, a);
-}
-
 void kin_on_link(const kin_state *st, int l, const double *r, double *p, double *v, double *a)
 {
-    on_any_link(st, l, r, p, v, a);
+    on_link(st, l, r, p, v, a);
 }
 
 /* Place link l so that its point r is at p (with rates v, a). */
@@ -338,12 +310,26 @@ void kin_update(const kin_tree *t, kin_state *st, const double *pos, const doubl
     }
     for (int k = 0; k < t->span->norder; k++) {
         int l = t->span->order[k];
-        if (t->active[l]) {  /* its frame: its own and its parent's cos and sin */
-            fresh_cs(st, t->span->parent_link[l]);
+        if (t->keep_cs[l])  /* a parent comes before its children in the order */
             fresh_cs(st, l);
+        if (t->active[l])
             place_link(t, st, l, pos, vel, acc);
-        }
     }
+}
+
+void kin_tree_finish(kin_tree *t)
+{
+    const mech_model *m = t->model;
+    for (int l = 0; l < m->nlinks; l++)
+        if (t->active[l]) {
+            t->keep_cs[l] = 1;
+            if (t->span->parent_link[l] >= 0)
+                t->keep_cs[t->span->parent_link[l]] = 1;
+        }
+    for (int i = 0; i < m->nsprings; i++)
+        for (int k = 0; k < 2; k++)
+            if (m->springs[i].link[k] >= 0 && m->springs[i].link[k] < m->nlinks)
+                t->keep_cs[m->springs[i].link[k]] = 1;
 }
 
 void kin_refresh_all(const kin_tree *t, kin_state *st)

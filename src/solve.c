@@ -446,6 +446,7 @@ int solver_plan_init(solver_plan *sp, const mech_model *m, const mech_solve_opti
     free(need);
     free(row_on);
     free(col_on);
+    kin_tree_finish(&sp->tree);  /* the active links are chosen */
     if (rc == MECH_ENOMEM)
         return diag_error(d, m->file, (mech_mark){0, 0}, "out of memory"), MECH_ENOMEM;
     if (rc != MECH_OK)
