@@ -202,7 +202,7 @@ static void heap_breakdown(const mech_model *m, int N, result *r, mech_diag *d)
     solver_plan sp;
     mech_solve_options_default(&o);
     if (solver_plan_init(&sp, m, &o, d) == MECH_OK) {
-        r->kib_tape = ((double)sp.tp.nins * (sizeof(tape_code) + 1) +
+        r->kib_tape = ((double)sp.tp.nins * sizeof(tape_ins) +
                        (double)sp.tp.nconst * (sizeof(int) + sizeof(double))) /
                       1024.0 / N;
         r->ins_loop = (double)sp.tp.nins / N;

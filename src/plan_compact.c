@@ -31,7 +31,7 @@ void solver_plan_compact(solver_plan *sp)
     if (!s)
         return;
     size_t freed = s->ex.cap * sizeof(expr_node) + s->ex.tcap * sizeof(int) +
-                   (size_t)s->tp.nins * (sizeof(tape_code) + 1) +
+                   (size_t)s->tp.nins * sizeof(tape_ins) +
                    (size_t)s->tp.nreg * sizeof(double);
     expr_free(&s->ex);  /* every ex below indexes it: all go */
     void *sym[] = {s->f, s->Jx, s->fq, s->vel, s->acc, s->link_angle, s->slide, s->reg};

@@ -11,8 +11,6 @@ void tape_free(tape *t)
     free(t->reg0);
     free(t->const_reg);
     free(t->const_val);
-    free(t->op);
-    free(t->code);
     free(t->ins);
     free(t->var_reg);
     free(t->node_reg);
@@ -138,52 +136,16 @@ static int fuse_sincos(tape *t)
     return 0;
 }
 
-/* The editing form from the stored one (t->ins), or -1 out of memory. */
-static int unpack(tape *t)
-{
-    t->ins = xcalloc((size_t)t->nins + 1, sizeof *t->ins);
-    if (!t->ins)
-        return -1;
-    for (int i = 0; i < t->nins; i++)
-        t->ins[i] = (tape_ins){t->op[i], t->code[i].d, t->code[i].a, t->code[i].b,
-                               t->code[i].c};
-    return 0;
-}
-
-/* Arrays for the stored form of the edited instructions (the old ones are
- * kept until store), or -1 out of memory. */
-static int store_alloc(int nins, unsigned char **op, tape_code **code)
-{
-    *op = xcalloc((size_t)nins + 1, sizeof **op);
-    *code = xcalloc((size_t)nins + 1, sizeof **code);
-    if (*op && *code)
-        return 0;
-    free(*op);
-    free(*code);
-    return -1;
-}
-
-/* The edited instructions into the arrays of store_alloc; the editing form
- * is freed. */
-static void store(tape *t, unsigned char *op, tape_code *code)
-{
-    for (int i = 0; i < t->nins; i++) {
-        op[i] = (unsigned char)t->ins[i].op;
-        code[i] = (tape_code){t->ins[i].d, t->ins[i].a, t->ins[i].b, t->ins[i].c};
-    }
-    free(t->op);
-    free(t->code);
-    free(t->ins);
-    t->op = op;
-    t->code = code;
-    t->ins = NULL;
-}
-
-/* Give back what compiling over-allocated: the image was sized for every
- * node of the DAG (a chain of 10^5 loops: megabytes). A failed shrink keeps
- * the larger block. */
+/* Give back what compiling over-allocated: the instruction array grew by
+ * doubling and the image was sized for every node of the DAG (a chain of
+ * 10^5 loops: megabytes). A failed shrink keeps the larger block. */
 static void trim(tape *t)
 {
+    if (t->nins > 0) {
+        tape_ins *ins = xrealloc_array(t->ins, (size_t)t->nins, sizeof *ins);
+        if (ins)
+            t->ins = ins;
+    }
     if (t->nreg > 0 && t->reg0) {
         double *reg0 = xrealloc_array(t->reg0, (size_t)t->nreg, sizeof *reg0);
         if (reg0)
@@ -311,18 +273,11 @@ static void renumber(tape *t, const ex *const *roots, const int *nroots)
 
 int tape_fuse(tape *t, const ex *const *roots, const int *nroots)
 {
-    if (unpack(t) < 0)
-        return -1;
     int *uses = count_uses(t, roots, nroots);
     int *def = xcalloc((size_t)t->nreg + 1, sizeof *def);  /* 1 + instruction writing reg */
-    int phase_start[TAPE_MAX_PHASES + 1], phase_split[TAPE_MAX_PHASES], nins = t->nins;
-    memcpy(phase_start, t->phase_start, sizeof phase_start);
-    memcpy(phase_split, t->phase_split, sizeof phase_split);
     if (!uses || !def) {
         free(uses);
         free(def);
-        free(t->ins);
-        t->ins = NULL;
         return -1;
     }
     for (int i = 0; i < t->nins; i++)
@@ -338,32 +293,19 @@ int tape_fuse(tape *t, const ex *const *roots, const int *nroots)
     t->phase_start[t->nphases] = t->nins = out;
     free(uses);
     free(def);
-    unsigned char *op;
-    tape_code *code;
-    if (store_alloc(t->nins, &op, &code) < 0) {  /* the stored form is still the old tape */
-        memcpy(t->phase_start, phase_start, sizeof phase_start);
-        memcpy(t->phase_split, phase_split, sizeof phase_split);
-        t->nins = nins;
-        free(t->ins);
-        t->ins = NULL;
-        return -1;
-    }
     renumber(t, roots, nroots);
-    store(t, op, code);
+    trim(t);
     return 0;
 }
 
 void tape_hoist(tape *t, int phase, const unsigned char *invariant)
 {
-    unsigned char *variant = xcalloc((size_t)t->nreg + 1, 1), *op = NULL;
+    unsigned char *variant = xcalloc((size_t)t->nreg + 1, 1);
     tape_ins *moved = xcalloc((size_t)t->nins + 1, sizeof *moved);
-    tape_code *code = NULL;
     int start = t->phase_start[phase], end = t->phase_start[phase + 1];
-    if (!variant || !moved || store_alloc(t->nins, &op, &code) < 0 || unpack(t) < 0) {
-        free(variant);  /* no hoisting: still correct, run whole */
+    if (!variant || !moved) {  /* no hoisting: still correct, run whole */
+        free(variant);
         free(moved);
-        free(op);
-        free(code);
         return;
     }
     for (int v = 0; v < t->nvars; v++)
@@ -394,7 +336,6 @@ void tape_hoist(tape *t, int phase, const unsigned char *invariant)
     t->phase_split[phase] = start + nfixed;
     free(variant);
     free(moved);
-    store(t, op, code);
 }
 
 /* The register image as a list of its constants other than +0 (most
@@ -449,11 +390,8 @@ int tape_compile(tape *t, expr_ctx *c, int nvars, int nphases, const ex *const *
     for (int k = 0; k < nphases; k++)
         t->phase_split[k] = t->phase_start[k];
     free(stack.v);
-    unsigned char *op;
-    tape_code *code;
-    if (fuse_sincos(t) < 0 || constant_list(t) < 0 || store_alloc(t->nins, &op, &code) < 0)
+    if (fuse_sincos(t) < 0 || constant_list(t) < 0)
         goto fail;
-    store(t, op, code);
     trim(t);
     return 0;
 fail:
@@ -464,11 +402,10 @@ fail:
 
 static void run_range(const tape *t, double *r, int from, int to)
 {
-    const unsigned char *op = t->op;
-    const tape_code *code = t->code;
+    const tape_ins *ins = t->ins;
     for (int i = from; i < to; i++) {
-        const tape_code *p = &code[i];
-        switch (op[i]) {
+        const tape_ins *p = &ins[i];
+        switch (p->op) {
         case TOP_ADD: r[p->d] = r[p->a] + r[p->b]; break;
         case TOP_MUL: r[p->d] = r[p->a] * r[p->b]; break;
         case TOP_NEG: r[p->d] = -r[p->a]; break;

@@ -26,18 +26,15 @@ typedef enum {
     TOP_ADDADD  /* r[d] = r[a] + r[b] + r[c] */
 } tape_op;
 
-/* An instruction as compiling, hoisting and fusing edit it. */
+/* 20 bytes. Packing the operation into the destination's word (16 bytes)
+ * or into a byte array beside (17) saved 3-4 bytes an instruction (60-80
+ * bytes a loop of a chain, under 2 % of its memory) but cost one or two
+ * instructions a dispatch (the four-bar +56 per step, docs/performance.md):
+ * not kept. */
 typedef struct tape_ins {
     int op;             /* tape_op (TOP_DROPPED: removed while fusing) */
     int d, a, b, c;     /* c: the third operand of a superinstruction */
 } tape_ins;
-
-/* ... and as the tape keeps and runs it: the operation in a byte array
- * beside (17 bytes an instruction, not 20: large systems stream the program
- * from memory every evaluation; the dispatch reads a byte, no unpacking). */
-typedef struct tape_code {
-    int d, a, b, c;
-} tape_code;
 
 enum { TOP_DROPPED = 15 };
 
@@ -50,10 +47,7 @@ typedef struct tape {
     int nconst;         /* registers holding a nonzero constant (the others start 0) */
     int *const_reg;     /* [nconst] their registers */
     double *const_val;  /* [nconst] their values */
-    unsigned char *op;  /* [nins] each instruction's tape_op, grouped by phase */
-    tape_code *code;    /* [nins] its registers */
-    tape_ins *ins;      /* the editing form: NULL but inside tape_compile, tape_hoist,
-                           tape_fuse */
+    tape_ins *ins;      /* [nins] instructions, grouped by phase */
     int nins;
     int phase_start[TAPE_MAX_PHASES + 1]; /* phase k: phase_start[k] .. phase_start[k+1]-1 */
     int phase_split[TAPE_MAX_PHASES];     /* phase k's instructions before this one depend
