@@ -51,8 +51,9 @@ enum { NN = 5, DENSE_MAX = 1000, STEPS = 10, TIMEOUT = 150 };
 
 typedef struct result {
     int ok, n, nnz, rows;
-    double load, setup, us_step, cpu_us_step, it_step, min_rcond, rss_mb, sweep_mb, heap_mb,
-        kib_model, kib_analysis, kib_state, kib_tape, ins_loop, reg_loop, const_loop, klu_factor_us, klu_re_us, dense_us;
+    double load, setup, us_step, cpu_us_step, it_step, min_rcond, rss_mb, sweep_mb, heap_mb;
+    double kib_model, kib_analysis, kib_state, kib_tape, ins_loop, reg_loop, const_loop;
+    double klu_factor_us, klu_re_us, dense_us;
     char msg[256];
 } result;
 
