@@ -85,6 +85,17 @@ static int place_entries(blocklu_plan *b, const int *Ap, const int *Ai, const in
     }
     b->op[n] = e;
     b->nnz = nnz;
+    unsigned char *hit = xcalloc((size_t)b->ndense + 1, 1);  /* slots covered */
+    if (!hit)
+        return -1;
+    int covered = 0;
+    for (int p = 0; p < nnz; p++)
+        if (b->where[p] < b->ndense && !hit[b->where[p]]) {
+            hit[b->where[p]] = 1;
+            covered++;
+        }
+    free(hit);
+    b->dense_full = covered == b->ndense;
     return 0;
 }
 
@@ -415,7 +426,8 @@ static void column_norms(blocklu *b)
 int blocklu_factor(blocklu *b, const double *Ax)
 {
     const blocklu_plan *pl = b->plan;
-    memset(b->v, 0, (size_t)pl->ndense * sizeof *b->v);
+    if (!pl->dense_full)  /* the structural zeros inside the blocks */
+        memset(b->v, 0, (size_t)pl->ndense * sizeof *b->v);
     b->singular_col = -1;
     for (int p = 0; p < pl->nnz; p++) {
         if (!isfinite(Ax[p]))
