@@ -489,9 +489,9 @@ static void target_table(const int *Ns, const result *r)
     printf("issue 21, target 2: chains of N four-bars, per loop (load average now %.1f on %ld "
            "processors)\n", load_average(), sysconf(_SC_NPROCESSORS_ONLN));
     printf("%-42s %-10s %-11s %-8s %s\n", "target", "goal", "measured", "", "cause");
-    snprintf(cause, sizeof cause, "6 block solves (3 of them the whole-matrix condition "
-             "estimate), 2 evaluations, 2 factorisations, rates; ~3.7k instructions per loop "
-             "(bench_ratio.sh chain row); CPU time moves with the machine's load");
+    snprintf(cause, sizeof cause, "per loop 2 evaluations, 2 factorisations, 4 block solves "
+             "(Newton, rates) and 3 for the whole-matrix condition estimate; instructions and "
+             "their kinds: bench_ratio.sh's chain row; CPU time moves with the load");
     snprintf(m, sizeof m, "%.3f us", cpu4);
     target_row("CPU per step, N = 10 000", "<= 0.25 us", m, cpu4 <= 0.25, cause);
     snprintf(m, sizeof m, "%.3f us", cpu5);
