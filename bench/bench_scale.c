@@ -9,16 +9,18 @@
  *   set-up      mech_solve's set-up (system, tape, blocks, klu_analyze)
  *   per step    mech_solve's sweep time per driver step (60..110 deg, 20 steps):
  *               wall time (stats.seconds, row 0 included) and CPU time
- *               (difference of that sweep and 10 steps over 60..85 deg: the
- *               same step, so that set-up, row 0 and other processes on the
- *               machine matter less)
+ *               (cpu_per_step: the difference of that sweep and 10 steps over
+ *               60..85 deg on analyses built once, the minimum of several:
+ *               the same step, so that set-up, row 0 and other processes on
+ *               the machine matter less)
  *   KLU         one klu_refactor + klu_solve of the Jacobian (2N x 2N)
  *   dense       the same Jacobian by LAPACK dgetrf + dgetrs (N <= 1000; the
  *               cost grows as N^3, N = 10 000 would take ~1000 times longer)
  *
  * A child that takes longer than 150 s is stopped and reported.
- * Usage: bench-scale [SVGDIR]; bench-scale --yaml N > chain.yaml writes the
- * chain of N loops (to run `mech solve` on it, or profile). Not a test. */
+ * Usage: bench-scale [SVGDIR]; bench-scale --only N measures one N; bench-scale
+ * --yaml N > chain.yaml writes the chain of N loops (to run `mech solve` on
+ * it, or profile). Not a test. */
 #include <math.h>
 #include <signal.h>
 #include <stdarg.h>
@@ -31,9 +33,13 @@
 #include <unistd.h>
 
 #include <klu.h>
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 
 #include "bench_util.h"
 #include "mech.h"
+#include "solve.h"
 #include "system.h"
 
 /* LAPACK (Fortran calling convention) */
@@ -45,7 +51,9 @@ enum { NN = 5, DENSE_MAX = 1000, STEPS = 10, TIMEOUT = 150 };
 
 typedef struct result {
     int ok, n, nnz, rows;
-    double load, setup, us_step, cpu_us_step, it_step, min_rcond, rss_mb, klu_factor_us, klu_re_us, dense_us;
+    double load, setup, us_step, cpu_us_step, it_step, min_rcond, rss_mb, sweep_mb, heap_mb;
+    double kib_model, kib_analysis, kib_state, kib_tape, ins_loop, reg_loop, const_loop;
+    double klu_factor_us, klu_re_us, dense_us;
     char msg[256];
 } result;
 
@@ -131,6 +139,122 @@ static char *chain_text(int n, size_t *len)
 
 /* ---- one N, in the child --------------------------------------------------- */
 
+/* Resident memory now (not the peak), MB: /proc/self/statm's second field
+ * (Linux); NAN elsewhere. */
+static double rss_now_mb(void)
+{
+    FILE *f = fopen("/proc/self/statm", "r");
+    long size = 0, res = -1;
+    if (f) {
+        if (fscanf(f, "%ld %ld", &size, &res) != 2)
+            res = -1;
+        fclose(f);
+    }
+    return res < 0 ? NAN : (double)res * (double)sysconf(_SC_PAGESIZE) / (1024.0 * 1024.0);
+}
+
+/* Heap in use now, MB (glibc's mallinfo2: small blocks and mmapped ones);
+ * NAN elsewhere. */
+static double heap_now_mb(void)
+{
+#ifdef __GLIBC__
+    struct mallinfo2 mi = mallinfo2();
+    return (double)(mi.uordblks + mi.hblkhd) / (1024.0 * 1024.0);
+#else
+    return NAN;
+#endif
+}
+
+/* mech_solve's progress callback (after the last row, while the analysis
+ * and the sweep's state are alive): the resident memory of the sweep, once
+ * the set-up has given back what only it needed */
+static void on_progress(void *ctx, int done, int total)
+{
+    (void)done, (void)total;
+    double *mb = ctx, now = rss_now_mb();
+    if (!(*mb >= now))
+        *mb = now;
+    mb[1] = heap_now_mb();
+}
+
+/* Where the heap of a sweep goes, KiB per loop (the cause column of target
+ * 2): the model (measured at load), the analysis (mech_analysis_new: plan,
+ * tape, pattern, columns, after solver_plan_compact), the sweep's state and
+ * table (heap in use during mech_analysis_solve, less the analysis); and the
+ * solver tape's share of the analysis (program and constants' image, from
+ * its own solver_plan_init). */
+static void heap_breakdown(const mech_model *m, int N, result *r, mech_diag *d)
+{
+    mech_solve_options o;
+    mech_solve_options_default(&o);
+    double h0 = heap_now_mb(), mb[2] = {NAN, NAN};
+    o.progress = on_progress;  /* copied by the analysis */
+    o.progress_ctx = mb;
+    mech_analysis *a = NULL;
+    if (mech_analysis_new(m, &o, &a, d) != MECH_OK)
+        return;
+    double h1 = heap_now_mb();
+    mech_table t = {0};
+    mech_analysis_solve(a, NULL, 0, &t, NULL, d);
+    mech_table_free(&t);
+    mech_analysis_free(&a);
+    r->kib_analysis = (h1 - h0) * 1024.0 / N;
+    r->kib_state = (mb[1] - h1) * 1024.0 / N;
+    solver_plan sp;
+    mech_solve_options_default(&o);
+    if (solver_plan_init(&sp, m, &o, d) == MECH_OK) {
+        r->kib_tape = ((double)sp.tp.nins * sizeof(tape_ins) +
+                       (double)sp.tp.nconst * (sizeof(int) + sizeof(double))) /
+                      1024.0 / N;
+        r->ins_loop = (double)sp.tp.nins / N;
+        r->reg_loop = (double)sp.tp.nreg / N;
+        r->const_loop = (double)sp.tp.nconst / N;
+    }
+    solver_plan_free(&sp);
+}
+
+/* CPU time per driver step, us: two analyses built once (2 STEPS steps
+ * over the file's range, STEPS over its first half: the same step, so the
+ * same work per step; row 0 cancels), their sweeps alternated `reps` times,
+ * the difference of the two minima over STEPS. The minimum is what the
+ * step costs when the other processes of a shared machine disturb it
+ * least; NAN when an analysis fails. */
+static double cpu_per_step(const mech_model *m, int reps)
+{
+    mech_analysis *a[2] = {NULL, NULL};
+    double best[2] = {INFINITY, INFINITY};
+    mech_diag d;
+    mech_diag_init(&d);
+    for (int k = 0; k < 2; k++) {
+        mech_solve_options o;
+        mech_solve_options_default(&o);
+        o.has_range = 1;
+        o.from = m->driver.values[0];
+        o.to = m->driver.values[m->driver.nvalues - 1];
+        if (!k)
+            o.to = 0.5 * (o.from + o.to);
+        o.steps = STEPS * (1 + k);
+        if (mech_analysis_new(m, &o, &a[k], &d) != MECH_OK)
+            reps = 0;
+    }
+    for (int rep = 0; rep < reps; rep++)
+        for (int k = 0; k < 2; k++) {
+            mech_table t = {0};
+            double c0 = bench_cpu();
+            int rc = mech_analysis_solve(a[k], NULL, 0, &t, NULL, &d);
+            double c = bench_cpu() - c0;
+            mech_table_free(&t);
+            if (rc != MECH_OK)
+                rep = reps;
+            best[k] = rc == MECH_OK && c < best[k] ? c : best[k];
+        }
+    mech_analysis_free(&a[0]);
+    mech_analysis_free(&a[1]);
+    mech_diag_free(&d);
+    return reps > 0 && isfinite(best[0]) && isfinite(best[1]) ? (best[1] - best[0]) / STEPS * 1e6
+                                                              : NAN;
+}
+
 static void measure(int N, result *r)
 {
     size_t len;
@@ -139,6 +263,7 @@ static void measure(int N, result *r)
     mech_diag_init(&d);
     mech_model *m = NULL;
     mech_summary sum;
+    double h0 = heap_now_mb() - (double)len / (1024.0 * 1024.0);  /* the text is freed below */
     double t0 = bench_now();
     if (mech_load_string(text, len, "chain.yaml", &m, &d) != MECH_OK ||
         mech_check(m, &sum, &d) != MECH_OK) {
@@ -147,6 +272,7 @@ static void measure(int N, result *r)
     }
     r->load = bench_now() - t0;
     free(text);
+    r->kib_model = (heap_now_mb() - h0) * 1024.0 / N;
     /* the sweep: the best of up to 5 runs (fewer for large N); wall time per
        step from mech_solve's stats of 2*STEPS steps over the file's range
        (row 0 included), CPU time per step from the difference between that
@@ -166,6 +292,9 @@ static void measure(int N, result *r)
             if (!twice)
                 o.to = 0.5 * (o.from + o.to);
             o.steps = STEPS * (1 + twice);
+            double sweep_mb[2] = {NAN, NAN};
+            o.progress = on_progress;
+            o.progress_ctx = sweep_mb;
             mech_table t = {0};
             double c0 = bench_cpu();
             if (mech_solve(m, &o, &t, &st, &d) != MECH_OK) {
@@ -175,6 +304,8 @@ static void measure(int N, result *r)
             }
             cpu[twice] = fmin(cpu[twice], bench_cpu() - c0);
             mech_table_free(&t);
+            if (twice && (k == 0 || sweep_mb[0] < r->sweep_mb))
+                r->sweep_mb = sweep_mb[0], r->heap_mb = sweep_mb[1];
             if (twice && st.seconds < best)
                 best = st.seconds, r->setup = st.setup_seconds, full = st;
         }
@@ -245,6 +376,12 @@ static void measure(int N, result *r)
     }
     free(x), free(f), free(J), free(b);
     mech_system_free(&s);
+    /* after the peak is read (two analyses at once): the CPU time of a step
+       with the set-up out of the timed sweeps, and more of them */
+    double cps = cpu_per_step(m, N <= 1000 ? 15 : N <= 10000 ? 9 : 5);
+    if (cps == cps)
+        r->cpu_us_step = cps;
+    heap_breakdown(m, N, r, &d);
     mech_model_free(&m);
     mech_diag_free(&d);
     r->ok = 1;
@@ -295,8 +432,105 @@ static double slope(const int *x, const double *y, int n)
     return k < 2 ? NAN : (k * sxy - sx * sy) / (k * sxx - sx * sx);
 }
 
+static void print_header(void)
+{
+    printf("%7s %7s %8s %8s %8s %10s %10s %7s %9s %8s %8s %11s %11s %12s %8s\n", "N", "unknowns",
+           "nnz", "load s", "setup s", "us/step", "CPU us/st", "it/step", "min rcond", "peak MB",
+           "sweep MB", "KLU fact us", "KLU re+sol", "dense LU us", "dense/KLU");
+}
+
+static void print_row(int N, result *r)
+{
+    if (!r->ok) {
+        printf("%7d  not measured: %s\n", N, r->msg);
+        r->us_step = r->rss_mb = r->sweep_mb = r->klu_re_us = r->load = r->cpu_us_step = NAN;
+        r->dense_us = NAN;
+        return;
+    }
+    printf("%7d %7d %8d %8.3f %8.3f %10.1f %10.1f %7.2f %9.2e %8.1f %8.1f %11.1f %11.1f %12.1f "
+           "%8.1f\n", N, r->n, r->nnz, r->load, r->setup, r->us_step, r->cpu_us_step, r->it_step,
+           r->min_rcond, r->rss_mb, r->sweep_mb, r->klu_factor_us, r->klu_re_us, r->dense_us,
+           r->dense_us / r->klu_re_us);
+    fflush(stdout);
+}
+
+/* The load average over the last minute (/proc/loadavg), or NAN. */
+static double load_average(void)
+{
+    FILE *f = fopen("/proc/loadavg", "r");
+    double l = NAN;
+    if (f) {
+        if (fscanf(f, "%lf", &l) != 1)
+            l = NAN;
+        fclose(f);
+    }
+    return l;
+}
+
+static void target_row(const char *what, const char *goal, const char *measured, int met,
+                       const char *cause)
+{
+    printf("%-42s %-10s %-11s %-8s %s\n", what, goal, measured, met ? "met" : "not met",
+           met ? "" : cause);
+}
+
+/* issue 21, target 2, per loop: CPU time (what this process used, not the
+ * other processes of a loaded machine), its growth with N, and the resident
+ * memory of the sweep; for a target not met, the cause from what this run
+ * measured (heap per part; the machine's load) and the instruction profile
+ * of bench_ratio.sh's chain row (docs/performance.md, "Target 2"). */
+static void target_table(const int *Ns, const result *r)
+{
+    const result *r3 = &r[2], *r4 = &r[3], *r5 = &r[4];
+    double cpu3 = r3->cpu_us_step / Ns[2], cpu4 = r4->cpu_us_step / Ns[3],
+           cpu5 = r5->cpu_us_step / Ns[4];
+    double kib5 = r5->sweep_mb * 1024.0 / Ns[4], heap5 = r5->heap_mb * 1024.0 / Ns[4];
+    char m[64], cause[512];
+    printf("issue 21, target 2: chains of N four-bars, per loop (load average now %.1f on %ld "
+           "processors)\n", load_average(), sysconf(_SC_NPROCESSORS_ONLN));
+    printf("%-42s %-10s %-11s %-8s %s\n", "target", "goal", "measured", "", "cause");
+    snprintf(cause, sizeof cause, "per loop 2 evaluations, 2 factorisations, 4 block solves "
+             "(Newton, rates) and 3 for the whole-matrix condition estimate; instructions and "
+             "their kinds: bench_ratio.sh's chain row; CPU time moves with the load");
+    snprintf(m, sizeof m, "%.3f us", cpu4);
+    target_row("CPU per step, N = 10 000", "<= 0.25 us", m, cpu4 <= 0.25, cause);
+    snprintf(m, sizeof m, "%.3f us", cpu5);
+    target_row("CPU per step, N = 100 000", "<= 0.25 us", m, cpu5 <= 0.25, cause);
+    snprintf(m, sizeof m, "%.2f", cpu5 / cpu3);
+    snprintf(cause, sizeof cause, "beyond the caches: the tape, registers, factors and "
+             "frames of every loop stream from memory each step (%.1f KiB per loop)", heap5);
+    target_row("linear: CPU per loop, 10^5 over 10^3", "<= 1.25", m, cpu5 / cpu3 <= 1.25, cause);
+    snprintf(m, sizeof m, "%.2f KiB", kib5);
+    snprintf(cause, sizeof cause, "heap %.2f KiB: model %.2f (the file's links, points, joints, "
+             "names), analysis %.2f (solver tape %.2f: %.0f instructions; pattern, BTF, spanning "
+             "tree, unknowns' names), sweep state %.2f (%.0f registers, x and 6 rate/work "
+             "vectors, 2x2 factors, link frames, predictor history)", heap5, r5->kib_model,
+             r5->kib_analysis, r5->kib_tape, r5->ins_loop, r5->kib_state, r5->reg_loop);
+    target_row("resident in the sweep, N = 100 000", "<= 1 KiB", m, kib5 <= 1.0, cause);
+    snprintf(m, sizeof m, "%.2f KiB", r5->rss_mb * 1024.0 / Ns[4]);
+    printf("%-42s %-10s %-11s %-8s %s\n", "(peak resident, N = 100 000: set-up)", "-", m, "",
+           "the expression DAG and the system's tape until the solver's tape is compiled, "
+           "freed after (plan_compact.c)");
+}
+
 int main(int argc, char **argv)
 {
+    if (argc > 2 && strcmp(argv[1], "--only") == 0) {  /* one N (to profile or compare) */
+        int N = atoi(argv[2]);
+        result r = run_child(N);
+        print_header();
+        print_row(N, &r);
+        if (r.ok)
+            printf("per loop: CPU %.3f us per step, sweep resident %.2f KiB (heap in use %.2f KiB), "
+                   "peak %.2f KiB\n", r.cpu_us_step / N, r.sweep_mb * 1024.0 / N,
+                   r.heap_mb * 1024.0 / N, r.rss_mb * 1024.0 / N);
+        if (r.ok)
+            printf("heap per loop: model %.2f KiB, analysis %.2f KiB (solver tape %.2f KiB: %.1f "
+                   "instructions, %.1f constants; %.1f registers per state), sweep state and "
+                   "table %.2f KiB\n", r.kib_model, r.kib_analysis, r.kib_tape, r.ins_loop,
+                   r.const_loop, r.reg_loop, r.kib_state);
+        return r.ok ? 0 : 1;
+    }
     if (argc > 2 && strcmp(argv[1], "--yaml") == 0) {
         size_t len;
         char *text = chain_text(atoi(argv[2]), &len);
@@ -309,23 +543,10 @@ int main(int argc, char **argv)
     result r[NN];
     printf("scaling: chains of N four-bar loops (2N unknowns), %d driver steps (2.5 deg); each N in its own\n"
            "process; KLU and dense: one factorisation + solve of the same 2N x 2N Jacobian\n", 2 * STEPS);
-    printf("%7s %7s %8s %8s %8s %10s %10s %7s %9s %8s %11s %11s %12s %8s\n", "N", "unknowns",
-           "nnz", "load s", "setup s", "us/step", "CPU us/st", "it/step", "min rcond", "RSS MB", "KLU fact us",
-           "KLU re+sol", "dense LU us", "dense/KLU");
+    print_header();
     for (int i = 0; i < NN; i++) {
         r[i] = run_child(Ns[i]);
-        if (!r[i].ok) {
-            printf("%7d  not measured: %s\n", Ns[i], r[i].msg);
-            r[i].us_step = r[i].rss_mb = r[i].klu_re_us = r[i].load = r[i].cpu_us_step = NAN;
-            r[i].dense_us = NAN;
-            continue;
-        }
-        printf("%7d %7d %8d %8.3f %8.3f %10.1f %10.1f %7.2f %9.2e %8.1f %11.1f %11.1f %12.1f "
-               "%8.1f\n", Ns[i], r[i].n, r[i].nnz, r[i].load, r[i].setup, r[i].us_step,
-               r[i].cpu_us_step, r[i].it_step,
-               r[i].min_rcond, r[i].rss_mb, r[i].klu_factor_us, r[i].klu_re_us, r[i].dense_us,
-               r[i].dense_us / r[i].klu_re_us);
-        fflush(stdout);
+        print_row(Ns[i], &r[i]);
     }
     double y[7][NN];
     for (int i = 0; i < NN; i++) {
@@ -340,14 +561,7 @@ int main(int argc, char **argv)
            slope(Ns + 1, y[1] + 1, NN - 1),
            slope(Ns + 1, y[3] + 1, NN - 1), slope(Ns + 1, y[5] + 1, NN - 1),
            slope(Ns + 1, y[4] + 1, NN - 1), slope(Ns + 1, y[2] + 1, 2));
-    /* issue 21, target 2: per loop (CPU time: what this process used, not the
-       other processes of a loaded machine) */
-    double cpu4 = r[3].cpu_us_step / Ns[3], cpu5 = r[4].cpu_us_step / Ns[4];
-    double kib5 = r[4].rss_mb * 1024.0 / Ns[4];
-    printf("issue 21, target 2: CPU per loop and step %.3f us at N = 10 000, %.3f us at N = 100 000 "
-           "(target 0.25: %s); peak RSS per loop at N = 100 000 %.1f KiB (target 1 KiB: %s)\n",
-           cpu4, cpu5, cpu4 <= 0.25 && cpu5 <= 0.25 ? "met" : "not met", kib5,
-           kib5 <= 1.0 ? "met" : "not met");
+    target_table(Ns, r);
     if (!svgdir)
         return 0;
     double xs[NN];

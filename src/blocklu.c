@@ -20,7 +20,7 @@ enum { EXACT_NORM_MAX = 8, HAGER_ITERATIONS = 5, WHOLE_HAGER_ITERATIONS = 2 };
 
 void blocklu_plan_free(blocklu_plan *b)
 {
-    void *blocks[] = {b->P, b->Q, b->R, b->at, b->where, b->op, b->oi};
+    void *blocks[] = {b->P, b->Q, b->R, b->at, b->where, b->op, b->oi, b->oj};
     free_all(blocks, COUNT_OF(blocks));
     memset(b, 0, sizeof *b);
 }
@@ -63,9 +63,10 @@ static int place_entries(blocklu_plan *b, const int *Ap, const int *Ai, const in
     }
     b->op = xcalloc((size_t)n + 1, sizeof *b->op);
     b->oi = xcalloc((size_t)above + 1, sizeof *b->oi);
+    b->oj = xcalloc((size_t)above + 1, sizeof *b->oj);
     b->where = xcalloc((size_t)nnz + 1, sizeof *b->where);
     b->nv = b->ndense + above;
-    if (!b->op || !b->oi || !b->where)
+    if (!b->op || !b->oi || !b->oj || !b->where)
         return -1;
     int e = 0;
     for (int k = 0; k < n; k++) {
@@ -77,12 +78,24 @@ static int place_entries(blocklu_plan *b, const int *Ap, const int *Ai, const in
                 b->where[p] = b->at[bk] + (i - k0) + (k - k0) * size;
             } else {
                 b->oi[e] = i;
+                b->oj[e] = k;
                 b->where[p] = b->ndense + e++;
             }
         }
     }
     b->op[n] = e;
     b->nnz = nnz;
+    unsigned char *hit = xcalloc((size_t)b->ndense + 1, 1);  /* slots covered */
+    if (!hit)
+        return -1;
+    int covered = 0;
+    for (int p = 0; p < nnz; p++)
+        if (b->where[p] < b->ndense && !hit[b->where[p]]) {
+            hit[b->where[p]] = 1;
+            covered++;
+        }
+    free(hit);
+    b->dense_full = covered == b->ndense;
     return 0;
 }
 
@@ -248,7 +261,7 @@ static inline void block_solve(const double *a, int k, const int *piv, double *y
 }
 
 /* y := (P^T L U)^-T y = P^T L^-T U^-T y */
-static void block_solve_transposed(const double *a, int k, const int *piv, double *y)
+static void block_solve_transposed_general(const double *a, int k, const int *piv, double *y)
 {
     for (int j = 0; j < k; j++) {
         double s = y[j];
@@ -266,6 +279,23 @@ static void block_solve_transposed(const double *a, int k, const int *piv, doubl
         double t = y[piv[j]];
         y[piv[j]] = y[j];
         y[j] = t;
+    }
+}
+
+/* ... a 2 x 2 block unrolled (the same operations in the same order) */
+static inline void block_solve_transposed(const double *a, int k, const int *piv, double *y)
+{
+    if (k != 2) {
+        block_solve_transposed_general(a, k, piv, y);
+        return;
+    }
+    y[0] = y[0] / a[0];
+    y[1] = (y[1] - a[2] * y[0]) / a[3];
+    y[0] = y[0] - a[1] * y[1];
+    if (piv[0]) {  /* piv[1] is 1: no swap */
+        double t = y[0];
+        y[0] = y[1];
+        y[1] = t;
     }
 }
 
@@ -396,7 +426,8 @@ static void column_norms(blocklu *b)
 int blocklu_factor(blocklu *b, const double *Ax)
 {
     const blocklu_plan *pl = b->plan;
-    memset(b->v, 0, (size_t)pl->ndense * sizeof *b->v);
+    if (!pl->dense_full)  /* the structural zeros inside the blocks */
+        memset(b->v, 0, (size_t)pl->ndense * sizeof *b->v);
     b->singular_col = -1;
     for (int p = 0; p < pl->nnz; p++) {
         if (!isfinite(Ax[p]))
@@ -431,9 +462,8 @@ void blocklu_solve(blocklu *b, double *x)
     for (int k = pl->nblocks - 1; k >= 0 && pl->nblocks > 1; k--) {
         int k0 = pl->R[k], size = pl->R[k + 1] - k0;
         block_solve(b->v + pl->at[k], size, b->piv + k0, y + k0);
-        for (int j = k0; j < k0 + size; j++)
-            for (int p = pl->op[j]; p < pl->op[j + 1]; p++)
-                y[pl->oi[p]] -= above[p] * y[j];
+        for (int p = pl->op[k0]; p < pl->op[k0 + size]; p++)  /* by column, then row */
+            y[pl->oi[p]] -= above[p] * y[pl->oj[p]];
     }
     for (int k = 0; k < pl->n; k++)
         x[pl->Q[k]] = y[k];
@@ -449,9 +479,8 @@ static void solve_transposed(blocklu *b, double *x)
         y[k] = x[pl->Q[k]];
     for (int k = 0; k < pl->nblocks; k++) {
         int k0 = pl->R[k], size = pl->R[k + 1] - k0;
-        for (int j = k0; j < k0 + size; j++)
-            for (int p = pl->op[j]; p < pl->op[j + 1]; p++)
-                y[j] -= above[p] * y[pl->oi[p]];
+        for (int p = pl->op[k0]; p < pl->op[k0 + size]; p++)  /* by column, then row */
+            y[pl->oj[p]] -= above[p] * y[pl->oi[p]];
         block_solve_transposed(b->v + pl->at[k], size, b->piv + k0, y + k0);
     }
     for (int k = 0; k < pl->n; k++)

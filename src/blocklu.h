@@ -24,7 +24,11 @@ typedef struct blocklu_plan {
                                   above the blocks */
     int *op, *oi;              /* [n+1], [above]: entries above the blocks, by permuted
                                   column: their permuted rows; values v[ndense + p] */
+    int *oj;                   /* [above] the permuted column of each (a block's entries
+                                  are op[R[k]] .. op[R[k+1]]-1: one loop for them) */
     int ndense;
+    int dense_full;            /* every slot of the dense blocks is an entry of A (no
+                                  structural zero to clear before factoring) */
     int pq_parity;             /* parity of P and Q together */
 } blocklu_plan;
 

@@ -206,6 +206,7 @@ static void in_line_text(solver *sv, double q, const double *x, char *buf, size_
     memcpy(sv->x, x, (size_t)sv->p->ns * sizeof *sv->x);
     sv->generation++;
     solver_publish(sv, q, 0.0, 0.0);
+    kin_refresh_all(&sv->p->tree, &sv->ks);  /* kin_point on any link below */
     double best = 1.0 - 5e-7;  /* cos of 1e-3 rad */
     buf[0] = '\0';
     for (int j = 0; j < m->njoints; j++) {

@@ -73,8 +73,9 @@ int kin_tree_build(kin_tree *t, const mech_system *s)
     t->point_link = xcalloc(np, sizeof *t->point_link);
     t->point_index = xcalloc(np, sizeof *t->point_index);
     t->active = xcalloc(nl, sizeof *t->active);
+    t->keep_cs = xcalloc(nl, sizeof *t->keep_cs);
     t->attach = xcalloc(4 * nl, sizeof *t->attach);
-    if (!t->angle_var || !t->slide_var || !t->point_link || !t->point_index || !t->active ||
+    if (!t->angle_var || !t->slide_var || !t->point_link || !t->point_index || !t->active || !t->keep_cs ||
         !t->attach) {
         kin_tree_free(t);
         return MECH_ENOMEM;
@@ -96,6 +97,7 @@ void kin_tree_free(kin_tree *t)
     free(t->point_link);
     free(t->point_index);
     free(t->active);
+    free(t->keep_cs);
     free(t->attach);
     memset(t, 0, sizeof *t);
 }
@@ -141,18 +143,23 @@ int kin_state_init(kin_state *st, const mech_model *m)
     st->al = xcalloc(nl, sizeof *st->al);
     st->c = xcalloc(nl, sizeof *st->c);
     st->s = xcalloc(nl, sizeof *st->s);
+    st->cth = xcalloc(nl, sizeof *st->cth);
     st->o = xcalloc(2 * nl, sizeof *st->o);
     st->vo = xcalloc(2 * nl, sizeof *st->vo);
     st->ao = xcalloc(2 * nl, sizeof *st->ao);
-    st->guide = xcalloc(3 * (size_t)m->njoints + 1, sizeof *st->guide);
-    if (!st->th || !st->om || !st->al || !st->c || !st->s || !st->o || !st->vo || !st->ao ||
+    int nguide = 0;  /* joints up to the last slider: a chain of pins needs none */
+    for (int j = 0; j < m->njoints; j++)
+        if (m->joints[j].kind == MECH_JOINT_SLIDER)
+            nguide = j + 1;
+    st->guide = xcalloc(3 * (size_t)nguide + 1, sizeof *st->guide);
+    if (!st->th || !st->om || !st->al || !st->c || !st->s || !st->cth || !st->o || !st->vo || !st->ao ||
         !st->guide) {
         kin_state_free(st);
         return MECH_ENOMEM;
     }
     for (size_t l = 0; l < nl; l++)
         st->c[l] = 1.0;  /* angle 0 until updated; the ground stays so */
-    for (int j = 0; j < m->njoints; j++)
+    for (int j = 0; j < nguide; j++)
         st->guide[3 * j] = NAN;  /* no direction yet */
     return MECH_OK;
 }
@@ -164,6 +171,7 @@ void kin_state_free(kin_state *st)
     free(st->al);
     free(st->c);
     free(st->s);
+    free(st->cth);
     free(st->o);
     free(st->vo);
     free(st->ao);
@@ -173,11 +181,11 @@ void kin_state_free(kin_state *st)
 
 static double var_value(const double *v, int var) { return v && var >= 0 ? v[var] : 0.0; }
 
-/* Point r of link l: position, and rates when the link's rates are known. */
-static inline void on_link(const kin_state *st, int l, const double *r, double *p, double *v,
-                           double *a)
+/* Point r of link l (cos c, sin s of its angle): position, and rates when
+ * the link's rates are known. */
+static inline void on_link_cs(const kin_state *st, int l, double c, double s, const double *r,
+                              double *p, double *v, double *a)
 {
-    double c = st->c[l], s = st->s[l];
     double rx = c * r[0] - s * r[1], ry = s * r[0] + c * r[1];  /* R r */
     double w = st->om[l], al = st->al[l];
     p[0] = st->o[2 * l] + rx;
@@ -189,6 +197,26 @@ static inline void on_link(const kin_state *st, int l, const double *r, double *
     if (a) {
         a[0] = st->ao[2 * l] - al * ry - w * w * rx;
         a[1] = st->ao[2 * l + 1] + al * rx - w * w * ry;
+    }
+}
+
+/* ... with the cached cos and sin (links placed by kin_update: fresh) */
+static inline void on_link(const kin_state *st, int l, const double *r, double *p, double *v,
+                           double *a)
+{
+    on_link_cs(st, l, st->c[l], st->s[l], r, p, v, a);
+}
+
+/* Refresh link l's cos and sin when its angle has changed since they were
+ * computed (the same values the cache held when every link was refreshed at
+ * every update; a NaN angle is recomputed every time, as before). */
+static inline void fresh_cs(kin_state *st, int l)
+{
+    double th = st->th[l];
+    if (th != st->cth[l]) {
+        st->cth[l] = th;
+        st->c[l] = cos(th);  /* once per link and angle: on_link is hot */
+        st->s[l] = sin(th);
     }
 }
 
@@ -276,18 +304,38 @@ void kin_update(const kin_tree *t, kin_state *st, const double *pos, const doubl
     /* angles first: a guide's angle may be needed before its frame */
     for (int k = 0; k < t->span->norder; k++) {
         int l = t->span->order[k], var = t->angle_var[l];
-        double th = var_value(pos, var);
-        if (th != st->th[l]) {  /* c, s belong to th: a link that did not turn keeps them */
-            st->th[l] = th;
-            st->c[l] = cos(th);  /* once per link and angle: on_link is hot */
-            st->s[l] = sin(th);
-        }
+        st->th[l] = var_value(pos, var);  /* c, s: only where needed, below */
         st->om[l] = var_value(vel, var);
         st->al[l] = var_value(acc, var);
     }
-    for (int k = 0; k < t->span->norder; k++)
-        if (t->active[t->span->order[k]])
-            place_link(t, st, t->span->order[k], pos, vel, acc);
+    for (int k = 0; k < t->span->norder; k++) {
+        int l = t->span->order[k];
+        if (t->keep_cs[l])  /* a parent comes before its children in the order */
+            fresh_cs(st, l);
+        if (t->active[l])
+            place_link(t, st, l, pos, vel, acc);
+    }
+}
+
+void kin_tree_finish(kin_tree *t)
+{
+    const mech_model *m = t->model;
+    for (int l = 0; l < m->nlinks; l++)
+        if (t->active[l]) {
+            t->keep_cs[l] = 1;
+            if (t->span->parent_link[l] >= 0)
+                t->keep_cs[t->span->parent_link[l]] = 1;
+        }
+    for (int i = 0; i < m->nsprings; i++)
+        for (int k = 0; k < 2; k++)
+            if (m->springs[i].link[k] >= 0 && m->springs[i].link[k] < m->nlinks)
+                t->keep_cs[m->springs[i].link[k]] = 1;
+}
+
+void kin_refresh_all(const kin_tree *t, kin_state *st)
+{
+    for (int l = 0; l < t->model->nlinks; l++)
+        fresh_cs(st, l);
 }
 
 void kin_point(const kin_tree *t, const kin_state *st, int name_id, double *p, double *v,

@@ -20,6 +20,8 @@ typedef struct kin_tree {
     int *point_link;    /* [npoint_names] the carrier link of a point name nearest the ground */
     int *point_index;   /* [npoint_names] the point's index in that link */
     unsigned char *active; /* [nlinks] frames to compute (kin_mark_point/link) */
+    unsigned char *keep_cs; /* [nlinks] cos and sin kin_update keeps (kin_tree_finish):
+                              the active links, their parents, the springs' links */
     double *attach;     /* [4 nlinks] link l is placed from its parent through the joint's
                            point: at attach[4l], [4l+1] in the parent's frame (revolute: the
                            pin; slider: the guide's point), at [4l+2], [4l+3] in l's */
@@ -28,11 +30,14 @@ typedef struct kin_tree {
 /* Positions, velocities and accelerations of every active link frame. */
 typedef struct kin_state {
     double *th, *om, *al;   /* [nlinks] angle, angular velocity, angular acceleration */
-    double *c, *s;          /* [nlinks] cos and sin of th (ground: 1, 0); kept while th
-                               does not change */
+    double *c, *s;          /* [nlinks] cos and sin of cth (ground: 1, 0): computed by
+                               kin_update for the links of kin_tree.keep_cs when th has
+                               changed, for every link by kin_refresh_all */
+    double *cth;            /* [nlinks] the angle c and s belong to */
     double *o, *vo, *ao;    /* [2 nlinks] frame origin and its rates */
-    double *guide;          /* [3 njoints] a slider's guide angle, its cos and sin, kept
-                               while the angle does not change (a ground guide: always) */
+    double *guide;          /* [3 (last slider joint + 1)] a slider's guide angle, its cos
+                               and sin, kept while the angle does not change (a ground
+                               guide: always) */
 } kin_state;
 
 int kin_tree_build(kin_tree *t, const mech_system *s);
@@ -52,7 +57,16 @@ void kin_update(const kin_tree *t, kin_state *st, const double *pos, const doubl
                 const double *acc);
 
 /* Position p[2], velocity v[2], acceleration a[2] of a point name (v or a may
- * be NULL when not computed). */
+ * be NULL when not computed): of a point on a link kin_update placed (the
+ * outputs' and branches'), or after kin_refresh_all. kin_on_link: the same
+ * for a link of keep_cs (forces: every link; springs: theirs). */
+/* Once the active links are chosen: the links whose cos and sin kin_update
+ * keeps (keep_cs). */
+void kin_tree_finish(kin_tree *t);
+/* cos and sin of every link's angle (kin_update keeps only those of
+ * keep_cs): before kin_point on any link (diagnostics). The frames of links
+ * not placed stay as they were. */
+void kin_refresh_all(const kin_tree *t, kin_state *st);
 void kin_point(const kin_tree *t, const kin_state *st, int name_id, double *p, double *v,
                double *a);
 

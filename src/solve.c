@@ -466,6 +466,7 @@ int solver_plan_init_with(solver_plan *sp, const mech_model *m, const mech_solve
     free(need);
     free(row_on);
     free(col_on);
+    kin_tree_finish(&sp->tree);  /* the active links are chosen */
     if (rc == MECH_ENOMEM)
         return diag_error(d, m->file, (mech_mark){0, 0}, "out of memory"), MECH_ENOMEM;
     if (rc != MECH_OK)
@@ -509,7 +510,8 @@ int solver_init(solver *sv, const solver_plan *sp)
                       (size_t)sp->nnzJ + 1, (size_t)sp->nnz + 1};
     if (xcalloc_doubles(arrays, sizes, 0, COUNT_OF(arrays)) < 0)
         return -1;
-    memcpy(sv->Ax, sp->Ax0, (size_t)sp->nnz * sizeof *sv->Ax);
+    if (sp->Ax0)  /* NULL once compacted when square: zeros, as calloc left them */
+        memcpy(sv->Ax, sp->Ax0, (size_t)sp->nnz * sizeof *sv->Ax);
     if (!(sv->reg = tape_registers_new(&sp->tp)))
         return -1;
     if (sp->ns > 0 && linsys_init(&sv->ls, &sp->lp) != 0)

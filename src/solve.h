@@ -92,6 +92,10 @@ void solver_plan_free(solver_plan *sp);
 int solver_plan_init_with(solver_plan *sp, const mech_model *m, const mech_solve_options *o,
                           mech_system *sys, mech_diag *d);
 double solver_largest_length(const mech_model *m);
+/* plan_compact.c: free what only the set-up needed (the system's DAG,
+ * symbolic rows and tape, LaTeX names, the tape's node map and roots); the
+ * plan still solves, but codegen and sys_eval_* can no longer use it. */
+void solver_plan_compact(solver_plan *sp);
 
 /* A numeric state for the plan (allocates everything a step needs). */
 int solver_init(solver *sv, const solver_plan *sp);

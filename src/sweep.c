@@ -128,6 +128,11 @@ static int build_plans(mech_analysis *a, mech_system *sys, mech_diag *d)
     }
     if (rc != MECH_OK)
         return rc;
+    /* the sweep needs only the compiled plan; a sweep's shared analysis
+       (SYS_REGISTERS) keeps the set-up data: its variants look up their
+       coefficients' registers through it (variant_regs.c) */
+    if (a->sp.sys && a->sp.sys->mode != SYS_REGISTERS)
+        solver_plan_compact(&a->sp);
     column_request rq = {&a->outputs, a->sp.level, a->want_forces, friction_columns(a),
                          a->opt.diagnostics};
     if (columns_build(&a->cols, m, &rq) != MECH_OK)
@@ -202,6 +207,9 @@ void mech_analysis_free(mech_analysis **pa)
 typedef struct analysis_view {
     mech_analysis a;           /* first: the view is used as an analysis */
     mech_system sys;           /* the system's fields, its model the variant's */
+    int *const_reg;            /* the tape's constant list: the base's, then the */
+    double *const_val;         /* coefficients' registers set by analysis_view_set */
+    int nbase, ncap;           /* the base's constants; room in the lists */
 } analysis_view;
 
 mech_analysis *analysis_view_new(const mech_analysis *base, const mech_model *mv)
@@ -219,17 +227,31 @@ mech_analysis *analysis_view_new(const mech_analysis *base, const mech_model *mv
     sp->sys = &v->sys;
     sp->lref = solver_largest_length(mv);
     sp->ftol = sp->opt.tol * sp->lref;
-    sp->tp.reg0 = xcalloc((size_t)sp->tp.nreg + 1, sizeof *sp->tp.reg0);
+    /* the registers a state starts from (tape_registers_new): the base's
+       constants and, appended by analysis_view_set, the coefficients */
+    v->nbase = base->sp.tp.nconst;
+    v->ncap = v->nbase + v->sys.nvars + 1;
+    v->const_reg = xcalloc((size_t)v->ncap, sizeof *v->const_reg);
+    v->const_val = xcalloc((size_t)v->ncap, sizeof *v->const_val);
     sp->unit = xcalloc((size_t)sp->ns + 1, sizeof *sp->unit);
-    int ok = sp->tp.reg0 && sp->unit && kin_tree_build(&sp->tree, &v->sys) == MECH_OK;
+    int ok = v->const_reg && v->const_val && sp->unit &&
+             kin_tree_build(&sp->tree, &v->sys) == MECH_OK;
     if (!ok) {  /* what is not the view's own is the base's: not freed */
-        free(sp->tp.reg0);
+        free(v->const_reg);
+        free(v->const_val);
         free(sp->unit);
         free(v);
         return NULL;
     }
-    memcpy(sp->tp.reg0, base->sp.tp.reg0, (size_t)sp->tp.nreg * sizeof *sp->tp.reg0);
+    if (v->nbase > 0) {
+        memcpy(v->const_reg, base->sp.tp.const_reg, (size_t)v->nbase * sizeof *v->const_reg);
+        memcpy(v->const_val, base->sp.tp.const_val, (size_t)v->nbase * sizeof *v->const_val);
+    }
+    sp->tp.const_reg = v->const_reg;
+    sp->tp.const_val = v->const_val;
+    sp->tp.nconst = v->nbase;
     memcpy(sp->tree.active, base->sp.tree.active, (size_t)mv->nlinks);
+    kin_tree_finish(&sp->tree);  /* the links whose cos and sin are kept, as the base's */
     for (int i = 0; i < sp->ns; i++)  /* as root_registers (solve.c) */
         sp->unit[i] = v->sys.unk_kind[sp->col[i]] == UNK_SLIDE ? sp->lref : 1.0;
     if (a->want_forces) {
@@ -244,7 +266,20 @@ mech_analysis *analysis_view_new(const mech_analysis *base, const mech_model *mv
 
 void analysis_view_set(mech_analysis *view, int var, double value)
 {
-    tape_set_var(&view->sp.tp, view->sp.tp.reg0, var, value);
+    analysis_view *v = (analysis_view *)view;
+    tape *tp = &view->sp.tp;
+    int r = tp->var_reg[var], k = v->nbase;
+    if (r < 0)
+        return;  /* a coefficient the compiled phases do not read */
+    while (k < tp->nconst && v->const_reg[k] != r)
+        k++;
+    if (k == tp->nconst) {
+        if (k >= v->ncap)
+            return;  /* not reached: a register per variable at most */
+        tp->nconst++;
+        v->const_reg[k] = r;
+    }
+    v->const_val[k] = value;
 }
 
 void analysis_view_free(mech_analysis **pv)
@@ -252,7 +287,8 @@ void analysis_view_free(mech_analysis **pv)
     if (!pv || !*pv)
         return;
     analysis_view *v = (analysis_view *)*pv;
-    free(v->a.sp.tp.reg0);
+    free(v->const_reg);
+    free(v->const_val);
     free(v->a.sp.unit);
     kin_tree_free(&v->a.sp.tree);
     free(v);

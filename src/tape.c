@@ -9,6 +9,8 @@
 void tape_free(tape *t)
 {
     free(t->reg0);
+    free(t->const_reg);
+    free(t->const_val);
     free(t->ins);
     free(t->var_reg);
     free(t->node_reg);
@@ -144,7 +146,7 @@ static void trim(tape *t)
         if (ins)
             t->ins = ins;
     }
-    if (t->nreg > 0) {
+    if (t->nreg > 0 && t->reg0) {
         double *reg0 = xrealloc_array(t->reg0, (size_t)t->nreg, sizeof *reg0);
         if (reg0)
             t->reg0 = reg0;
@@ -209,13 +211,64 @@ static int fuse_range(tape *t, const int *uses, const int *def, int from, int to
             if (op < 0)
                 continue;
             *in = (tape_ins){op, in->d, t->ins[p].a, t->ins[p].b, side ? in->a : in->b};
-            t->ins[p].op = -1;  /* dropped */
+            t->ins[p].op = TOP_DROPPED;
         }
     }
     for (int i = from; i < to; i++)
-        if (t->ins[i].op >= 0)
+        if (t->ins[i].op != TOP_DROPPED)
             t->ins[out++] = t->ins[i];
     return out;
+}
+
+/* Number the registers still in use 0, 1, ... in their order: the fused
+ * instructions' results leave holes (a chain of four-bars: 34 registers per
+ * loop, 24 in use), and every register file is nreg long. */
+static void renumber(tape *t, const ex *const *roots, const int *nroots)
+{
+    int *map = xcalloc((size_t)t->nreg + 1, sizeof *map);  /* 0 unused, else new + 1 */
+    if (!map)
+        return;  /* the holes stay: still correct */
+    for (int i = 0; i < t->nins; i++) {
+        const tape_ins *in = &t->ins[i];
+        int k = operands(in->op);
+        map[in->d] = map[in->a] = 1;
+        if (k >= 2 || in->op == TOP_SINCOS)
+            map[in->b] = 1;
+        if (k == 3)
+            map[in->c] = 1;
+    }
+    for (int v = 0; v < t->nvars; v++)
+        if (t->var_reg[v] >= 0)
+            map[t->var_reg[v]] = 1;
+    for (int k = 0; k < t->nconst; k++)
+        map[t->const_reg[k]] = 1;
+    for (int k = 0; k < t->nphases; k++)  /* a root may be a constant 0, in no list */
+        for (int i = 0; i < nroots[k]; i++)
+            map[t->node_reg[roots[k][i]]] = 1;
+    int n = 0;
+    for (int r = 0; r < t->nreg; r++)
+        if (map[r])
+            map[r] = ++n;
+    for (int i = 0; i < t->nins; i++) {
+        tape_ins *in = &t->ins[i];
+        int k = operands(in->op);
+        in->d = map[in->d] - 1;
+        in->a = map[in->a] - 1;
+        if (k >= 2 || in->op == TOP_SINCOS)
+            in->b = map[in->b] - 1;
+        if (k == 3)
+            in->c = map[in->c] - 1;
+    }
+    for (int v = 0; v < t->nvars; v++)
+        if (t->var_reg[v] >= 0)
+            t->var_reg[v] = map[t->var_reg[v]] - 1;
+    for (int k = 0; k < t->nconst; k++)
+        t->const_reg[k] = map[t->const_reg[k]] - 1;
+    for (size_t e = 0; e < t->nnodes; e++)
+        if (t->node_reg[e] >= 0)
+            t->node_reg[e] = map[t->node_reg[e]] - 1;
+    t->nreg = n;
+    free(map);
 }
 
 int tape_fuse(tape *t, const ex *const *roots, const int *nroots)
@@ -240,6 +293,7 @@ int tape_fuse(tape *t, const ex *const *roots, const int *nroots)
     t->phase_start[t->nphases] = t->nins = out;
     free(uses);
     free(def);
+    renumber(t, roots, nroots);
     trim(t);
     return 0;
 }
@@ -284,12 +338,37 @@ void tape_hoist(tape *t, int phase, const unsigned char *invariant)
     free(moved);
 }
 
+/* The register image as a list of its constants other than +0 (most
+ * registers are computed, and the image was copied whole into every
+ * register file); +0 is what calloc gives. */
+static int kept_const(double v) { return !(v == 0.0 && !signbit(v)); }
+
+static int constant_list(tape *t)
+{
+    int n = 0;
+    for (int r = 0; r < t->nreg; r++)
+        n += kept_const(t->reg0[r]);
+    t->const_reg = xcalloc((size_t)n + 1, sizeof *t->const_reg);
+    t->const_val = xcalloc((size_t)n + 1, sizeof *t->const_val);
+    if (!t->const_reg || !t->const_val)
+        return -1;
+    for (int r = 0; r < t->nreg; r++)
+        if (kept_const(t->reg0[r])) {
+            t->const_reg[t->nconst] = r;
+            t->const_val[t->nconst++] = t->reg0[r];
+        }
+    free(t->reg0);
+    t->reg0 = NULL;
+    return 0;
+}
+
 int tape_compile(tape *t, expr_ctx *c, int nvars, int nphases, const ex *const *roots,
                  const int *nroots)
 {
     memset(t, 0, sizeof *t);
     size_t nodes = c->count, cap_ins = 0;
     t->node_reg = xcalloc(nodes, sizeof *t->node_reg);
+    t->nnodes = nodes;
     t->reg0 = xcalloc(nodes, sizeof *t->reg0);      /* at most one register per node */
     t->var_reg = xcalloc((size_t)nvars, sizeof *t->var_reg);
     work_stack stack = {0};
@@ -311,7 +390,7 @@ int tape_compile(tape *t, expr_ctx *c, int nvars, int nphases, const ex *const *
     for (int k = 0; k < nphases; k++)
         t->phase_split[k] = t->phase_start[k];
     free(stack.v);
-    if (fuse_sincos(t) < 0)
+    if (fuse_sincos(t) < 0 || constant_list(t) < 0)
         goto fail;
     trim(t);
     return 0;
@@ -363,7 +442,8 @@ void tape_run_variant(const tape *t, double *reg, int phase)
 double *tape_registers_new(const tape *t)
 {
     double *reg = xcalloc((size_t)t->nreg + 1, sizeof *reg);
-    if (reg && t->nreg > 0)
-        memcpy(reg, t->reg0, (size_t)t->nreg * sizeof *reg);
+    if (reg)
+        for (int k = 0; k < t->nconst; k++)
+            reg[t->const_reg[k]] = t->const_val[k];
     return reg;
 }

@@ -26,16 +26,27 @@ typedef enum {
     TOP_ADDADD  /* r[d] = r[a] + r[b] + r[c] */
 } tape_op;
 
+/* 20 bytes. Packing the operation into the destination's word (16 bytes)
+ * or into a byte array beside (17) saved 3-4 bytes an instruction (60-80
+ * bytes a loop of a chain, under 2 % of its memory) but cost one or two
+ * instructions a dispatch (the four-bar +56 per step, docs/performance.md):
+ * not kept. */
 typedef struct tape_ins {
-    int op;
+    int op;             /* tape_op (TOP_DROPPED: removed while fusing) */
     int d, a, b, c;     /* c: the third operand of a superinstruction */
 } tape_ins;
+
+enum { TOP_DROPPED = 15 };
 
 enum { TAPE_MAX_PHASES = 4 };
 
 typedef struct tape {
-    double *reg0;       /* [nreg] register image: the constants, zero elsewhere */
+    double *reg0;       /* compiling only: [nreg] the constants' register image; then
+                           NULL, the constants kept as the list below */
     int nreg;
+    int nconst;         /* registers holding a nonzero constant (the others start 0) */
+    int *const_reg;     /* [nconst] their registers */
+    double *const_val;  /* [nconst] their values */
     tape_ins *ins;      /* [nins] instructions, grouped by phase */
     int nins;
     int phase_start[TAPE_MAX_PHASES + 1]; /* phase k: phase_start[k] .. phase_start[k+1]-1 */
@@ -44,7 +55,9 @@ typedef struct tape {
     int nphases;
     int *var_reg;       /* [nvars] register of each variable (-1: not used) */
     int nvars;
-    int *node_reg;      /* [DAG nodes] register of a node, -1 when not compiled */
+    int *node_reg;      /* [nnodes] register of a DAG node, -1 when not compiled (or,
+                           after tape_fuse, computed inside a superinstruction) */
+    size_t nnodes;
 } tape;
 
 /* Compile phases of roots: roots[k][0..nroots[k]-1] for k < nphases. Nodes
@@ -61,15 +74,17 @@ void tape_hoist(tape *t, int phase, const unsigned char *invariant);
  * there: (x * y) + z, (x * y) * z, (x + y) + z, the same two roundings in
  * the same order (addition and multiplication commute exactly), so no value
  * changes; one dispatch fewer. The roots (the registers the caller reads)
- * are kept. Call after tape_hoist; 0, or -1 when out of memory (the tape is
- * then unchanged and still correct). */
+ * are kept. The registers are then renumbered densely (those of the fused
+ * results are gone), in the same order: register files made before are
+ * stale (make them after). Call after tape_hoist; 0, or -1
+ * when out of memory (the tape is then unchanged and still correct). */
 int tape_fuse(tape *t, const ex *const *roots, const int *nroots);
 /* Run the instructions of one phase; or only its invariant part, or only
  * the rest (valid while the invariant variables have not changed). */
 void tape_run(const tape *t, double *reg, int phase);
 void tape_run_invariant(const tape *t, double *reg, int phase);
 void tape_run_variant(const tape *t, double *reg, int phase);
-/* A register file for this tape (the image's copy; free() it), or NULL. */
+/* A register file for this tape (zeros and the constants; free() it), or NULL. */
 double *tape_registers_new(const tape *t);
 static inline double tape_value(const tape *t, const double *reg, ex e)
 {

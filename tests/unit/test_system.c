@@ -268,10 +268,15 @@ static void check_fused(const char *path)
     unsigned char *inv = calloc((size_t)nv, 1);
     inv[SYS_VAR_Q(n)] = 1;
     tape_hoist(t, 0, inv);
-    int before = t->nins;
+    int before = t->nins, regs_before = t->nreg;
     cr_assert_eq(tape_fuse(t, roots, nroots), 0);
+    cr_assert(t->nreg < regs_before, "%s: %d registers before fusing, %d after (renumbered)",
+              path, regs_before, t->nreg);
     cr_assert(t->nins < before, "%s: %d instructions before fusing, %d after", path, before,
               t->nins);
+    free(s->reg);  /* the registers are renumbered: a register file made before is stale */
+    s->reg = tape_registers_new(t);
+    cr_assert_not_null(s->reg);
     for (int trial = 0; trial < 10; trial++) {
         random_state(s, mechanism_size(m), vars);
         if (trial % 2) {  /* the solver's way: hoisted part, then the rest */
