@@ -2,12 +2,8 @@
  * a law into a tree, its evaluation, its expression DAG, and the hooks the
  * system and the continuation call.
  *
- * The grammar is that of a quantity expression (units.c):
- *   expr  := term (('+' | '-') term)*
- *   term  := unary (('*' | '/') unary)*
- *   unary := ('-' | '+') unary | power
- *   power := atom ('^' ['-'] integer)?
- *   atom  := number [unit] | name | func '(' expr [',' expr] ')' | '(' expr ')'
+ * The parser is qparse.c's (the grammar and the dimensions of a quantity
+ * expression, as units.c reads them); this file is its backend for laws,
  * with one more name, t (a time, the sweep variable). Parts that do not
  * depend on t are numbers at once (any function: sqrt, sin, cos, tan,
  * atan2); a part that depends on t may be added, subtracted, multiplied,
@@ -16,7 +12,6 @@
  * other operand's default unit under + and -, as in units.c. */
 #include <ctype.h>
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>

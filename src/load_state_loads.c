@@ -1,18 +1,18 @@
 /* src/load_state_loads.c: the loader's part of the loads that depend on
  * the motion (docs/format.md section 10.2). A load component that does not
- * read as a constant quantity is parsed here, with the grammar and the unit
- * rules of units.c's quantity expressions (bare numbers take their
+ * read as a constant quantity is parsed by qparse.c (the grammar and the
+ * unit rules of units.c's quantity expressions: bare numbers take their
  * context's unit, + - min max atan2 need one dimension, sin cos tan an
- * angle, sqrt even powers), plus
+ * angle, sqrt even powers) with this file as its backend, which adds
  *   dotted names of the state: P.x P.y P.vx P.vy P.ax P.ay (a point),
  *     L.angle L.omega L.alpha (a link), J.s J.v J.a (a slider joint),
  *     driver.value driver.speed driver.accel;
- *   functions: abs min max exp log tanh step sign smoothsign(x, eps).
+ *   functions: abs min max exp log tanh step sign smoothsign(x, eps);
+ *   the time t under laws of time.
  * It compiles into the model's state_loads program (src/state_loads.c),
  * folding constants; every error is reported at its line:column. */
 #include <ctype.h>
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>

@@ -1,12 +1,8 @@
 /* src/units.c: physical dimensions, unit names and quantity expressions
  * such as "60 mm", "a21 + 1 cm", "beta - gamma", "120 rpm".
  *
- * Grammar of a quantity expression (docs/format.md, "Values and units"):
- *   expr   := term  (('+' | '-') term)*
- *   term   := unary (('*' | '/') unary)*
- *   unary  := '-' unary | '+' unary | power
- *   power  := atom ('^' ['-'] integer)?
- *   atom   := number [unit] | name | func '(' expr [',' expr] ')' | '(' expr ')'
+ * Quantity expressions are read by qparse.c (the grammar, the dimensions);
+ * this file is its numeric backend. A unit after a number is
  *   unit   := uname ['^' ['-'] integer] (('*' | '/') uname ['^' ['-'] integer])*
  * A bare number (no unit) is "bare": it takes the file's default unit of
  * whatever quantity it turns out to be (the expected quantity at the top,
@@ -94,14 +90,6 @@ int unit_is_name(const char *s, size_t len) { return unit_lookup(s, len) != NULL
 
 int dim_equal(dim a, dim b) { return memcmp(a.e, b.e, sizeof a.e) == 0; }
 
-/* Powers of a unit beyond +-99 would wrap around in a signed char (m^257
- * read as m): they become DIM_BAD (qparse.h), which sticks, and the
- * evaluator reports it. */
-#define DIM_MAX QDIM_MAX
-#define dim_is_bad qdim_is_bad
-#define dim_add qdim_add
-#define dim_scale qdim_scale
-
 static int dim_is_none(dim a) { return dim_equal(a, (dim){{0, 0, 0, 0}}); }
 
 void dim_format(dim d, char *buf, size_t size)
@@ -134,16 +122,13 @@ void dim_format(dim d, char *buf, size_t size)
 
 /* ---- the unit expression parser ---------------------------------- */
 
-#define ident_len qparse_ident_len
-#define skip_space qparse_skip
-
 /* "^2", "^-2": returns 1 and the exponent, or 0 when no '^' follows. */
 static int parse_exponent(const char **ps, int *exp)
 {
-    const char *s = skip_space(*ps);
+    const char *s = qparse_skip(*ps);
     if (*s != '^')
         return 0;
-    s = skip_space(s + 1);
+    s = qparse_skip(s + 1);
     int sign = 1;
     if (*s == '-') {
         sign = -1;
@@ -164,8 +149,8 @@ static int parse_exponent(const char **ps, int *exp)
 /* one unit name with its optional exponent */
 static int unit_factor(const char **ps, double *scale, dim *d)
 {
-    const char *s = skip_space(*ps);
-    size_t n = ident_len(s);
+    const char *s = qparse_skip(*ps);
+    size_t n = qparse_ident_len(s);
     const unit_info *u = n ? unit_lookup(s, n) : NULL;
     if (!u)
         return 0;
@@ -174,7 +159,7 @@ static int unit_factor(const char **ps, double *scale, dim *d)
     if (parse_exponent(&s, &e) < 0)
         return 0;
     *scale = pow(u->scale, e);
-    *d = dim_scale(u->d, e);
+    *d = qdim_scale(u->d, e);
     *ps = s;
     return 1;
 }
@@ -186,7 +171,7 @@ int unit_parse(const char *s, double *scale, dim *d, const char **end)
     if (!unit_factor(&s, &sc, &dd))
         return 0;
     for (;;) {
-        const char *t = skip_space(s);
+        const char *t = qparse_skip(s);
         if (*t != '*' && *t != '/')
             break;
         int div = *t == '/';
@@ -196,7 +181,7 @@ int unit_parse(const char *s, double *scale, dim *d, const char **end)
         if (!unit_factor(&u, &fs, &fd))
             break;  /* "2 mm * a1": the '*' belongs to the expression */
         sc = div ? sc / fs : sc * fs;
-        dd = dim_add(dd, fd, div ? -1 : 1);
+        dd = qdim_add(dd, fd, div ? -1 : 1);
         s = u;
     }
     *scale = sc;
@@ -226,8 +211,8 @@ static int q_unit(qparse *p, const char *u, double *scale, dim *d, const char **
                     (int)n, u);
         return -1;
     }
-    if (known_unit && dim_is_bad(*d)) {
-        qparse_fail(p, u, "unit power out of range (at most %d)", DIM_MAX);
+    if (known_unit && qdim_is_bad(*d)) {
+        qparse_fail(p, u, "unit power out of range (at most %d)", QDIM_MAX);
         return -1;
     }
     if (known_unit)
