@@ -137,11 +137,8 @@ static qv l_call(qparse *p, const char *name, size_t n, const char *at, qv a, qv
     }
     if (IS("sqrt")) {
         dim half;
-        if (qparse_sqrt_dim(a.d, &half) || a.v < 0) {
-            qparse_fail(p, at, a.v < 0 ? "sqrt of a negative value"
-                                       : "sqrt of a quantity whose unit has an odd power");
+        if (qparse_sqrt_dim(p, a, at, 1, &half) < 0)
             return a;
-        }
         return number(sqrt(a.v), half, a.bare);
     }
     /* sin, cos, tan: of an angle (a bare number takes the default angle unit) */

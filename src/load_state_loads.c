@@ -271,10 +271,8 @@ static qv s_call(qparse *p, const char *name, size_t n, const char *at, qv a, qv
         return a;
     }
     if (IS("sqrt")) {
-        if (qparse_sqrt_dim(a.d, &a.d)) {
-            qparse_fail(p, at, "sqrt of a quantity whose unit has an odd power");
+        if (qparse_sqrt_dim(p, a, at, 0, &a.d) < 0)
             return fail_val();
-        }
         a.h = emit(p, SLOP_SQRT, a.h, -1, 0);
         return a;
     }

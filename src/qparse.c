@@ -112,13 +112,18 @@ void qparse_describe(dim d, char *buf, size_t size)
     snprintf(buf, size, "a quantity in %s", u);
 }
 
-int qparse_sqrt_dim(dim d, dim *half)
+int qparse_sqrt_dim(qparse *p, qv a, const char *at, int value_known, dim *half)
 {
+    int odd = 0;
     for (int i = 0; i < NDIMS; i++)
-        if (d.e[i] % 2)
-            return 1;
+        odd |= a.d.e[i] % 2 != 0;
+    if (odd || (value_known && a.v < 0)) {
+        qparse_fail(p, at, value_known && a.v < 0 ? "sqrt of a negative value"
+                                                  : "sqrt of a quantity whose unit has an odd power");
+        return -1;
+    }
     for (int i = 0; i < NDIMS; i++)
-        half->e[i] = (signed char)(d.e[i] / 2);
+        half->e[i] = (signed char)(a.d.e[i] / 2);
     return 0;
 }
 

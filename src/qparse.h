@@ -103,8 +103,9 @@ int qparse_unify(qparse *p, qv *a, qv *b, const char *at, const char *what);
 double qparse_default_scale(const qparse *p, dim d);
 /* "a length (m)", "a pure number", "a quantity in kg*m" */
 void qparse_describe(dim d, char *buf, size_t size);
-/* sqrt: 1 when some power of d is odd; else *half is d / 2 */
-int qparse_sqrt_dim(dim d, dim *half);
+/* sqrt(a) at `at`: its dimension *half; -1 (reported) when a power of a's
+ * is odd or, if value_known, a.v < 0 */
+int qparse_sqrt_dim(qparse *p, qv a, const char *at, int value_known, dim *half);
 int qparse_is_fn(const char *name, size_t n, const char *fn);
 size_t qparse_ident_len(const char *s);
 const char *qparse_skip(const char *s);

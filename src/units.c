@@ -261,11 +261,8 @@ static qv q_call(qparse *p, const char *name, size_t n, const char *at, qv a, qv
     }
     if (IS("sqrt")) {
         dim half;
-        if (qparse_sqrt_dim(a.d, &half) || a.v < 0) {
-            qparse_fail(p, at, a.v < 0 ? "sqrt of a negative value"
-                                       : "sqrt of a quantity whose unit has an odd power");
+        if (qparse_sqrt_dim(p, a, at, 1, &half) < 0)
             return a;
-        }
         a.d = half;
         a.v = sqrt(a.v);
         a.dv = a.v > 0 ? a.dv / (2.0 * a.v) : 0.0;
