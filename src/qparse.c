@@ -34,28 +34,6 @@ void qparse_fail(qparse *p, const char *at, const char *fmt, ...)
     va_end(ap);
 }
 
-size_t qparse_ident_len(const char *s)
-{
-    size_t n = 0;
-    if (!(isalpha((unsigned char)s[0]) || s[0] == '_'))
-        return 0;
-    while (isalnum((unsigned char)s[n]) || s[n] == '_')
-        n++;
-    return n;
-}
-
-const char *qparse_skip(const char *s)
-{
-    while (*s == ' ' || *s == '\t')
-        s++;
-    return s;
-}
-
-int qparse_is_fn(const char *name, size_t n, const char *fn)
-{
-    return n == strlen(fn) && memcmp(name, fn, n) == 0;
-}
-
 /* ---- dimensions ----------------------------------------------------- */
 
 static signed char dim_clamp(int e)

@@ -25,7 +25,9 @@
 #ifndef MECH_QPARSE_H
 #define MECH_QPARSE_H
 
+#include <ctype.h>
 #include <stddef.h>
+#include <string.h>
 
 #include "internal.h"
 
@@ -106,9 +108,30 @@ void qparse_describe(dim d, char *buf, size_t size);
 /* sqrt(a) at `at`: its dimension *half; -1 (reported) when a power of a's
  * is odd or, if value_known, a.v < 0 */
 int qparse_sqrt_dim(qparse *p, qv a, const char *at, int value_known, dim *half);
-int qparse_is_fn(const char *name, size_t n, const char *fn);
-size_t qparse_ident_len(const char *s);
-const char *qparse_skip(const char *s);
+
+/* the length of the word (letter or _, then letters, digits, _) at s, 0 if none */
+static inline size_t qparse_ident_len(const char *s)
+{
+    size_t n = 0;
+    if (!(isalpha((unsigned char)s[0]) || s[0] == '_'))
+        return 0;
+    while (isalnum((unsigned char)s[n]) || s[n] == '_')
+        n++;
+    return n;
+}
+
+/* the n bytes at name are the word fn */
+static inline int qparse_is_fn(const char *name, size_t n, const char *fn)
+{
+    return n == strlen(fn) && memcmp(name, fn, n) == 0;
+}
+
+static inline const char *qparse_skip(const char *s)
+{
+    while (*s == ' ' || *s == '\t')
+        s++;
+    return s;
+}
 
 /* Dimensions whose powers beyond +-99 become DIM_BAD, which sticks
  * (units.c: m^257 must not read as m). */
