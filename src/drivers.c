@@ -2,12 +2,8 @@
  * a law into a tree, its evaluation, its expression DAG, and the hooks the
  * system and the continuation call.
  *
- * The grammar is that of a quantity expression (units.c):
- *   expr  := term (('+' | '-') term)*
- *   term  := unary (('*' | '/') unary)*
- *   unary := ('-' | '+') unary | power
- *   power := atom ('^' ['-'] integer)?
- *   atom  := number [unit] | name | func '(' expr [',' expr] ')' | '(' expr ')'
+ * The parser is qparse.c's (the grammar and the dimensions of a quantity
+ * expression, as units.c reads them); this file is its backend for laws,
  * with one more name, t (a time, the sweep variable). Parts that do not
  * depend on t are numbers at once (any function: sqrt, sin, cos, tan,
  * atan2); a part that depends on t may be added, subtracted, multiplied,
@@ -16,7 +12,6 @@
  * other operand's default unit under + and -, as in units.c. */
 #include <ctype.h>
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -24,83 +19,33 @@
 #include <btf.h>
 
 #include "drivers.h"
+#include "qparse.h"
 #include "system.h"
 
-#define PI 3.14159265358979323846
-
-typedef struct lval {
-    double v;    /* the value when node < 0 */
-    dim d;
-    int bare;
-    int node;    /* -1: a number (v); else the tree node of a part that depends on t */
-} lval;
-
-typedef struct lparser {
-    const char *start, *s;
-    const expr_env *env;
-    struct mech_law *law;
-    char *err;
-    size_t errsize, err_pos;
-    int failed, depth;
-} lparser;
-
-static void lfail(lparser *p, const char *at, const char *fmt, ...) MECH_PRINTF(3, 4);
-static void lfail(lparser *p, const char *at, const char *fmt, ...)
-{
-    if (p->failed)
-        return;
-    p->failed = 1;
-    p->err_pos = (size_t)(at - p->start);
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(p->err, p->errsize, fmt, ap);
-    va_end(ap);
-}
+/* ---- the parser: a backend of qparse.c ------------------------------------
+ * A value is a number (qv.h < 0, qv.v) or the tree node qv.h of a part
+ * that depends on t. The tree goes to p->ctx, the law. */
 
 static const dim NONE = {{0, 0, 0, 0}};
 static const dim TIME = {{0, 0, 1, 0}};
 static const dim ANGLE = {{0, 0, 0, 1}};
 
-static void describe(dim d, char *buf, size_t size)
+static int node(qparse *p, law_op op, int a, int b, double k)
 {
-    for (int q = 0; q < NQUANTITIES; q++)
-        if (dim_equal(d, quantity_get((quantity)q)->d)) {
-            if (q == Q_NUMBER)
-                snprintf(buf, size, "a pure number");
-            else
-                snprintf(buf, size, "%s (%s)", quantity_get((quantity)q)->noun,
-                         quantity_get((quantity)q)->si_unit);
-            return;
-        }
-    char u[64];
-    dim_format(d, u, sizeof u);
-    snprintf(buf, size, "a quantity in %s", u);
-}
-
-static double default_scale(const expr_env *env, dim d)
-{
-    for (int q = 1; q < NQUANTITIES; q++)
-        if (dim_equal(d, quantity_get((quantity)q)->d))
-            return env->units->scale[q];
-    return 1.0;
-}
-
-static int node(lparser *p, law_op op, int a, int b, double k)
-{
-    struct mech_law *l = p->law;
+    struct mech_law *l = p->ctx;
     if (l->n >= LAW_MAX_NODES) {  /* law_eval works in a fixed buffer */
-        lfail(p, p->s, "the law is too long (more than %d operations)", LAW_MAX_NODES);
+        qparse_fail(p, p->s, "the law is too long (more than %d operations)", LAW_MAX_NODES);
         return 0;
     }
     if (op == LAW_CONST && !isfinite(k)) {  /* "t + 0^-1 s": no law */
-        lfail(p, p->s, "value is not a finite number");
+        qparse_fail(p, p->s, "value is not a finite number");
         return 0;
     }
     if (l->n == l->cap) {
         int cap = l->cap ? 2 * l->cap : 16;
         law_node *more = xrealloc_array(l->nodes, (size_t)cap, sizeof *more);
         if (!more) {
-            lfail(p, p->s, "out of memory");
+            qparse_fail(p, p->s, "out of memory");
             return 0;
         }
         l->nodes = more;
@@ -110,267 +55,165 @@ static int node(lparser *p, law_op op, int a, int b, double k)
     return l->n++;
 }
 
-static int as_node(lparser *p, lval a)
+static int as_node(qparse *p, qv a)
 {
-    return a.node >= 0 ? a.node : node(p, LAW_CONST, -1, -1, a.v);
+    return a.h >= 0 ? a.h : node(p, LAW_CONST, -1, -1, a.v);
 }
 
-static lval number(double v, dim d, int bare) { return (lval){v, d, bare, -1}; }
+static qv number(double v, dim d, int bare) { return (qv){v, 0.0, -1, d, bare}; }
 
-static lval scaled(lparser *p, lval a, double k)
+static qv scaled(qparse *p, qv a, double k)
 {
     if (k == 1.0)
         return a;
-    if (a.node < 0)
+    if (a.h < 0)
         return number(a.v * k, a.d, a.bare);
-    a.node = node(p, LAW_MUL, node(p, LAW_CONST, -1, -1, k), a.node, 0.0);
+    a.h = node(p, LAW_MUL, node(p, LAW_CONST, -1, -1, k), a.h, 0.0);
     return a;
 }
 
-static size_t ident_len(const char *s)
+static qv l_constant(qparse *p, double v, double dv)
 {
-    size_t n = 0;
-    if (!(isalpha((unsigned char)s[0]) || s[0] == '_'))
-        return 0;
-    while (isalnum((unsigned char)s[n]) || s[n] == '_')
-        n++;
-    return n;
+    (void)p, (void)dv;
+    return number(v, NONE, 0);
 }
 
-static const char *skip(const char *s)
+/* t is the time here, not the tonne: "10 rad/s * t" has the unit rad/s, so
+ * the unit is read from a copy cut before a word t */
+static int l_unit(qparse *p, const char *u, double *scale, dim *d, const char **end)
 {
-    while (*s == ' ' || *s == '\t')
-        s++;
-    return s;
-}
-
-static lval parse_expr(lparser *p);
-
-static lval parse_number(lparser *p)
-{
-    char *end;
-    double v = strtod(p->s, &end);
-    if (end == p->s || !isfinite(v)) {
-        lfail(p, p->s, end == p->s ? "expected a number" : "number out of range");
-        return number(0, NONE, 1);
-    }
-    p->s = end;
-    const char *u = skip(end), *uend;
-    size_t n = ident_len(u);
-    double scale;
-    dim d;
-    /* t is the time here, not the tonne: "10 rad/s * t" has the unit rad/s,
-       so the unit is read from a copy cut before a word t */
+    (void)p;
     char buf[128];
     size_t len = 0;
     for (; u[len] && len + 1 < sizeof buf; len++) {
         int starts = (isalpha((unsigned char)u[len]) || u[len] == '_') &&
                      (len == 0 || !(isalnum((unsigned char)u[len - 1]) || u[len - 1] == '_'));
-        if (starts && ident_len(u + len) == 1 && u[len] == 't')
+        if (starts && qparse_ident_len(u + len) == 1 && u[len] == 't')
             break;
         buf[len] = u[len];
     }
     buf[len] = '\0';
-    if (n == 0 || !unit_parse(buf, &scale, &d, &uend))
-        return number(v, NONE, 1);
-    p->s = u + (uend - buf);
-    return number(v * scale, d, 0);
+    const char *uend;
+    if (!unit_parse(buf, scale, d, &uend))
+        return 0;
+    *end = u + (uend - buf);
+    return 1;
 }
 
-static int find_param(const expr_env *env, const char *name, size_t n)
+static int l_word(qparse *p, const char *at, size_t n, qv *out)
 {
-    char word[65];
-    if (n >= sizeof word)
-        return -1;
-    memcpy(word, name, n);
-    word[n] = '\0';
-    if (env->param_index)
-        return name_map_get(env->param_index, word);
-    for (int i = 0; i < env->nparams; i++)
-        if (strcmp(env->params[i].name, word) == 0)
-            return i;
-    return -1;
+    if (!(n == 1 && *at == 't'))
+        return 0;
+    *out = (qv){0, 0.0, node(p, LAW_T, -1, -1, 0.0), TIME, 0};
+    return 1;
 }
 
-/* Under + and -: a bare operand takes the other's unit; else equal units. */
-static int unify(lparser *p, lval *a, lval *b, const char *at, char op)
+static qv l_call(qparse *p, const char *name, size_t n, const char *at, qv a, qv b, int two)
 {
-    if (a->bare && !b->bare) {
-        *a = scaled(p, *a, default_scale(p->env, b->d));
-        a->d = b->d, a->bare = 0;
-    } else if (b->bare && !a->bare) {
-        *b = scaled(p, *b, default_scale(p->env, a->d));
-        b->d = a->d, b->bare = 0;
-    } else if (!dim_equal(a->d, b->d)) {
-        char da[96], db[96];
-        describe(a->d, da, sizeof da);
-        describe(b->d, db, sizeof db);
-        lfail(p, at, "cannot %s %s and %s", op == '+' ? "add" : "subtract", da, db);
-        return -1;
-    }
-    return 0;
-}
-
-static lval call(lparser *p, const char *name, size_t n, const char *at)
-{
-    lval a = parse_expr(p), b = number(0, NONE, 1);
-    int two = 0;
-    p->s = skip(p->s);
-    if (*p->s == ',') {
-        p->s++;
-        b = parse_expr(p);
-        two = 1;
-        p->s = skip(p->s);
-    }
-    if (p->failed)
-        return a;
-    if (*p->s != ')') {
-        lfail(p, p->s, "expected ')' to close %.*s(", (int)n, name);
-        return a;
-    }
-    p->s++;
-#define IS(fn) (n == strlen(fn) && memcmp(name, fn, n) == 0)
+#define IS(fn) qparse_is_fn(name, n, fn)
     int known = IS("sin") || IS("cos") || IS("tan") || IS("sqrt") || IS("atan2");
     if (!known) {
-        lfail(p, at, "unknown function '%.*s' (known: sin, cos, tan, sqrt, atan2)", (int)n, name);
+        qparse_fail(p, at, "unknown function '%.*s' (known: sin, cos, tan, sqrt, atan2)", (int)n,
+                    name);
         return a;
     }
     if (two != IS("atan2")) {
-        lfail(p, at, two ? "%.*s takes one argument" : "atan2 takes two arguments: atan2(y, x)",
-              (int)n, name);
+        qparse_fail(p, at,
+                    two ? "%.*s takes one argument" : "atan2 takes two arguments: atan2(y, x)",
+                    (int)n, name);
         return a;
     }
-    if (a.node >= 0 || b.node >= 0) {
+    if (a.h >= 0 || b.h >= 0) {
         if (!(IS("sin") || IS("cos"))) {
-            lfail(p, at, "%.*s of an expression of t: only sin and cos may take t", (int)n,
-                  name);
+            qparse_fail(p, at, "%.*s of an expression of t: only sin and cos may take t", (int)n,
+                        name);
             return a;
         }
     }
     if (IS("atan2")) {
-        if (unify(p, &a, &b, at, '-') < 0)
+        if (qparse_unify(p, &a, &b, at, "subtract") < 0)
             return a;
         return number(atan2(a.v, b.v), ANGLE, 0);
     }
     if (IS("sqrt")) {
-        for (int i = 0; i < NDIMS; i++)
-            if (a.d.e[i] % 2 || a.v < 0) {
-                lfail(p, at, a.v < 0 ? "sqrt of a negative value"
-                                     : "sqrt of a quantity whose unit has an odd power");
-                return a;
-            }
-        for (int i = 0; i < NDIMS; i++)
-            a.d.e[i] = (signed char)(a.d.e[i] / 2);
-        return number(sqrt(a.v), a.d, a.bare);
+        dim half;
+        if (qparse_sqrt_dim(p, a, at, 1, &half) < 0)
+            return a;
+        return number(sqrt(a.v), half, a.bare);
     }
     /* sin, cos, tan: of an angle (a bare number takes the default angle unit) */
     if (a.bare)
         a = scaled(p, a, p->env->units->scale[Q_ANGLE]);
     else if (!dim_equal(a.d, ANGLE) && !dim_equal(a.d, NONE)) {
         char da[96];
-        describe(a.d, da, sizeof da);
-        lfail(p, at, "%.*s needs an angle or a pure number, not %s", (int)n, name, da);
+        qparse_describe(a.d, da, sizeof da);
+        qparse_fail(p, at, "%.*s needs an angle or a pure number, not %s", (int)n, name, da);
         return a;
     }
-    if (a.node < 0)
+    if (a.h < 0)
         return number(IS("sin") ? sin(a.v) : IS("cos") ? cos(a.v) : tan(a.v), NONE, 1);
-    return (lval){0, NONE, 1, node(p, IS("sin") ? LAW_SIN : LAW_COS, a.node, -1, 0.0)};
+    return (qv){0, 0.0, node(p, IS("sin") ? LAW_SIN : LAW_COS, a.h, -1, 0.0), NONE, 1};
 #undef IS
 }
 
-static lval parse_atom(lparser *p)
+static qv l_neg(qparse *p, qv v)
 {
-    p->s = skip(p->s);
-    const char *at = p->s;
-    if (*at == '(') {
-        p->s++;
-        lval v = parse_expr(p);
-        p->s = skip(p->s);
-        if (*p->s != ')')
-            lfail(p, p->s, "expected ')'");
-        else
-            p->s++;
-        return v;
-    }
-    size_t n = ident_len(at);
-    if (n) {
-        p->s = at + n;
-        const char *after = skip(p->s);
-        if (*after == '(') {
-            p->s = after + 1;
-            return call(p, at, n, at);
+    if (v.h < 0)
+        v.v = -v.v;
+    else
+        v.h = node(p, LAW_NEG, v.h, -1, 0.0);
+    return v;
+}
+
+static qv l_add(qparse *p, qv a, qv b, char op, const char *at)
+{
+    (void)at;
+    if (op == '-')
+        b = b.h < 0 ? number(-b.v, b.d, b.bare)
+                    : (qv){0, 0.0, node(p, LAW_NEG, b.h, -1, 0.0), b.d, b.bare};
+    if (a.h < 0 && b.h < 0)
+        a.v += b.v;
+    else
+        a.h = node(p, LAW_ADD, as_node(p, a), as_node(p, b), 0.0);
+    return a;
+}
+
+/* a * b; the dimensions are the caller's */
+static qv mul(qparse *p, qv a, qv b)
+{
+    if (a.h < 0 && b.h < 0)
+        return number(a.v * b.v, NONE, 0);
+    if (a.h < 0 || b.h < 0)  /* a number times an expression of t */
+        return scaled(p, a.h < 0 ? b : a, a.h < 0 ? a.v : b.v);
+    return (qv){0, 0.0, node(p, LAW_MUL, a.h, b.h, 0.0), NONE, 0};
+}
+
+static qv l_mul(qparse *p, qv a, qv b, char op, const char *at)
+{
+    if (op == '/') {
+        if (b.h >= 0) {
+            qparse_fail(p, at, "division by an expression of t (divide by numbers only)");
+            return a;
         }
-        if (n == 1 && *at == 't')
-            return (lval){0, TIME, 0, node(p, LAW_T, -1, -1, 0.0)};
-        if (n == 2 && memcmp(at, "pi", 2) == 0)
-            return number(PI, ANGLE, 0);
-        int k = find_param(p->env, at, n);
-        if (k >= 0)
-            return number(p->env->params[k].value, p->env->params[k].d, p->env->params[k].bare);
-        if (unit_is_name(at, n))
-            lfail(p, at, "unit '%.*s' without a number (write 1 %.*s)", (int)n, at, (int)n, at);
-        else
-            lfail(p, at, "unknown name '%.*s' (not the time t, a function, or a parameter "
-                         "defined under 'parameters')", (int)(n < 64 ? n : 64), at);
-        return number(0, NONE, 1);
+        if (b.v == 0) {
+            qparse_fail(p, at, "division by zero");
+            return a;
+        }
+        b.v = 1.0 / b.v;
     }
-    if (*at == '\0') {
-        lfail(p, at, "value missing");
-        return number(0, NONE, 1);
-    }
-    if (!(isdigit((unsigned char)*at) || *at == '.')) {
-        lfail(p, at, "unexpected '%c'", *at);
-        return number(0, NONE, 1);
-    }
-    return parse_number(p);
+    return mul(p, a, b);
 }
 
-static lval mul(lparser *p, lval a, lval b)
+static qv l_powi(qparse *p, qv a, int e, const char *at)
 {
-    dim d;
-    for (int i = 0; i < NDIMS; i++)
-        d.e[i] = (signed char)(a.d.e[i] + b.d.e[i]);
-    int bare = a.bare && b.bare;
-    if (a.node < 0 && b.node < 0)
-        return number(a.v * b.v, d, bare);
-    if (a.node < 0 || b.node < 0) {  /* a number times an expression of t */
-        lval r = scaled(p, a.node < 0 ? b : a, a.node < 0 ? a.v : b.v);
-        r.d = d, r.bare = bare;
-        return r;
-    }
-    return (lval){0, d, bare, node(p, LAW_MUL, a.node, b.node, 0.0)};
-}
-
-static lval parse_power(lparser *p)
-{
-    lval a = parse_atom(p);
-    const char *at = skip(p->s);
-    if (*at != '^' || p->failed)
-        return a;
-    const char *s = skip(at + 1);
-    int sign = 1, e = 0;
-    if (*s == '-')
-        sign = -1, s++;
-    if (!isdigit((unsigned char)*s)) {
-        lfail(p, at, "expected an integer exponent after '^'");
-        return a;
-    }
-    while (isdigit((unsigned char)*s) && e < 100)
-        e = e * 10 + (*s++ - '0');
-    p->s = s;
-    e *= sign;
-    if (a.node < 0) {
-        dim d;
-        for (int i = 0; i < NDIMS; i++)
-            d.e[i] = (signed char)(a.d.e[i] * e);
-        return number(pow(a.v, e), d, a.bare);
-    }
+    if (a.h < 0)
+        return number(pow(a.v, e), NONE, 0);
     if (e < 0 || e > 64) {
-        lfail(p, at, "a power of an expression of t must be 0 to 64");
+        qparse_fail(p, at, "a power of an expression of t must be 0 to 64");
         return a;
     }
-    lval r = number(1.0, NONE, a.bare);  /* by squaring: t^64 is 7 products */
-    for (lval base = a; e > 0; e >>= 1) {
+    qv r = number(1.0, NONE, a.bare);  /* by squaring: t^64 is 7 products */
+    for (qv base = a; e > 0; e >>= 1) {
         if (e & 1)
             r = mul(p, r, base);
         if (e > 1)
@@ -379,75 +222,22 @@ static lval parse_power(lparser *p)
     return r;
 }
 
-static lval parse_unary(lparser *p)
-{
-    p->s = skip(p->s);
-    if (++p->depth > 64) {
-        lfail(p, p->s, "expression nested too deeply");
-        return number(0, NONE, 1);
-    }
-    lval v;
-    if (*p->s == '-' || *p->s == '+') {
-        int neg = *p->s == '-';
-        p->s++;
-        v = parse_unary(p);
-        if (neg && v.node < 0)
-            v.v = -v.v;
-        else if (neg)
-            v.node = node(p, LAW_NEG, v.node, -1, 0.0);
-    } else {
-        v = parse_power(p);
-    }
-    p->depth--;
-    return v;
-}
-
-static lval parse_term(lparser *p)
-{
-    lval a = parse_unary(p);
-    for (;;) {
-        const char *at = skip(p->s);
-        if (p->failed || (*at != '*' && *at != '/'))
-            return a;
-        p->s = at + 1;
-        lval b = parse_unary(p);
-        if (*at == '/') {
-            if (b.node >= 0) {
-                lfail(p, at, "division by an expression of t (divide by numbers only)");
-                return a;
-            }
-            if (b.v == 0) {
-                lfail(p, at, "division by zero");
-                return a;
-            }
-            for (int i = 0; i < NDIMS; i++)
-                b.d.e[i] = (signed char)-b.d.e[i];
-            b.v = 1.0 / b.v;
-        }
-        a = mul(p, a, b);
-    }
-}
-
-static lval parse_expr(lparser *p)
-{
-    lval a = parse_term(p);
-    for (;;) {
-        const char *at = skip(p->s);
-        if (p->failed || (*at != '+' && *at != '-'))
-            return a;
-        p->s = at + 1;
-        lval b = parse_term(p);
-        if (p->failed || unify(p, &a, &b, at, *at) < 0)
-            return a;
-        if (*at == '-')
-            b = b.node < 0 ? number(-b.v, b.d, b.bare)
-                           : (lval){0, b.d, b.bare, node(p, LAW_NEG, b.node, -1, 0.0)};
-        if (a.node < 0 && b.node < 0)
-            a.v += b.v;
-        else
-            a.node = node(p, LAW_ADD, as_node(p, a), as_node(p, b), 0.0);
-    }
-}
+static const qparse_ops law_ops = {
+    .constant = l_constant,
+    .unit = l_unit,
+    .word = l_word,
+    .call = l_call,
+    .neg = l_neg,
+    .scale = scaled,
+    .add = l_add,
+    .mul = l_mul,
+    .powi = l_powi,
+    .unknown_name = " (not the time t, a function, or a parameter defined under 'parameters')",
+    .unit_alone = 1,
+    .strict_exponent = 0,
+    .checked_dims = 0,
+    .after = "law",
+};
 
 int law_parse(const char *text, quantity want, const expr_env *env, struct mech_law **out,
               char *err, size_t errsize, size_t *err_pos)
@@ -459,21 +249,19 @@ int law_parse(const char *text, quantity want, const expr_env *env, struct mech_
         *err_pos = 0;
         return -1;
     }
-    lparser p = {text, text, env, l, err, errsize, 0, 0, 0};
-    lval v = parse_expr(&p);
-    p.s = skip(p.s);
-    if (!p.failed && *p.s != '\0')
-        lfail(&p, p.s, "unexpected '%c' after the law", *p.s);
+    qparse p;
+    qparse_init(&p, text, env, &law_ops, l, err, errsize);
+    qv v = qparse_run(&p);
     const quantity_info *qi = quantity_get(want);
     if (!p.failed && v.bare)
         v = scaled(&p, v, env->units->scale[want]);
     else if (!p.failed && !dim_equal(v.d, qi->d)) {
         char got[96];
-        describe(v.d, got, sizeof got);
-        lfail(&p, text, "the law must be %s of t, not %s", qi->noun, got);
+        qparse_describe(v.d, got, sizeof got);
+        qparse_fail(&p, text, "the law must be %s of t, not %s", qi->noun, got);
     }
-    if (!p.failed && v.node < 0 && !isfinite(v.v))
-        lfail(&p, text, "value is not a finite number");
+    if (!p.failed && v.h < 0 && !isfinite(v.v))
+        qparse_fail(&p, text, "value is not a finite number");
     if (!p.failed)
         l->root = as_node(&p, v);
     if (p.failed) {

@@ -1,69 +1,36 @@
 /* src/load_state_loads.c: the loader's part of the loads that depend on
  * the motion (docs/format.md section 10.2). A load component that does not
- * read as a constant quantity is parsed here, with the grammar and the unit
- * rules of units.c's quantity expressions (bare numbers take their
+ * read as a constant quantity is parsed by qparse.c (the grammar and the
+ * unit rules of units.c's quantity expressions: bare numbers take their
  * context's unit, + - min max atan2 need one dimension, sin cos tan an
- * angle, sqrt even powers), plus
+ * angle, sqrt even powers) with this file as its backend, which adds
  *   dotted names of the state: P.x P.y P.vx P.vy P.ax P.ay (a point),
  *     L.angle L.omega L.alpha (a link), J.s J.v J.a (a slider joint),
  *     driver.value driver.speed driver.accel;
- *   functions: abs min max exp log tanh step sign smoothsign(x, eps).
+ *   functions: abs min max exp log tanh step sign smoothsign(x, eps);
+ *   the time t under laws of time.
  * It compiles into the model's state_loads program (src/state_loads.c),
  * folding constants; every error is reported at its line:column. */
 #include <ctype.h>
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "load.h"
+#include "qparse.h"
 #include "state_loads.h"
 
-static const double PI = 3.14159265358979323846;
-
-typedef struct sval {
-    int reg;   /* -1: failed */
-    dim d;
-    int bare;  /* a number without unit whose quantity is not known yet */
-} sval;
-
+/* The backend's state (qparse.h: p->ctx). A value is a register, qv.h
+ * (-1: failed). */
 typedef struct sparser {
     loader *ld;
     state_loads *s;
-    const char *start, *p;
-    char err[256];
-    size_t err_pos;
-    int failed;
-    int depth;
     int uses_state;  /* a dotted name or a function units.c does not know was seen */
     int nomem;       /* an allocation failed */
 } sparser;
 
 static const dim NONE = {{0, 0, 0, 0}};
-
-static void sfail(sparser *sp, const char *at, const char *fmt, ...) MECH_PRINTF(3, 4);
-static void sfail(sparser *sp, const char *at, const char *fmt, ...)
-{
-    if (sp->failed)
-        return;
-    sp->failed = 1;
-    sp->err_pos = (size_t)(at - sp->start);
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(sp->err, sizeof sp->err, fmt, ap);
-    va_end(ap);
-}
-
-static size_t ident_len(const char *s)
-{
-    size_t n = 0;
-    if (!(isalpha((unsigned char)s[0]) || s[0] == '_'))
-        return 0;
-    while (isalnum((unsigned char)s[n]) || s[n] == '_')
-        n++;
-    return n;
-}
 
 /* With laws of time (`sweep: {time}`, MECH_DRIVE_TIME) a load may read the
  * time as `t`, as the drivers' laws do: the word `t` is then the time, never
@@ -80,94 +47,49 @@ static const char *time_word(const loader *ld, const char *s)
     return NULL;
 }
 
-static const char *skip_space(const char *s)
-{
-    while (*s == ' ' || *s == '\t')
-        s++;
-    return s;
-}
-
-static dim dim_combine(dim a, dim b, int sign)
-{
-    dim r;
-    for (int i = 0; i < NDIMS; i++)
-        r.e[i] = (signed char)(a.e[i] + sign * b.e[i]);
-    return r;
-}
-
 static int dim_none(dim d) { return dim_equal(d, NONE); }
 
-static double default_scale(const sparser *sp, dim d)
-{
-    for (int q = 1; q < NQUANTITIES; q++)
-        if (dim_equal(d, quantity_get((quantity)q)->d))
-            return sp->ld->units.scale[q];
-    return 1.0;
-}
+static qv fail_val(void) { return (qv){0, 0.0, -1, {{0, 0, 0, 0}}, 1}; }
 
-static void describe_dim(dim d, char *buf, size_t size)
-{
-    for (int q = 0; q < NQUANTITIES; q++)
-        if (dim_equal(d, quantity_get((quantity)q)->d)) {
-            if (q == Q_NUMBER)
-                snprintf(buf, size, "a pure number");
-            else
-                snprintf(buf, size, "%s (%s)", quantity_get((quantity)q)->noun,
-                         quantity_get((quantity)q)->si_unit);
-            return;
-        }
-    char u[64];
-    dim_format(d, u, sizeof u);
-    snprintf(buf, size, "a quantity in %s", u);
-}
+static qv reg_val(int reg, dim d, int bare) { return (qv){0, 0.0, reg, d, bare}; }
 
-static sval fail_val(void) { return (sval){-1, NONE, 1}; }
-
-static int emit(sparser *sp, int op, int a, int b, int k)
+static int emit(qparse *p, int op, int a, int b, int k)
 {
-    if (sp->failed || a < 0 || (b < -1))
+    sparser *sp = p->ctx;
+    if (p->failed || a < 0 || (b < -1))
         return -1;
     int r = sl_emit(sp->s, op, a, b, k);
     if (r < 0)
-        sp->nomem = 1, sfail(sp, sp->p, "out of memory");
+        sp->nomem = 1, qparse_fail(p, p->s, "out of memory");
     return r;
 }
 
-static int constant(sparser *sp, double v)
+static int constant(qparse *p, double v)
 {
+    sparser *sp = p->ctx;
     int r = sl_const(sp->s, v);
     if (r < 0)
-        sp->nomem = 1, sfail(sp, sp->p, "out of memory");
+        sp->nomem = 1, qparse_fail(p, p->s, "out of memory");
     return r;
+}
+
+/* a bare value taking the unit k times SI */
+static qv s_scale(qparse *p, qv a, double k)
+{
+    if (k != 1.0)
+        a.h = emit(p, SLOP_MUL, a.h, constant(p, k), 0);
+    return a;
 }
 
 /* A bare value given dimension d: times the default unit of d. */
-static void adopt(sparser *sp, sval *a, dim d)
+static void adopt(qparse *p, qv *a, dim d)
 {
-    double k = default_scale(sp, d);
-    if (k != 1.0)
-        a->reg = emit(sp, SLOP_MUL, a->reg, constant(sp, k), 0);
+    *a = s_scale(p, *a, qparse_default_scale(p, d));
     a->d = d;
     a->bare = 0;
 }
 
-/* Under + - min max atan2 smoothsign: one dimension; a bare operand takes
- * the other's. */
-static void unify(sparser *sp, sval *a, sval *b, const char *at, const char *what)
-{
-    if (a->bare && !b->bare)
-        adopt(sp, a, b->d);
-    else if (b->bare && !a->bare)
-        adopt(sp, b, a->d);
-    else if (!dim_equal(a->d, b->d)) {
-        char da[96], db[96];
-        describe_dim(a->d, da, sizeof da);
-        describe_dim(b->d, db, sizeof db);
-        sfail(sp, at, "cannot %s %s and %s", what, da, db);
-    }
-}
 
-static sval parse_expr(sparser *sp);
 
 /* ---- names of the state -------------------------------------------- */
 
@@ -205,23 +127,25 @@ static void list_members(const member *ms, size_t n, char *buf, size_t size)
         at += (size_t)snprintf(buf + at, size - at, "%s%s", i ? ", " : "", ms[i].name);
 }
 
-static sval input(sparser *sp, int kind, int index, quantity q)
+static qv input(qparse *p, int kind, int index, quantity q)
 {
+    sparser *sp = p->ctx;
     int r = sl_input_reg(sp->s, kind, index);
     if (r < 0)
-        sp->nomem = 1, sfail(sp, sp->p, "out of memory");
-    return (sval){r, quantity_get(q)->d, 0};
+        sp->nomem = 1, qparse_fail(p, p->s, "out of memory");
+    return reg_val(r, quantity_get(q)->d, 0);
 }
 
 /* NAME.MEMBER at `at` (name n bytes, member at mem, mlen bytes). */
-static sval dotted(sparser *sp, const char *at, size_t n, const char *mem, size_t mlen)
+static qv s_dotted(qparse *p, const char *at, size_t n, const char *mem, size_t mlen)
 {
+    sparser *sp = p->ctx;
     loader *ld = sp->ld;
     const mech_model *m = ld->m;
     char name[MAX_NAME + 1], list[128];
     sp->uses_state = 1;
     if (n > MAX_NAME) {
-        sfail(sp, at, "name too long");
+        qparse_fail(p, at, "name too long");
         return fail_val();
     }
     memcpy(name, at, n);
@@ -235,7 +159,7 @@ static sval dotted(sparser *sp, const char *at, size_t n, const char *mem, size_
         const member *dm = find_member(driver_members, COUNT(driver_members), mem, mlen);
         if (!dm || !m->has_driver) {
             list_members(driver_members, COUNT(driver_members), list, sizeof list);
-            sfail(sp, mem, m->has_driver ? "the driver has no '%.*s' (it has: %s)"
+            qparse_fail(p, mem, m->has_driver ? "the driver has no '%.*s' (it has: %s)"
                                          : "no driver to read '%.*s' of (%s)",
                   (int)mlen, mem, list);
             return fail_val();
@@ -243,7 +167,7 @@ static sval dotted(sparser *sp, const char *at, size_t n, const char *mem, size_
         quantity q = dm->q;
         if (m->driver.kind == MECH_DRIVE_TIME) {  /* the sweep variable is the time */
             if (dm->kind != SLIN_DRIVER) {
-                sfail(sp, mem, "with laws of time the driver's value is the time t and has no "
+                qparse_fail(p, mem, "with laws of time the driver's value is the time t and has no "
                                "'%.*s': read the driven links' or sliders' rates instead",
                       (int)mlen, mem);
                 return fail_val();
@@ -253,19 +177,19 @@ static sval dotted(sparser *sp, const char *at, size_t n, const char *mem, size_
         if (m->driver.kind == MECH_DRIVE_SLIDER)
             q = dm->kind == SLIN_DRIVER ? Q_LENGTH
                 : dm->kind == SLIN_DRIVER_SPEED ? Q_SPEED : Q_ACCELERATION;
-        return input(sp, dm->kind, 0, q);
+        return input(p, dm->kind, 0, q);
     }
     if (pm && pt >= 0)
-        return input(sp, pm->kind, pt, pm->q);
+        return input(p, pm->kind, pt, pm->q);
     if (lm && li >= 0) {
         if (li == 0) {
-            sfail(sp, at, "the ground does not move: '%s.%.*s' is always 0", name, (int)mlen, mem);
+            qparse_fail(p, at, "the ground does not move: '%s.%.*s' is always 0", name, (int)mlen, mem);
             return fail_val();
         }
-        return input(sp, lm->kind, li, lm->q);
+        return input(p, lm->kind, li, lm->q);
     }
     if (jm && jt >= 0 && m->joints[jt].kind == MECH_JOINT_SLIDER)
-        return input(sp, jm->kind, jt, jm->q);
+        return input(p, jm->kind, jt, jm->q);
     /* the name is something, but not with that member */
     const member *ms = pt >= 0 ? point_members : li >= 0 ? link_members : jt >= 0 ? slider_members
                                                                               : NULL;
@@ -274,11 +198,11 @@ static sval dotted(sparser *sp, const char *at, size_t n, const char *mem, size_
                                                              : COUNT(slider_members);
         const char *what = pt >= 0 ? "point" : li >= 0 ? "link" : "joint";
         if (jt >= 0 && pt < 0 && li < 0 && m->joints[jt].kind != MECH_JOINT_SLIDER)
-            sfail(sp, at, "'%s' is a revolute joint: it has no value to read (a slider has s, "
+            qparse_fail(p, at, "'%s' is a revolute joint: it has no value to read (a slider has s, "
                           "v, a)", name);
         else {
             list_members(ms, nm, list, sizeof list);
-            sfail(sp, mem, "%s '%s' has no '%.*s' (it has: %s)", what, name, (int)mlen, mem, list);
+            qparse_fail(p, mem, "%s '%s' has no '%.*s' (it has: %s)", what, name, (int)mlen, mem, list);
         }
         return fail_val();
     }
@@ -292,148 +216,106 @@ static sval dotted(sparser *sp, const char *at, size_t n, const char *mem, size_
         near = nearest_name(name, links, k);
     }
     if (near)
-        sfail(sp, at, "unknown name '%s' in '%s.%.*s' (did you mean '%s'?)", name, name,
+        qparse_fail(p, at, "unknown name '%s' in '%s.%.*s' (did you mean '%s'?)", name, name,
               (int)mlen, mem, near);
     else
-        sfail(sp, at, "unknown name '%s' in '%s.%.*s' (not a point, link, slider or 'driver')",
+        qparse_fail(p, at, "unknown name '%s' in '%s.%.*s' (not a point, link, slider or 'driver')",
               name, name, (int)mlen, mem);
     return fail_val();
 }
 
 /* ---- functions ------------------------------------------------------ */
 
-static int is_fn(const char *name, size_t n, const char *fn)
+static const char *const new_fns[] = {"abs", "min", "max", "exp", "log", "tanh",
+                                      "step", "sign", "smoothsign"};
+
+static void s_call_start(qparse *p, const char *name, size_t n)
 {
-    return n == strlen(fn) && memcmp(name, fn, n) == 0;
+    sparser *sp = p->ctx;
+    for (size_t i = 0; i < COUNT(new_fns); i++)
+        if (qparse_is_fn(name, n, new_fns[i]))
+            sp->uses_state = 1;
 }
 
-static sval call(sparser *sp, const char *name, size_t n, const char *at)
+static qv s_call(qparse *p, const char *name, size_t n, const char *at, qv a, qv b, int two)
 {
-    static const char *const new_fns[] = {"abs", "min", "max", "exp", "log", "tanh",
-                                          "step", "sign", "smoothsign"};
-    for (size_t i = 0; i < COUNT(new_fns); i++)
-        if (is_fn(name, n, new_fns[i]))
-            sp->uses_state = 1;
-    sval a = parse_expr(sp), b = {-1, NONE, 1};
-    int two = 0;
-    sp->p = skip_space(sp->p);
-    if (*sp->p == ',') {
-        sp->p++;
-        b = parse_expr(sp);
-        two = 1;
-        sp->p = skip_space(sp->p);
-    }
-    if (sp->failed)
-        return fail_val();
-    if (*sp->p != ')') {
-        sfail(sp, sp->p, "expected ')' to close %.*s(", (int)n, name);
-        return fail_val();
-    }
-    sp->p++;
+    sparser *sp = p->ctx;
     const dim angle = quantity_get(Q_ANGLE)->d;
-    int wants_two = is_fn(name, n, "atan2") || is_fn(name, n, "min") || is_fn(name, n, "max") ||
-                    is_fn(name, n, "smoothsign");
-    int known = wants_two || is_fn(name, n, "sqrt") || is_fn(name, n, "sin") ||
-                is_fn(name, n, "cos") || is_fn(name, n, "tan");
+#define IS(fn) qparse_is_fn(name, n, fn)
+    int wants_two = IS("atan2") || IS("min") || IS("max") || IS("smoothsign");
+    int known = wants_two || IS("sqrt") || IS("sin") || IS("cos") || IS("tan");
     for (size_t i = 0; i < COUNT(new_fns); i++)
-        known |= is_fn(name, n, new_fns[i]);
+        known |= IS(new_fns[i]);
     if (!known) {
-        sfail(sp, at, "unknown function '%.*s' (known: sqrt, sin, cos, tan, atan2, abs, min, "
-                      "max, exp, log, tanh, step, sign, smoothsign)", (int)n, name);
+        qparse_fail(p, at, "unknown function '%.*s' (known: sqrt, sin, cos, tan, atan2, abs, "
+                           "min, max, exp, log, tanh, step, sign, smoothsign)", (int)n, name);
         return fail_val();
     }
     if (wants_two != two) {
-        sfail(sp, at, wants_two ? "%.*s takes two arguments" : "%.*s takes one argument",
-              (int)n, name);
+        qparse_fail(p, at, wants_two ? "%.*s takes two arguments" : "%.*s takes one argument",
+                    (int)n, name);
         return fail_val();
     }
     if (wants_two) {
-        unify(sp, &a, &b, at, is_fn(name, n, "atan2") ? "compare" : "compare");
-        if (is_fn(name, n, "atan2"))
-            return (sval){emit(sp, SLOP_ATAN2, a.reg, b.reg, 0), angle, 0};
-        if (is_fn(name, n, "smoothsign")) {
-            if (sl_is_const(sp->s, b.reg) && !(sp->s->reg0[b.reg] > 0.0)) {
-                sfail(sp, at, "smoothsign(x, eps) needs eps > 0");
+        qparse_unify(p, &a, &b, at, "compare");
+        if (IS("atan2"))
+            return reg_val(emit(p, SLOP_ATAN2, a.h, b.h, 0), angle, 0);
+        if (IS("smoothsign")) {
+            if (sl_is_const(sp->s, b.h) && !(sp->s->reg0[b.h] > 0.0)) {
+                qparse_fail(p, at, "smoothsign(x, eps) needs eps > 0");
                 return fail_val();
             }
-            return (sval){emit(sp, SLOP_SMOOTHSIGN, a.reg, b.reg, 0), NONE, 1};
+            return reg_val(emit(p, SLOP_SMOOTHSIGN, a.h, b.h, 0), NONE, 1);
         }
-        a.reg = emit(sp, is_fn(name, n, "min") ? SLOP_MIN : SLOP_MAX, a.reg, b.reg, 0);
+        a.h = emit(p, IS("min") ? SLOP_MIN : SLOP_MAX, a.h, b.h, 0);
         return a;
     }
-    if (is_fn(name, n, "sqrt")) {
-        for (int i = 0; i < NDIMS; i++)
-            if (a.d.e[i] % 2) {
-                sfail(sp, at, "sqrt of a quantity whose unit has an odd power");
-                return fail_val();
-            }
-        for (int i = 0; i < NDIMS; i++)
-            a.d.e[i] = (signed char)(a.d.e[i] / 2);
-        a.reg = emit(sp, SLOP_SQRT, a.reg, -1, 0);
+    if (IS("sqrt")) {
+        if (qparse_sqrt_dim(p, a, at, 0, &a.d) < 0)
+            return fail_val();
+        a.h = emit(p, SLOP_SQRT, a.h, -1, 0);
         return a;
     }
-    if (is_fn(name, n, "sin") || is_fn(name, n, "cos") || is_fn(name, n, "tan")) {
+    if (IS("sin") || IS("cos") || IS("tan")) {
         if (a.bare)
-            adopt(sp, &a, angle);
+            adopt(p, &a, angle);
         else if (!dim_equal(a.d, angle) && !dim_none(a.d)) {
-            sfail(sp, at, "%.*s needs an angle", (int)n, name);
+            qparse_fail(p, at, "%.*s needs an angle", (int)n, name);
             return fail_val();
         }
-        int op = is_fn(name, n, "sin") ? SLOP_SIN : is_fn(name, n, "cos") ? SLOP_COS : SLOP_TAN;
-        return (sval){emit(sp, op, a.reg, -1, 0), NONE, 1};
+        int op = IS("sin") ? SLOP_SIN : IS("cos") ? SLOP_COS : SLOP_TAN;
+        return reg_val(emit(p, op, a.h, -1, 0), NONE, 1);
     }
-    if (is_fn(name, n, "abs")) {
-        a.reg = emit(sp, SLOP_ABS, a.reg, -1, 0);
+    if (IS("abs")) {
+        a.h = emit(p, SLOP_ABS, a.h, -1, 0);
         return a;
     }
-    if (is_fn(name, n, "step") || is_fn(name, n, "sign"))
-        return (sval){emit(sp, is_fn(name, n, "step") ? SLOP_STEP : SLOP_SIGN, a.reg, -1, 0),
-                      NONE, 1};
+    if (IS("step") || IS("sign"))
+        return reg_val(emit(p, IS("step") ? SLOP_STEP : SLOP_SIGN, a.h, -1, 0), NONE, 1);
     /* exp, log, tanh: of a pure number */
     if (!a.bare && !dim_none(a.d)) {
         char da[96];
-        describe_dim(a.d, da, sizeof da);
-        sfail(sp, at, "%.*s needs a pure number, got %s (divide by a reference value)", (int)n,
-              name, da);
+        qparse_describe(a.d, da, sizeof da);
+        qparse_fail(p, at, "%.*s needs a pure number, got %s (divide by a reference value)",
+                    (int)n, name, da);
         return fail_val();
     }
-    int op = is_fn(name, n, "exp") ? SLOP_EXP : is_fn(name, n, "log") ? SLOP_LOG : SLOP_TANH;
-    return (sval){emit(sp, op, a.reg, -1, 0), NONE, 1};
+    int op = IS("exp") ? SLOP_EXP : IS("log") ? SLOP_LOG : SLOP_TANH;
+    return reg_val(emit(p, op, a.h, -1, 0), NONE, 1);
+#undef IS
 }
 
-/* ---- the grammar (units.c's) -------------------------------------- */
+/* ---- the rest of the backend of qparse.c ---------------------------- */
 
-static int param_index(const sparser *sp, const char *name, size_t n)
+static qv s_constant(qparse *p, double v, double dv)
 {
-    char word[MAX_NAME + 1];
-    if (n > MAX_NAME)
-        return -1;
-    memcpy(word, name, n);
-    word[n] = '\0';
-    const expr_env *env = &sp->ld->env;
-    if (env->param_index)
-        return name_map_get(env->param_index, word);
-    for (int i = 0; i < env->nparams; i++)
-        if (strcmp(env->params[i].name, word) == 0)
-            return i;
-    return -1;
+    (void)dv;
+    return reg_val(constant(p, v), NONE, 0);
 }
 
-static sval parse_number(sparser *sp)
+static int s_unit(qparse *p, const char *u, double *scale, dim *d, const char **end)
 {
-    const char *s = sp->p;
-    char *end;
-    double v = strtod(s, &end);
-    if (end == s || !isfinite(v)) {
-        sfail(sp, s, end == s ? "expected a number" : "number out of range");
-        return fail_val();
-    }
-    sp->p = end;
-    const char *u = skip_space(end);
-    if (ident_len(u) == 0)
-        return (sval){constant(sp, v), NONE, 1};
-    double scale;
-    dim d;
+    sparser *sp = p->ctx;
     const char *uend, *tw = time_word(sp->ld, u);
     char unit[128];
     if (tw) {  /* the unit ends before `t` and the operator in front of it */
@@ -447,159 +329,75 @@ static sval parse_number(sparser *sp)
         unit[len] = '\0';
     }
     if (tw && unit[0] == '\0')
-        return (sval){constant(sp, v), NONE, 1};  /* `2 * t`: a bare number */
-    if (!unit_parse(tw ? unit : u, &scale, &d, &uend)) {
-        sfail(sp, u, "unknown unit '%.*s'", (int)ident_len(u), u);
-        return fail_val();
+        return 0;  /* `2 * t`: a bare number */
+    if (!unit_parse(tw ? unit : u, scale, d, &uend)) {
+        qparse_fail(p, u, "unknown unit '%.*s'", (int)qparse_ident_len(u), u);
+        return -1;
     }
-    sp->p = tw ? u + (uend - unit) : uend;
-    return (sval){constant(sp, v * scale), d, 0};
+    *end = tw ? u + (uend - unit) : uend;
+    return 1;
 }
 
-static sval parse_atom(sparser *sp)
+static int s_word(qparse *p, const char *at, size_t n, qv *out)
 {
-    sp->p = skip_space(sp->p);
-    const char *at = sp->p;
-    if (*at == '(') {
-        sp->p++;
-        sval v = parse_expr(sp);
-        sp->p = skip_space(sp->p);
-        if (*sp->p != ')')
-            sfail(sp, sp->p, "expected ')'");
-        else
-            sp->p++;
-        return v;
-    }
-    size_t n = ident_len(at);
-    if (n) {
-        sp->p = at + n;
-        if (*sp->p == '.') {
-            const char *mem = sp->p + 1;
-            size_t ml = ident_len(mem);
-            if (!ml) {
-                sfail(sp, mem, "expected a name after '.'");
-                return fail_val();
-            }
-            sp->p = mem + ml;
-            return dotted(sp, at, n, mem, ml);
-        }
-        const char *after = skip_space(sp->p);
-        if (*after == '(') {
-            sp->p = after + 1;
-            return call(sp, at, n, at);
-        }
-        if (n == 1 && time_word(sp->ld, at) == at) {  /* the time of laws of time */
-            sp->uses_state = 1;
-            return input(sp, SLIN_DRIVER, 0, Q_TIME);
-        }
-        if (n == 2 && memcmp(at, "pi", 2) == 0)
-            return (sval){constant(sp, PI), quantity_get(Q_ANGLE)->d, 0};
-        int found = param_index(sp, at, n);
-        if (found >= 0) {
-            const expr_param *q = &sp->ld->env.params[found];
-            return (sval){constant(sp, q->value), q->d, q->bare};
-        }
-        sfail(sp, at, "unknown name '%.*s' (not a unit, a function, a parameter defined above, "
-                      "or NAME.MEMBER of the motion)", (int)(n < 64 ? n : 64), at);
-        return fail_val();
-    }
-    if (*at == '\0') {
-        sfail(sp, at, "value missing");
-        return fail_val();
-    }
-    if (!(isdigit((unsigned char)*at) || *at == '.')) {
-        sfail(sp, at, "unexpected '%c'", *at);
-        return fail_val();
-    }
-    return parse_number(sp);
+    sparser *sp = p->ctx;
+    if (!(n == 1 && time_word(sp->ld, at) == at))
+        return 0;
+    sp->uses_state = 1;  /* the time of laws of time */
+    *out = input(p, SLIN_DRIVER, 0, Q_TIME);
+    return 1;
 }
 
-static sval parse_power(sparser *sp)
+static qv s_neg(qparse *p, qv v)
 {
-    sval a = parse_atom(sp);
-    const char *s = skip_space(sp->p);
-    if (*s != '^')
-        return a;
-    const char *at = s;
-    s = skip_space(s + 1);
-    int sign = 1, e = 0;
-    if (*s == '-')
-        sign = -1, s++;
-    if (!isdigit((unsigned char)*s)) {
-        sfail(sp, at, "expected an integer exponent after '^'");
-        return fail_val();
-    }
-    while (isdigit((unsigned char)*s) && e < 100)
-        e = e * 10 + (*s++ - '0');
-    if (e >= 100) {
-        sfail(sp, at, "expected an integer exponent after '^'");
-        return fail_val();
-    }
-    sp->p = s;
-    e *= sign;
-    for (int i = 0; i < NDIMS; i++)
-        a.d.e[i] = (signed char)(a.d.e[i] * e);
-    a.reg = emit(sp, SLOP_POWI, a.reg, -1, e);
-    return a;
-}
-
-static sval parse_unary(sparser *sp)
-{
-    sp->p = skip_space(sp->p);
-    if (++sp->depth > 64) {
-        sfail(sp, sp->p, "expression nested too deeply");
-        return fail_val();
-    }
-    sval v;
-    if (*sp->p == '-' || *sp->p == '+') {
-        int neg = *sp->p == '-';
-        sp->p++;
-        v = parse_unary(sp);
-        if (neg)
-            v.reg = emit(sp, SLOP_NEG, v.reg, -1, 0);
-    } else {
-        v = parse_power(sp);
-    }
-    sp->depth--;
+    v.h = emit(p, SLOP_NEG, v.h, -1, 0);
     return v;
 }
 
-static sval parse_term(sparser *sp)
+static qv s_add(qparse *p, qv a, qv b, char op, const char *at)
 {
-    sval a = parse_unary(sp);
-    for (;;) {
-        const char *at = skip_space(sp->p);
-        if (sp->failed || (*at != '*' && *at != '/'))
-            return a;
-        sp->p = at + 1;
-        sval b = parse_unary(sp);
-        if (sp->failed)
-            return a;
-        if (*at == '/' && sl_is_const(sp->s, b.reg) && sp->s->reg0[b.reg] == 0.0) {
-            sfail(sp, at, "division by zero");
-            return a;
-        }
-        a.reg = emit(sp, *at == '*' ? SLOP_MUL : SLOP_DIV, a.reg, b.reg, 0);
-        a.d = dim_combine(a.d, b.d, *at == '*' ? 1 : -1);
-        a.bare = a.bare && b.bare;
-    }
+    (void)at;
+    a.h = emit(p, op == '+' ? SLOP_ADD : SLOP_SUB, a.h, b.h, 0);
+    return a;
 }
 
-static sval parse_expr(sparser *sp)
+static qv s_mul(qparse *p, qv a, qv b, char op, const char *at)
 {
-    sval a = parse_term(sp);
-    for (;;) {
-        const char *at = skip_space(sp->p);
-        if (sp->failed || (*at != '+' && *at != '-'))
-            return a;
-        sp->p = at + 1;
-        sval b = parse_term(sp);
-        if (sp->failed)
-            return a;
-        unify(sp, &a, &b, at, *at == '+' ? "add" : "subtract");
-        a.reg = emit(sp, *at == '+' ? SLOP_ADD : SLOP_SUB, a.reg, b.reg, 0);
+    sparser *sp = p->ctx;
+    if (op == '/' && sl_is_const(sp->s, b.h) && sp->s->reg0[b.h] == 0.0) {
+        qparse_fail(p, at, "division by zero");
+        return a;
     }
+    a.h = emit(p, op == '*' ? SLOP_MUL : SLOP_DIV, a.h, b.h, 0);
+    return a;
 }
+
+static qv s_powi(qparse *p, qv a, int e, const char *at)
+{
+    (void)at;
+    a.h = emit(p, SLOP_POWI, a.h, -1, e);
+    return a;
+}
+
+static const qparse_ops state_ops = {
+    .constant = s_constant,
+    .unit = s_unit,
+    .word = s_word,
+    .dotted = s_dotted,
+    .call_start = s_call_start,
+    .call = s_call,
+    .neg = s_neg,
+    .scale = s_scale,
+    .add = s_add,
+    .mul = s_mul,
+    .powi = s_powi,
+    .unknown_name = " (not a unit, a function, a parameter defined above, or NAME.MEMBER of "
+                    "the motion)",
+    .unit_alone = 0,
+    .strict_exponent = 1,
+    .checked_dims = 0,
+    .after = "value",
+};
 
 /* ---- load components ---------------------------------------------- */
 
@@ -630,22 +428,22 @@ static int component(loader *ld, const ynode *n, quantity q, const char *what)
             load_err(ld, n, "out of memory");
         return r;
     }
-    sparser sp = {ld, s, n->text, n->text, "", 0, 0, 0, 0, 0};
-    sval r = parse_expr(&sp);
-    sp.p = skip_space(sp.p);
-    if (!sp.failed && *sp.p != '\0')
-        sfail(&sp, sp.p, "unexpected '%c' after the value", *sp.p);
-    if (!sp.failed) {
+    sparser sp = {ld, s, 0, 0};
+    char err[256] = "";
+    qparse p;
+    qparse_init(&p, n->text, &ld->env, &state_ops, &sp, err, sizeof err);
+    qv r = qparse_run(&p);
+    if (!p.failed) {
         if (r.bare)
-            adopt(&sp, &r, quantity_get(q)->d);
+            adopt(&p, &r, quantity_get(q)->d);
         else if (!dim_equal(r.d, quantity_get(q)->d)) {
             char got[96];
-            describe_dim(r.d, got, sizeof got);
-            sfail(&sp, sp.start, "expected %s, got %s", quantity_get(q)->noun, got);
+            qparse_describe(r.d, got, sizeof got);
+            qparse_fail(&p, p.start, "expected %s, got %s", quantity_get(q)->noun, got);
         }
     }
-    if (!sp.failed && r.reg >= 0)
-        return r.reg;
+    if (!p.failed && r.h >= 0)
+        return r.h;
     if (sp.nomem)
         return load_err(ld, n, "out of memory"), -1;
     if (!sp.uses_state) {  /* nothing of the motion: units.c's own message */
@@ -656,8 +454,8 @@ static int component(loader *ld, const ynode *n, quantity q, const char *what)
         return -1;
     mech_mark at = n->mark;
     if (!strchr(n->text, '\n'))
-        at.col += (int)sp.err_pos + (n->quoted ? 1 : 0);
-    diag_error(ld->d, ld->file, at, "%s: %s", what, sp.err);
+        at.col += (int)p.err_pos + (n->quoted ? 1 : 0);
+    diag_error(ld->d, ld->file, at, "%s: %s", what, err);
     return -1;
 }
 

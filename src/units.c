@@ -1,12 +1,8 @@
 /* src/units.c: physical dimensions, unit names and quantity expressions
  * such as "60 mm", "a21 + 1 cm", "beta - gamma", "120 rpm".
  *
- * Grammar of a quantity expression (docs/format.md, "Values and units"):
- *   expr   := term  (('+' | '-') term)*
- *   term   := unary (('*' | '/') unary)*
- *   unary  := '-' unary | '+' unary | power
- *   power  := atom ('^' ['-'] integer)?
- *   atom   := number [unit] | name | func '(' expr [',' expr] ')' | '(' expr ')'
+ * Quantity expressions are read by qparse.c (the grammar, the dimensions);
+ * this file is its numeric backend. A unit after a number is
  *   unit   := uname ['^' ['-'] integer] (('*' | '/') uname ['^' ['-'] integer])*
  * A bare number (no unit) is "bare": it takes the file's default unit of
  * whatever quantity it turns out to be (the expected quantity at the top,
@@ -20,8 +16,9 @@
 #include <strings.h>
 
 #include "internal.h"
+#include "qparse.h"
 
-#define PI 3.14159265358979323846
+#define PI QPARSE_PI
 
 /* ORDER Q */
 static const quantity_info quantity_table[NQUANTITIES] = {
@@ -93,37 +90,6 @@ int unit_is_name(const char *s, size_t len) { return unit_lookup(s, len) != NULL
 
 int dim_equal(dim a, dim b) { return memcmp(a.e, b.e, sizeof a.e) == 0; }
 
-/* Powers of a unit beyond +-99 would wrap around in a signed char (m^257
- * read as m): they become DIM_BAD, which sticks, and the evaluator reports it. */
-enum { DIM_MAX = 99, DIM_BAD = 127 };
-
-static signed char dim_clamp(int e) { return e > DIM_MAX || e < -DIM_MAX ? DIM_BAD : (signed char)e; }
-
-static int dim_is_bad(dim a)
-{
-    for (int i = 0; i < NDIMS; i++)
-        if (a.e[i] == DIM_BAD)
-            return 1;
-    return 0;
-}
-
-static dim dim_add(dim a, dim b, int sign)
-{
-    dim r;
-    for (int i = 0; i < NDIMS; i++)
-        r.e[i] = a.e[i] == DIM_BAD || b.e[i] == DIM_BAD ? DIM_BAD
-                                                        : dim_clamp(a.e[i] + sign * b.e[i]);
-    return r;
-}
-
-static dim dim_scale(dim a, int k)
-{
-    dim r;
-    for (int i = 0; i < NDIMS; i++)
-        r.e[i] = a.e[i] == DIM_BAD ? DIM_BAD : dim_clamp(a.e[i] * k);
-    return r;
-}
-
 static int dim_is_none(dim a) { return dim_equal(a, (dim){{0, 0, 0, 0}}); }
 
 void dim_format(dim d, char *buf, size_t size)
@@ -156,30 +122,13 @@ void dim_format(dim d, char *buf, size_t size)
 
 /* ---- the unit expression parser ---------------------------------- */
 
-static size_t ident_len(const char *s)
-{
-    size_t n = 0;
-    if (!(isalpha((unsigned char)s[0]) || s[0] == '_'))
-        return 0;
-    while (isalnum((unsigned char)s[n]) || s[n] == '_')
-        n++;
-    return n;
-}
-
-static const char *skip_space(const char *s)
-{
-    while (*s == ' ' || *s == '\t')
-        s++;
-    return s;
-}
-
 /* "^2", "^-2": returns 1 and the exponent, or 0 when no '^' follows. */
 static int parse_exponent(const char **ps, int *exp)
 {
-    const char *s = skip_space(*ps);
+    const char *s = qparse_skip(*ps);
     if (*s != '^')
         return 0;
-    s = skip_space(s + 1);
+    s = qparse_skip(s + 1);
     int sign = 1;
     if (*s == '-') {
         sign = -1;
@@ -200,8 +149,8 @@ static int parse_exponent(const char **ps, int *exp)
 /* one unit name with its optional exponent */
 static int unit_factor(const char **ps, double *scale, dim *d)
 {
-    const char *s = skip_space(*ps);
-    size_t n = ident_len(s);
+    const char *s = qparse_skip(*ps);
+    size_t n = qparse_ident_len(s);
     const unit_info *u = n ? unit_lookup(s, n) : NULL;
     if (!u)
         return 0;
@@ -210,7 +159,7 @@ static int unit_factor(const char **ps, double *scale, dim *d)
     if (parse_exponent(&s, &e) < 0)
         return 0;
     *scale = pow(u->scale, e);
-    *d = dim_scale(u->d, e);
+    *d = qdim_scale(u->d, e);
     *ps = s;
     return 1;
 }
@@ -222,7 +171,7 @@ int unit_parse(const char *s, double *scale, dim *d, const char **end)
     if (!unit_factor(&s, &sc, &dd))
         return 0;
     for (;;) {
-        const char *t = skip_space(s);
+        const char *t = qparse_skip(s);
         if (*t != '*' && *t != '/')
             break;
         int div = *t == '/';
@@ -232,7 +181,7 @@ int unit_parse(const char *s, double *scale, dim *d, const char **end)
         if (!unit_factor(&u, &fs, &fd))
             break;  /* "2 mm * a1": the '*' belongs to the expression */
         sc = div ? sc / fs : sc * fs;
-        dd = dim_add(dd, fd, div ? -1 : 1);
+        dd = qdim_add(dd, fd, div ? -1 : 1);
         s = u;
     }
     *scale = sc;
@@ -241,196 +190,80 @@ int unit_parse(const char *s, double *scale, dim *d, const char **end)
     return 1;
 }
 
-/* ---- the quantity expression evaluator ---------------------------- */
+/* ---- the quantity expression evaluator: a backend of qparse.c ------- */
 
-typedef struct qval {
-    double v;
-    dim d;
-    int bare;  /* a number without unit whose quantity is not known yet */
-    double dv; /* dv/dp for the parameter p the environment seeds (expr_param.dvalue):
-                  forward-mode derivative, carried beside v through every operation */
-} qval;
+/* Values are numbers: qv.v and its derivative qv.dv by the parameter the
+ * environment seeds (expr_param.dvalue), forward mode, carried beside v
+ * through every operation. */
 
-typedef struct qparser {
-    const char *start, *s;
-    const expr_env *env;
-    char *err;
-    size_t errsize;
-    size_t err_pos;
-    int failed;
-    int depth;
-} qparser;
-
-static void qfail(qparser *p, const char *at, const char *fmt, ...) MECH_PRINTF(3, 4);
-static void qfail(qparser *p, const char *at, const char *fmt, ...)
+static qv q_constant(qparse *p, double v, double dv)
 {
-    if (p->failed)
-        return;
-    p->failed = 1;
-    p->err_pos = (size_t)(at - p->start);
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(p->err, p->errsize, fmt, ap);
-    va_end(ap);
+    (void)p;
+    return (qv){v, dv, -1, {{0, 0, 0, 0}}, 0};
 }
 
-/* Default scale for a bare number that turns out to have dimension d. */
-static double default_scale(const expr_env *env, dim d)
+static int q_unit(qparse *p, const char *u, double *scale, dim *d, const char **end)
 {
-    for (int q = 1; q < NQUANTITIES; q++)
-        if (dim_equal(d, quantity_table[q].d))
-            return env->units->scale[q];
-    return 1.0;
-}
-
-static void describe_dim(dim d, char *buf, size_t size)
-{
-    for (int q = 0; q < NQUANTITIES; q++)
-        if (dim_equal(d, quantity_table[q].d)) {
-            if (q == Q_NUMBER)
-                snprintf(buf, size, "a pure number");
-            else
-                snprintf(buf, size, "%s (%s)", quantity_table[q].noun, quantity_table[q].si_unit);
-            return;
-        }
-    char u[64];
-    dim_format(d, u, sizeof u);
-    snprintf(buf, size, "a quantity in %s", u);
-}
-
-static qval parse_expr(qparser *p);
-
-static qval make_bare(double v) { return (qval){v, {{0, 0, 0, 0}}, 1, 0.0}; }
-
-static qval parse_number(qparser *p)
-{
-    const char *s = p->s;
-    char *end;
-    if (!(isdigit((unsigned char)*s) || *s == '.')) {
-        qfail(p, s, "expected a number");
-        return make_bare(0);
-    }
-    double v = strtod(s, &end);
-    if (end == s) {
-        qfail(p, s, "expected a number");
-        return make_bare(0);
-    }
-    if (!isfinite(v)) {
-        qfail(p, s, "number out of range");
-        return make_bare(0);
-    }
-    p->s = end;
-    const char *u = skip_space(end);
-    size_t n = ident_len(u);
-    if (n == 0)
-        return make_bare(v);
-    double scale;
-    dim d;
-    const char *uend;
-    int known_unit = unit_parse(u, &scale, &d, &uend);
+    size_t n = qparse_ident_len(u);
+    int known_unit = unit_parse(u, scale, d, end);
     if (!known_unit && unit_lookup(u, n)) {  /* "m^100": the unit is fine, its power is not */
-        qfail(p, u, "bad power of unit '%.*s' (write an integer from -99 to 99 after '^')",
-              (int)n, u);
-        return make_bare(v);
+        qparse_fail(p, u, "bad power of unit '%.*s' (write an integer from -99 to 99 after '^')",
+                    (int)n, u);
+        return -1;
     }
-    if (known_unit && dim_is_bad(d)) {
-        qfail(p, u, "unit power out of range (at most %d)", DIM_MAX);
-        return make_bare(v);
+    if (known_unit && qdim_is_bad(*d)) {
+        qparse_fail(p, u, "unit power out of range (at most %d)", QDIM_MAX);
+        return -1;
     }
-    if (!known_unit) {
-        char word[64];
-        snprintf(word, sizeof word, "%.*s", (int)(n < 40 ? n : 40), u);
-        const char *names[NUNITS];
-        for (size_t i = 0; i < NUNITS; i++)
-            names[i] = unit_table[i].name;
-        const char *near = NULL;
-        for (size_t i = 0; i < NUNITS && !near; i++)  /* "RPM", "MM": the case is wrong */
-            if (strcasecmp(word, names[i]) == 0)
-                near = names[i];
-        if (!near)
-            near = nearest_name(word, names, NUNITS);
-        if (near)
-            qfail(p, u, "unknown unit '%s' (did you mean '%s'?)", word, near);
-        else {
-            char known[160];
-            size_t k = 0;
-            known[0] = '\0';
-            for (size_t i = 0; i < NUNITS && k < sizeof known; i++)
-                k += (size_t)snprintf(known + k, sizeof known - k, "%s%s", i ? " " : "",
-                                      names[i]);
-            qfail(p, u, "unknown unit '%s' (known units: %s)", word, known);
-        }
-        return make_bare(v);
+    if (known_unit)
+        return 1;
+    char word[64];
+    snprintf(word, sizeof word, "%.*s", (int)(n < 40 ? n : 40), u);
+    const char *names[NUNITS];
+    for (size_t i = 0; i < NUNITS; i++)
+        names[i] = unit_table[i].name;
+    const char *near = NULL;
+    for (size_t i = 0; i < NUNITS && !near; i++)  /* "RPM", "MM": the case is wrong */
+        if (strcasecmp(word, names[i]) == 0)
+            near = names[i];
+    if (!near)
+        near = nearest_name(word, names, NUNITS);
+    if (near)
+        qparse_fail(p, u, "unknown unit '%s' (did you mean '%s'?)", word, near);
+    else {
+        char known[160];
+        size_t k = 0;
+        known[0] = '\0';
+        for (size_t i = 0; i < NUNITS && k < sizeof known; i++)
+            k += (size_t)snprintf(known + k, sizeof known - k, "%s%s", i ? " " : "", names[i]);
+        qparse_fail(p, u, "unknown unit '%s' (known units: %s)", word, known);
     }
-    p->s = uend;
-    return (qval){v * scale, d, 0, 0.0};
+    return -1;
 }
 
-/* Under + or -, a bare operand takes the other operand's quantity. */
-static void unify(qparser *p, qval *a, qval *b, const char *at, char op)
+static qv q_call(qparse *p, const char *name, size_t n, const char *at, qv a, qv b, int two)
 {
-    if (a->bare && !b->bare) {
-        a->v *= default_scale(p->env, b->d);
-        a->dv *= default_scale(p->env, b->d);
-        a->d = b->d;
-        a->bare = 0;
-    } else if (b->bare && !a->bare) {
-        b->v *= default_scale(p->env, a->d);
-        b->dv *= default_scale(p->env, a->d);
-        b->d = a->d;
-        b->bare = 0;
-    } else if (!dim_equal(a->d, b->d)) {
-        char da[96], db[96];
-        describe_dim(a->d, da, sizeof da);
-        describe_dim(b->d, db, sizeof db);
-        qfail(p, at, "cannot %s %s and %s", op == '+' ? "add" : "subtract", da, db);
-    }
-}
-
-static qval call_function(qparser *p, const char *name, size_t n, const char *at)
-{
-    /* the '(' has been consumed */
-    qval a = parse_expr(p), b = make_bare(0);
-    int two = 0;
-    p->s = skip_space(p->s);
-    if (*p->s == ',') {
-        p->s++;
-        b = parse_expr(p);
-        two = 1;
-        p->s = skip_space(p->s);
-    }
-    if (*p->s != ')') {
-        qfail(p, p->s, "expected ')' to close %.*s(", (int)n, name);
-        return a;
-    }
-    p->s++;
     const dim angle = quantity_table[Q_ANGLE].d;
-    int is = 0;
-#define IS(fn) (n == strlen(fn) && memcmp(name, fn, n) == 0)
+#define IS(fn) qparse_is_fn(name, n, fn)
     if (IS("atan2")) {
         if (!two) {
-            qfail(p, at, "atan2 takes two arguments: atan2(y, x)");
+            qparse_fail(p, at, "atan2 takes two arguments: atan2(y, x)");
             return a;
         }
-        unify(p, &a, &b, at, '-');
+        qparse_unify(p, &a, &b, at, "subtract");
         double r2 = a.v * a.v + b.v * b.v;  /* d atan2(y, x) = (x dy - y dx) / (x^2 + y^2) */
         double dv = r2 > 0 ? (b.v * a.dv - a.v * b.dv) / r2 : 0.0;
-        return (qval){atan2(a.v, b.v), angle, 0, dv};
+        return (qv){atan2(a.v, b.v), dv, -1, angle, 0};
     }
     if (two) {
-        qfail(p, at, "%.*s takes one argument", (int)n, name);
+        qparse_fail(p, at, "%.*s takes one argument", (int)n, name);
         return a;
     }
     if (IS("sqrt")) {
-        for (int i = 0; i < NDIMS; i++)
-            if (a.d.e[i] % 2)
-                is = 1;
-        if (is || a.v < 0) {
-            qfail(p, at, a.v < 0 ? "sqrt of a negative value" : "sqrt of a quantity whose unit has an odd power");
+        dim half;
+        if (qparse_sqrt_dim(p, a, at, 1, &half) < 0)
             return a;
-        }
-        for (int i = 0; i < NDIMS; i++)
-            a.d.e[i] = (signed char)(a.d.e[i] / 2);
+        a.d = half;
         a.v = sqrt(a.v);
         a.dv = a.v > 0 ? a.dv / (2.0 * a.v) : 0.0;
         return a;
@@ -440,192 +273,100 @@ static qval call_function(qparser *p, const char *name, size_t n, const char *at
             a.v *= p->env->units->scale[Q_ANGLE];
             a.dv *= p->env->units->scale[Q_ANGLE];
         } else if (!dim_equal(a.d, angle) && !dim_is_none(a.d)) {
-            qfail(p, at, "%.*s needs an angle", (int)n, name);
+            qparse_fail(p, at, "%.*s needs an angle", (int)n, name);
             return a;
         }
         double r = IS("sin") ? sin(a.v) : IS("cos") ? cos(a.v) : tan(a.v);
-        qval out = make_bare(r);
-        out.dv = a.dv * (IS("sin") ? cos(a.v) : IS("cos") ? -sin(a.v) : 1.0 + r * r);
-        return out;  /* a pure number: 100 * cos(60) takes the default length unit */
+        double dv = a.dv * (IS("sin") ? cos(a.v) : IS("cos") ? -sin(a.v) : 1.0 + r * r);
+        return (qv){r, dv, -1, {{0, 0, 0, 0}}, 1};  /* a pure number: 100 * cos(60) takes
+                                                       the default length unit */
     }
 #undef IS
-    qfail(p, at, "unknown function '%.*s' (known: sqrt, sin, cos, tan, atan2)", (int)n, name);
+    qparse_fail(p, at, "unknown function '%.*s' (known: sqrt, sin, cos, tan, atan2)", (int)n,
+                name);
     return a;
 }
 
-/* Index of the parameter named by the n bytes at `name`, or -1. Names are
- * at most 64 bytes (load.h), so a longer word is no parameter. */
-static int find_param(const expr_env *env, const char *name, size_t n)
+static qv q_neg(qparse *p, qv a)
 {
-    if (env->param_index) {
-        char word[65];
-        if (n >= sizeof word)
-            return -1;
-        memcpy(word, name, n);
-        word[n] = '\0';
-        return name_map_get(env->param_index, word);
-    }
-    for (int i = 0; i < env->nparams; i++)
-        if (strlen(env->params[i].name) == n && memcmp(env->params[i].name, name, n) == 0)
-            return i;
-    return -1;
+    (void)p;
+    a.v = -a.v;
+    a.dv = -a.dv;
+    return a;
 }
 
-static qval parse_atom(qparser *p)
+static qv q_scale(qparse *p, qv a, double k)
 {
-    p->s = skip_space(p->s);
-    const char *at = p->s;
-    if (*at == '(') {
-        p->s++;
-        qval v = parse_expr(p);
-        p->s = skip_space(p->s);
-        if (*p->s != ')')
-            qfail(p, p->s, "expected ')'");
-        else
-            p->s++;
-        return v;
-    }
-    size_t n = ident_len(at);
-    if (n) {
-        p->s = at + n;
-        const char *after = skip_space(p->s);
-        if (*after == '(') {
-            p->s = after + 1;
-            return call_function(p, at, n, at);
-        }
-        if (n == 2 && memcmp(at, "pi", 2) == 0)  /* pi rad: angle: pi/2 is 90 deg whatever the default */
-            return (qval){PI, quantity_table[Q_ANGLE].d, 0, 0.0};
-        int found = find_param(p->env, at, n);
-        if (found >= 0) {
-            const expr_param *q = &p->env->params[found];
-            return (qval){q->value, q->d, q->bare, q->dvalue};
-        }
-        if (unit_lookup(at, n))
-            qfail(p, at, "unit '%.*s' without a number (write 1 %.*s)", (int)n, at, (int)n, at);
-        else
-            qfail(p, at, "unknown name '%.*s' (not a unit, a function, or a parameter defined "
-                         "above)", (int)(n < 64 ? n : 64), at);
-        return make_bare(0);
-    }
-    if (*at == '\0') {
-        qfail(p, at, "value missing");
-        return make_bare(0);
-    }
-    if (!(isdigit((unsigned char)*at) || *at == '.')) {
-        qfail(p, at, "unexpected '%c'", *at);
-        return make_bare(0);
-    }
-    return parse_number(p);
+    (void)p;
+    a.v *= k;
+    a.dv *= k;
+    return a;
 }
 
-static qval parse_power(qparser *p);
-
-/* unary := ('-' | '+') unary | power, so -r^2 is -(r^2) */
-static qval parse_unary(qparser *p)
+static qv q_add(qparse *p, qv a, qv b, char op, const char *at)
 {
-    p->s = skip_space(p->s);
-    if (++p->depth > 64) {
-        qfail(p, p->s, "expression nested too deeply");
-        return make_bare(0);
-    }
-    qval v;
-    if (*p->s == '-' || *p->s == '+') {
-        int neg = *p->s == '-';
-        p->s++;
-        v = parse_unary(p);
-        if (neg) {
-            v.v = -v.v;
-            v.dv = -v.dv;
-        }
-    } else {
-        v = parse_power(p);
-    }
-    p->depth--;
-    return v;
+    (void)p, (void)at;
+    a.v = op == '+' ? a.v + b.v : a.v - b.v;
+    a.dv = op == '+' ? a.dv + b.dv : a.dv - b.dv;
+    return a;
 }
 
-static qval parse_power(qparser *p)
+static qv q_mul(qparse *p, qv a, qv b, char op, const char *at)
 {
-    qval a = parse_atom(p);
-    const char *at = skip_space(p->s);
-    int e;
-    int r = parse_exponent(&p->s, &e);
-    if (r < 0) {
-        qfail(p, at, "expected an integer exponent after '^'");
+    if (op == '*') {
+        a.dv = a.dv * b.v + a.v * b.dv;
+        a.v *= b.v;
         return a;
     }
-    if (r == 1) {
-        a.dv = e == 0 ? 0.0 : e * pow(a.v, e - 1) * a.dv;
-        a.v = pow(a.v, e);
-        int was_bad = dim_is_bad(a.d);
-        a.d = dim_scale(a.d, e);
-        if (dim_is_bad(a.d) && !was_bad)
-            qfail(p, at, "unit power out of range (at most %d)", DIM_MAX);
+    if (b.v == 0) {
+        qparse_fail(p, at, "division by zero");
+        return a;
     }
+    a.dv = a.dv / b.v - (a.v / b.v) * (b.dv / b.v);  /* (a/b)' without b^2 underflowing */
+    a.v /= b.v;
     return a;
 }
 
-static qval parse_term(qparser *p)
+static qv q_powi(qparse *p, qv a, int e, const char *at)
 {
-    qval a = parse_unary(p);
-    for (;;) {
-        const char *at = skip_space(p->s);
-        if (p->failed || (*at != '*' && *at != '/'))
-            return a;
-        p->s = at + 1;
-        qval b = parse_unary(p);
-        if (*at == '*') {
-            a.dv = a.dv * b.v + a.v * b.dv;
-            a.v *= b.v;
-        } else {
-            if (b.v == 0) {
-                qfail(p, at, "division by zero");
-                return a;
-            }
-            a.dv = a.dv / b.v - (a.v / b.v) * (b.dv / b.v);  /* (a/b)' without b^2 underflowing */
-            a.v /= b.v;
-        }
-        a.d = dim_add(a.d, b.d, *at == '*' ? 1 : -1);
-        a.bare = a.bare && b.bare;
-        if (dim_is_bad(a.d) && !dim_is_bad(b.d)) {  /* report once, where it happens */
-            qfail(p, at, "unit power out of range (at most %d)", DIM_MAX);
-            return a;
-        }
-    }
+    (void)p, (void)at;
+    a.dv = e == 0 ? 0.0 : e * pow(a.v, e - 1) * a.dv;
+    a.v = pow(a.v, e);
+    return a;
 }
 
-static qval parse_expr(qparser *p)
-{
-    qval a = parse_term(p);
-    for (;;) {
-        const char *at = skip_space(p->s);
-        if (p->failed || (*at != '+' && *at != '-'))
-            return a;
-        p->s = at + 1;
-        qval b = parse_term(p);
-        unify(p, &a, &b, at, *at);
-        a.v = *at == '+' ? a.v + b.v : a.v - b.v;
-        a.dv = *at == '+' ? a.dv + b.dv : a.dv - b.dv;
-    }
-}
+static const qparse_ops quantity_ops = {
+    .constant = q_constant,
+    .unit = q_unit,
+    .call = q_call,
+    .neg = q_neg,
+    .scale = q_scale,
+    .add = q_add,
+    .mul = q_mul,
+    .powi = q_powi,
+    .unknown_name = " (not a unit, a function, or a parameter defined above)",
+    .unit_alone = 1,
+    .strict_exponent = 1,
+    .checked_dims = 1,
+    .after = "value",
+};
 
-static int run_parser(qparser *p, qval *out)
+static int run_parser(qparse *p, const char *text, const expr_env *env, char *err,
+                      size_t errsize, qv *out)
 {
-    *out = parse_expr(p);
-    p->s = skip_space(p->s);
-    if (!p->failed && *p->s != '\0')
-        qfail(p, p->s, "unexpected '%c' after the value", *p->s);
+    qparse_init(p, text, env, &quantity_ops, NULL, err, errsize);
+    *out = qparse_run(p);
     if (!p->failed && !isfinite(out->v))
-        qfail(p, p->start, "value is not a finite number");
+        qparse_fail(p, p->start, "value is not a finite number");
     return p->failed ? -1 : 0;
 }
 
 int quantity_eval(const char *text, quantity want, const expr_env *env, double *value,
                   char *err, size_t errsize, size_t *err_pos)
 {
-    qparser p = {text, text, env, err, errsize, 0, 0, 0};
-    qval v;
-    if (run_parser(&p, &v) < 0) {
+    qparse p;
+    qv v;
+    if (run_parser(&p, text, env, err, errsize, &v) < 0) {
         *err_pos = p.err_pos;
         return -1;
     }
@@ -638,7 +379,7 @@ int quantity_eval(const char *text, quantity want, const expr_env *env, double *
     }
     if (!dim_equal(v.d, qi->d)) {
         char got[96];
-        describe_dim(v.d, got, sizeof got);
+        qparse_describe(v.d, got, sizeof got);
         snprintf(err, errsize, "expected %s, got %s", qi->noun, got);
         *err_pos = 0;
         return -1;
@@ -650,9 +391,9 @@ int quantity_eval(const char *text, quantity want, const expr_env *env, double *
 int quantity_eval_param(const char *text, const expr_env *env, expr_param *out, char *err,
                         size_t errsize, size_t *err_pos)
 {
-    qparser p = {text, text, env, err, errsize, 0, 0, 0};
-    qval v;
-    if (run_parser(&p, &v) < 0) {
+    qparse p;
+    qv v;
+    if (run_parser(&p, text, env, err, errsize, &v) < 0) {
         *err_pos = p.err_pos;
         return -1;
     }
