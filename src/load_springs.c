@@ -34,7 +34,9 @@ static int spring_ends(loader *ld, const ynode *map, mech_spring *s)
     int id[2], cand[2][8], n[2];
     for (int k = 0; k < 2; k++) {
         id[k] = load_find_point_or_report(ld, btw->items[k], "spring end");
-        n[k] = id[k] < 0 ? -1 : load_end_candidates(ld, links, k, id[k], btw->items[k], "spring link", cand[k], 8);
+        n[k] = id[k] < 0 ? -1
+                         : load_end_candidates(ld, links, k, id[k], btw->items[k], "spring link",
+                                               cand[k], 8);
     }
     if (n[0] <= 0 || n[1] <= 0)
         return 0;

@@ -535,7 +535,9 @@ void load_state_line(loader *ld, const ynode *map)
     int id[2], cand[2][8], n[2];
     for (int k = 0; k < 2; k++) {
         id[k] = load_find_point_or_report(ld, btw->items[k], "load end");
-        n[k] = id[k] < 0 ? -1 : load_end_candidates(ld, links, k, id[k], btw->items[k], "loaded link", cand[k], 8);
+        n[k] = id[k] < 0 ? -1
+                         : load_end_candidates(ld, links, k, id[k], btw->items[k], "loaded link",
+                                               cand[k], 8);
     }
     int reg = component(ld, f, Q_FORCE, "force");
     if (n[0] <= 0 || n[1] <= 0 || reg < 0)
