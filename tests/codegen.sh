@@ -112,6 +112,48 @@ fi
     2>/dev/null && sed 's/again\.h/gen.h/' "$tmp/again.c" | cmp -s - "$tmp/stirling/gen.c" \
     && pass || fail "codegen of stirling.yaml twice: the sources differ"
 
+# the condition (docs/codegen.md "The condition at a solution"): gen_rcond
+# equals the interpreter's rcond (mech solve --diagnostics) bit for bit at
+# every row, and where the solve kept a lower bound instead (no decision
+# depended on the exact value) it is one, above the singular threshold
+# (tests/codegen_rcond.c); the conveyor (one 4 x 4 block) must keep the bound
+# at most rows, the Stirling engine (several blocks) never
+for file in mechanisms/conveyor.yaml mechanisms/stirling.yaml mechanisms/slider-crank.yaml \
+        tests/hard/dead-centre-slider.yaml tests/hard/micrometre-fourbar.yaml \
+        tests/hard/mixed-scale.yaml; do
+    base=$(basename "$file" .yaml)
+    dir=$tmp/$base
+    if ! $CC $CFLAGS_GEN -I"$dir" -o "$dir/rcond" "$dir/gen.c" tests/codegen_rcond.c -lm \
+            2>"$dir/cc"; then
+        fail "cc $base's generated code with tests/codegen_rcond.c: $(head -n 3 "$dir/cc")"
+        continue
+    fi
+    "$MECH" solve "$file" -q --diagnostics -o "$dir/diag.csv" 2>/dev/null
+    if "$dir/rcond" "$dir/diag.csv" >"$dir/out" 2>"$dir/err"; then
+        pass
+        echo "  $base rcond: $(cat "$dir/out")"
+    else
+        fail "$base: the condition against mech solve's: $(cat "$dir/out" "$dir/err" | head -n 2)"
+        continue
+    fi
+    set -- $(cat "$dir/out")  # rows N bound B exact E loosest L
+    case $base in
+    conveyor) [ "$4" -gt $(($2 / 2)) ] && pass || fail "conveyor: the bound served $4 of $2 rows" ;;
+    stirling) [ "$4" -eq 0 ] && pass || fail "stirling: a bound with several blocks ($4 rows)" ;;
+    esac
+done
+# --stats: the smallest rcond of --jit (gen_rcond where it can be the
+# smallest) is the interpreter's
+mkdir -p "$tmp/jt"
+for file in mechanisms/conveyor.yaml tests/hard/mixed-scale.yaml; do
+    "$MECH" solve "$file" -q --stats -o /dev/null 2>"$tmp/st-interp"
+    TMPDIR=$tmp/jt "$MECH" solve "$file" -q --stats --jit -o /dev/null 2>"$tmp/st-jit"
+    want=$(grep "smallest rcond" "$tmp/st-interp")
+    got=$(grep "smallest rcond" "$tmp/st-jit")
+    [ -n "$want" ] && [ "$want" = "$got" ] && pass ||
+        fail "solve --jit --stats $file: '$got', the interpreter '$want'"
+done
+
 # ---- forces (docs/codegen.md "Forces") ----
 # forces NAME FILE [OPTIONS]: generate with OPTIONS (forces on), solve with
 # the same options, and require every column - the kinematics, each joint's
