@@ -12,12 +12,13 @@
  * bit for bit, and where the solve kept a lower bound in s.rcond
  * (s.rcond_exact == 0: no decision depended on the exact value), that bound
  * must be at most the interpreter's value, positive and at least the
- * singular threshold. Prints
+ * singular threshold, and the whole Jacobian's bound kept in s.rcond_whole
+ * at most the value gen_rcond computes then. Prints
  *
  *   rows N bound B exact E loosest L
  *
  * (B rows where the solve kept the bound, E where it computed the
- * condition, L the largest interpreter's rcond / bound), exit 0 when every
+ * condition, L the largest exact value / bound of the two), exit 0 when every
  * row holds, 1 otherwise, 2 for a malformed DIAG. */
 #include <math.h>
 #include <stdio.h>
@@ -77,7 +78,7 @@ int main(int argc, char **argv)
             return 1;
         }
         int kept = !s.rcond_exact;
-        double lo = s.rcond, r = gen_rcond(&s);
+        double lo = s.rcond, lo_whole = s.rcond_whole, r = gen_rcond(&s);
         if (kept) {
             bound++;
             if (!(lo > 0.0 && lo <= ref && lo >= 1e-6)) {
@@ -85,7 +86,12 @@ int main(int argc, char **argv)
                         "the interpreter's rcond %.17g above 1e-6\n", rows + 1, lo, ref);
                 bad++;
             }
-            loosest = fmax(loosest, ref / lo);
+            if (!(lo_whole > 0.0 && lo_whole <= s.rcond_whole)) {
+                fprintf(stderr, "codegen-rcond: row %d: the whole matrix's bound %.17g is not a "
+                        "lower bound of its rcond %.17g\n", rows + 1, lo_whole, s.rcond_whole);
+                bad++;
+            }
+            loosest = fmax(loosest, fmax(ref / lo, s.rcond_whole / lo_whole));
         } else {
             exact++;
         }
