@@ -2,7 +2,7 @@
  * --prefix gen` wrote against the interpreter's (tests/codegen.sh compiles
  * the two together).
  *
- *   codegen-rcond DIAG.csv
+ *   codegen-rcond DIAG.csv [MIN]
  *
  * DIAG.csv is `mech solve FILE --diagnostics`: its first column is the
  * driver position q, its column "rcond [-]" the interpreter's reciprocal
@@ -17,6 +17,12 @@
  *
  *   rows N bound B exact E loosest L
  *
+ * With MIN (the generated source compiled with its MIN_RCOND set to MIN),
+ * each row must be GEN_SINGULAR exactly where the interpreter's rcond is
+ * below MIN (rows within 1e-9 of MIN are not judged), the others GEN_OK
+ * with the interpreter's rcond within 1e-9 relatively (a row after a
+ * singular one starts from another guess): the bound never hides a
+ * singular position. It also prints "singular S".
  * (B rows where the solve kept the bound, E where it computed the
  * condition, L the largest exact value / bound of the two), exit 0 when every
  * row holds, 1 otherwise, 2 for a malformed DIAG. */
@@ -33,9 +39,10 @@ static char line[LINE];
 
 int main(int argc, char **argv)
 {
-    FILE *f = argc == 2 ? fopen(argv[1], "r") : NULL;
+    FILE *f = argc == 2 || argc == 3 ? fopen(argv[1], "r") : NULL;
+    double min = argc == 3 ? strtod(argv[2], NULL) : 0.0;
     if (!f) {
-        fprintf(stderr, "usage: codegen-rcond DIAG.csv\n");
+        fprintf(stderr, "usage: codegen-rcond DIAG.csv [MIN]\n");
         return 2;
     }
     int rc_col = -1, ncols = 0;
@@ -50,7 +57,7 @@ int main(int argc, char **argv)
         return 2;
     }
     static gen_state s;
-    int rows = 0, bound = 0, exact = 0, bad = 0;
+    int rows = 0, bound = 0, exact = 0, bad = 0, singular = 0;
     double loosest = 1.0;
     gen_init(&s);
     while (fgets(line, sizeof line, f)) {
@@ -72,6 +79,19 @@ int main(int argc, char **argv)
         if (rows > 0)
             gen_predict(&s, q);
         int st = gen_solve(&s, q, GEN_DRIVER_SPEED, GEN_DRIVER_ACCEL);
+        if (min > 0.0) {
+            int want = ref < min ? GEN_SINGULAR : GEN_OK;
+            double r = gen_rcond(&s);
+            if (fabs(ref - min) > 1e-9 * min && (st != want || fabs(r - ref) > 1e-9 * ref)) {
+                fprintf(stderr, "codegen-rcond: row %d (q %.17g): status %d rcond %.17g, the "
+                        "interpreter's rcond %.17g against MIN_RCOND %g\n", rows + 1, q, st, r,
+                        ref, min);
+                bad++;
+            }
+            singular += st == GEN_SINGULAR;
+            rows++;
+            continue;
+        }
         if (st != GEN_OK) {
             fprintf(stderr, "codegen-rcond: row %d (q %.17g) does not solve: status %d\n", rows + 1,
                     q, st);
@@ -107,6 +127,9 @@ int main(int argc, char **argv)
         rows++;
     }
     fclose(f);
-    printf("rows %d bound %d exact %d loosest %.3g\n", rows, bound, exact, loosest);
+    if (min > 0.0)
+        printf("rows %d singular %d\n", rows, singular);
+    else
+        printf("rows %d bound %d exact %d loosest %.3g\n", rows, bound, exact, loosest);
     return bad || rows == 0 ? 1 : 0;
 }
