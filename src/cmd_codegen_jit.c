@@ -298,7 +298,7 @@ int cmd_jit_solve(const mech_model *m, const mech_solve_options *o, mech_table *
     int nq = 0;
     double *q = positions(m, o, &nq);
     memset(st, 0, sizeof *st);
-    st->min_rcond = 1.0;
+    st->min_rcond = INFINITY;  /* as the interpreter (sweep.c): row 0 sets it */
     int ok = q && jit_build(&j, m, o, st, note, sizeof note) == 0;
     if (j.dir[0])
         remove_dir(j.dir);  /* the loaded object stays mapped */

@@ -165,7 +165,8 @@ done
 # --stats: the smallest rcond of --jit (gen_rcond where it can be the
 # smallest) is the interpreter's
 mkdir -p "$tmp/jt"
-for file in mechanisms/conveyor.yaml tests/hard/mixed-scale.yaml; do
+for file in mechanisms/conveyor.yaml mechanisms/watt-six-bar.yaml mechanisms/stephenson-six-bar.yaml \
+        tests/hard/mixed-scale.yaml tests/truths/incline-block.yaml; do
     "$MECH" solve "$file" -q --stats -o /dev/null 2>"$tmp/st-interp"
     TMPDIR=$tmp/jt "$MECH" solve "$file" -q --stats --jit -o /dev/null 2>"$tmp/st-jit"
     want=$(grep "smallest rcond" "$tmp/st-interp")
