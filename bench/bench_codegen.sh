@@ -19,6 +19,7 @@
 # Run from the repository root after building BUILD/mech and BUILD/bench-hand:
 #   make BUILD=build/bench OPT='-O2 -DNDEBUG' build/bench/bench-hand build/bench/mech
 #   MECH=build/bench/mech BUILD=build/bench sh bench/bench_codegen.sh
+# (ROWS="conveyor fourbar" for some rows only)
 MECH=${MECH:-build/bench/mech}
 BUILD=${BUILD:-build/bench}
 HAND=${HAND:-$BUILD/bench-hand}
@@ -54,7 +55,7 @@ per_step() {
 }
 
 printf "%-16s %9s %9s %9s %7s %9s %9s %8s\n" mechanism interp hand generated ratio "us/step" "(min)" "it/step"
-for row in fourbar stirling conveyor conveyor+forces; do
+for row in ${ROWS:-fourbar stirling conveyor conveyor+forces}; do
     m=${row%+forces} forces= opts=--no-forces
     [ "$row" != "$m" ] && forces=forces opts="--forces --friction off"
     gen=$out/$row

@@ -70,7 +70,10 @@ static const char *const wrapper[] = {
     "        out[c] = s->out[c];",
     "    info[0] = s->iterations;",
     "    info[1] = s->residual;",
-    "    info[2] = s->rcond;",
+    "    /* info[2] in: the smallest rcond so far; s->rcond is a lower bound of the",
+    "       interpreter's value, exact when it is not (docs/codegen.md): only one",
+    "       below the smallest so far can change it */",
+    "    info[2] = s->rcond < info[2] ? jit_rcond(s) : s->rcond;",
     "    info[3] = info[4] = 0.0;",
     "#ifdef NF",
     "    info[3] = fmax(fabs(s->power_residual), fabs(s->power_residual0));",
@@ -245,6 +248,7 @@ static int jit_sweep(const jit *j, const mech_model *m, const double *q, int nq,
     }
     double info[5];
     for (int i = 0; i < nq; i++) {
+        info[2] = st->min_rcond;
         int rc = j->row(s, q[i], m->driver.speed, m->driver.accel, i == 0,
                         t->values + (size_t)i * (size_t)nout, info);
         if (rc != 0) {
@@ -294,7 +298,7 @@ int cmd_jit_solve(const mech_model *m, const mech_solve_options *o, mech_table *
     int nq = 0;
     double *q = positions(m, o, &nq);
     memset(st, 0, sizeof *st);
-    st->min_rcond = 1.0;
+    st->min_rcond = INFINITY;  /* as the interpreter (sweep.c): row 0 sets it */
     int ok = q && jit_build(&j, m, o, st, note, sizeof note) == 0;
     if (j.dir[0])
         remove_dir(j.dir);  /* the loaded object stays mapped */

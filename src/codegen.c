@@ -284,8 +284,10 @@ static void emit_state(const codegen *g, FILE *f)
             "    double xqq[%d];   /* d2x/dq2 */\n"
             "    double out[%d];   /* output columns (%s_COL_*) */\n"
             "    double residual;  /* |f|inf at the solution, m */\n"
-            "    double rcond;     /* reciprocal condition of the Jacobian's worst block */\n"
+            "    double rcond;     /* reciprocal condition of the Jacobian's worst block (a\n"
+            "                         lower bound when rcond_exact is 0: %s_rcond) */\n"
             "    double rcond_whole; /* and of the whole Jacobian (Newton's rounding floor) */\n"
+            "    int rcond_exact;  /* 1: rcond, rcond_whole are the interpreter's values */\n"
             "    int iterations;   /* Newton iterations of the last solve */\n"
             "    int det_sign;     /* sign of det J at the solution (+1, -1): a change between\n"
             "                         two positions means a singular one was crossed */\n"
@@ -303,7 +305,7 @@ static void emit_state(const codegen *g, FILE *f)
             "    double keep[%d], Jv[%d], Ax[%d], lu[%d];\n"
             "    int piv[%d], swap_parity;\n",
             g->lower, g->lower, g->lower, nx, g->upper, nx, nx, nx, nx, g->cols.ncols, g->upper,
-            g->upper, g->lower, g->lower, g->lower, nx, nx, nx, nx, nx, nx, nx, nx, nx, nx, nx, nx, nx, nx, nx, nk,
+            g->lower, g->upper, g->lower, g->lower, g->lower, nx, nx, nx, nx, nx, nx, nx, nx, nx, nx, nx, nx, nx, nx, nx, nk,
             nz, nz, nd, nx);
     codegen_forces_state(g, f);
     fprintf(f, "} %s_state;\n\n", g->lower);
@@ -326,8 +328,12 @@ static void emit_prototypes(const codegen *g, FILE *f)
             "/* Set s->x to the prediction at driver position q from the last position\n"
             " * solved: x + h xq + h^2/2 xqq + h^3/6 xqqq (xqqq from the last two xqq),\n"
             " * the continuation of mech solve; the guesses of %s_init before any. */\n"
-            "void %s_predict(%s_state *s, double q);\n\n",
-            p, P, p, P, p, at_least_1(g->sp.ns), p, p, P, P, P, P, p, p, p, p, p);
+            "void %s_predict(%s_state *s, double q);\n"
+            "/* The reciprocal condition of the Jacobian's worst block at the position\n"
+            " * the last %s_solve converged to, the interpreter's value (s->rcond may\n"
+            " * hold a lower bound, when the solve needed no more: docs/codegen.md). */\n"
+            "double %s_rcond(%s_state *s);\n\n",
+            p, P, p, P, p, at_least_1(g->sp.ns), p, p, P, P, P, P, p, p, p, p, p, p, p, p);
 }
 
 static void emit_declarations(const codegen *g, FILE *f)
@@ -524,8 +530,11 @@ static void emit_solve(const codegen *g, FILE *f)
             "    for (int i = 0; i < NX; i++) {\n"
             "        double xqqq = prev ? (s->xqq[i] - s->xqq_prev[i]) / dq : 0.0;\n"
             "        s->x[i] = s->xc[i] + h * (s->xq[i] + h * (0.5 * s->xqq[i] + h * xqqq / 6.0));\n"
-            "    }\n}\n", p, p, g->want_forces ? "    if (s->force_status != 0)\n"
-                                             "        return s->force_status;\n" : "", p, p);
+            "    }\n}\n\n"
+            "double %s_rcond(%s_state *s)\n{\n"
+            "    if (!s->rcond_exact)\n        condition(s);  /* the factors are still those of the solution */\n"
+            "    return s->rcond;\n}\n", p, p, g->want_forces ? "    if (s->force_status != 0)\n"
+                                             "        return s->force_status;\n" : "", p, p, p, p);
 }
 
 int codegen_emit_source(FILE *f, const void *ctx)

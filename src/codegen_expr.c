@@ -239,7 +239,26 @@ static void kin_var(const codegen *g, int var, int lv, char *buf, size_t size)
         snprintf(buf, size, "0.0");
 }
 
-/* Angle, rates, cosine and sine of link l's frame. */
+/* The keep slot of the node op(q) (EX_COS or EX_SIN of the driver q) that
+ * eval_driver computes, or -1. */
+static int driver_trig_slot(const codegen *g, int op)
+{
+    const expr_ctx *pool = &g->sp.sys->ex;
+    for (size_t e = 0; e < pool->count; e++) {
+        const expr_node *nd = expr_at(pool, (int)e);
+        if ((int)nd->op != op || g->phase[e] != PH_DRIVER || g->keep[e] < 0)
+            continue;
+        const expr_node *a = expr_at(pool, nd->a);
+        if (a->op == EX_VAR && a->var == SYS_VAR_Q(g->sp.n))
+            return g->keep[e];
+    }
+    return -1;
+}
+
+/* Angle, rates, cosine and sine of link l's frame. The driven link's
+ * cosine and sine are eval_driver's cos(q) and sin(q) where it keeps them
+ * (the same function of the same argument: the same values), computed
+ * again otherwise. */
 static void emit_angle(const codegen *g, FILE *f, int l)
 {
     int var = g->sp.tree.angle_var[l];
@@ -247,7 +266,12 @@ static void emit_angle(const codegen *g, FILE *f, int l)
     for (int lv = 0; lv < 3; lv++)
         kin_var(g, var, lv, v[lv], sizeof v[lv]);
     fprintf(f, "    F[%d].th = %s, F[%d].om = %s, F[%d].al = %s;\n", l, v[0], l, v[1], l, v[2]);
-    if (var >= 0)
+    int kc = var == g->sp.n ? driver_trig_slot(g, EX_COS) : -1;
+    int ks = var == g->sp.n ? driver_trig_slot(g, EX_SIN) : -1;
+    if (kc >= 0 && ks >= 0 && g->sp.ns > 0)
+        fprintf(f, "    F[%d].c = s->keep[%d], F[%d].s = s->keep[%d];  /* eval_driver's */\n", l,
+                kc, l, ks);
+    else if (var >= 0)
         fprintf(f, "    F[%d].c = cos(F[%d].th), F[%d].s = sin(F[%d].th);\n", l, l, l, l);
 }
 

@@ -96,7 +96,7 @@ static int solve_at(int argc, char **argv)
     for (int i = 3; i < argc && i - 3 < GEN_NX; i++)
         s.x[i - 3] = strtod(argv[i], NULL);
     int st = gen_solve(&s, strtod(argv[2], NULL), GEN_DRIVER_SPEED, GEN_DRIVER_ACCEL);
-    printf("status %d iterations %d rcond %.3g branch %d det %d\n", st, s.iterations, s.rcond,
+    printf("status %d iterations %d rcond %.3g branch %d det %d\n", st, s.iterations, gen_rcond(&s),
            s.branch, s.det_sign);
     for (int c = 0; c < GEN_NOUT && st == GEN_OK; c++)
         printf("%s %.17g\n", gen_column_names[c], s.out[c]);
