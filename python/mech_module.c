@@ -273,6 +273,51 @@ static PyObject *joints_list(const mech_model *m)
     return list;
 }
 
+/* Gear pairs and racks (docs/format.md 6.4): name, kind, the two links (a
+ * rack: the pinion and its slider), the arm, pitch radii (m), teeth (0 when
+ * not given), internal, pressure angle (rad). */
+static PyObject *gears_list(const mech_model *m)
+{
+    PyObject *list = PyList_New(m->ngears);
+    for (int i = 0; list && i < m->ngears; i++) {
+        const mech_gear *g = &m->gears[i];
+        int rack = g->kind == MECH_GEAR_RACK;
+        PyObject *item = Py_BuildValue(
+            "{s:s,s:s,s:(ss),s:s,s:(dd),s:(ii),s:O,s:d}", "name", g->name, "kind",
+            rack ? "rack" : "pair", "links", m->links[g->link[0]].name,
+            rack ? m->joints[g->rack].name : m->links[g->link[1]].name, "arm",
+            m->links[g->arm].name, "radii", g->radius[0], g->radius[1], "teeth", g->teeth[0],
+            g->teeth[1], "internal", g->internal ? Py_True : Py_False, "pressure_angle",
+            g->pressure_angle);
+        if (!item) {
+            Py_CLEAR(list);
+            break;
+        }
+        PyList_SET_ITEM(list, i, item);
+    }
+    return list;
+}
+
+/* Drivers as laws of time (docs/format.md 7.3): kind, link or joint, the
+ * law as written. Empty for a `driver:` file. */
+static PyObject *motions_list(const mech_model *m)
+{
+    PyObject *list = PyList_New(m->nmotions);
+    for (int i = 0; list && i < m->nmotions; i++) {
+        const mech_motion *mo = &m->motions[i];
+        int angle = mo->kind == MECH_DRIVE_ANGLE;
+        PyObject *item = Py_BuildValue(
+            "{s:s,s:s,s:s}", "kind", angle ? "angle" : "slider", angle ? "link" : "joint",
+            angle ? m->links[mo->index].name : m->joints[mo->index].name, "law", mo->text);
+        if (!item) {
+            Py_CLEAR(list);
+            break;
+        }
+        PyList_SET_ITEM(list, i, item);
+    }
+    return list;
+}
+
 static PyObject *driver_dict(const mech_model *m)
 {
     const mech_driver *dr = &m->driver;
@@ -305,6 +350,8 @@ static PyObject *model_dict(const mech_model *m)
     ok = ok && put(d, "points", all_names(m, 1)) == 0;
     ok = ok && put(d, "joints", joints_list(m)) == 0;
     ok = ok && put(d, "driver", driver_dict(m)) == 0;
+    ok = ok && put(d, "drivers", motions_list(m)) == 0;
+    ok = ok && put(d, "gears", gears_list(m)) == 0;
     ok = ok && put(d, "outputs",
                    Py_BuildValue("{s:N,s:N,s:N,s:O}", "points",
                                  names_list(m, o->points, o->npoints, 0), "links",
@@ -318,11 +365,11 @@ static PyObject *model_dict(const mech_model *m)
 
 static PyObject *summary_dict(const mech_summary *s)
 {
-    return Py_BuildValue("{s:i,s:i,s:i,s:i,s:i,s:i,s:i,s:i,s:i}", "links", s->nlinks,
+    return Py_BuildValue("{s:i,s:i,s:i,s:i,s:i,s:i,s:i,s:i,s:i,s:i}", "links", s->nlinks,
                          "revolute", s->nrevolute, "prismatic", s->nprismatic, "pin_in_slot",
                          s->npin_in_slot, "unknowns", s->nunknowns, "loops", s->nloops,
                          "equations", s->nequations, "mobility", s->mobility, "drivers",
-                         s->ndrivers);
+                         s->ndrivers, "gears", s->ngears);
 }
 
 /* _mech.load(path, set=None, check=False) -> dict */

@@ -86,14 +86,17 @@ class Result:
 def load(path, set=None):
     """The model of a mechanism file as a dict: file, name, description,
     gravity, parameters {name: SI value}, links, points, joints, driver
-    (kind, link or joint, positions, from, to, speed, accel; SI) and outputs.
+    (kind, link or joint, positions, from, to, speed, accel; SI; kind 'time'
+    for laws of time), drivers (the laws of time: kind, link or joint, law),
+    gears (name, kind, links, arm, radii, teeth, internal, pressure_angle)
+    and outputs.
     set={'name': 'text'} replaces the file's parameters. Raises MechError."""
     return _mech.load(path, set=set)
 
 
 def check(path, set=None):
     """load() plus 'structure': links, revolute, prismatic, pin_in_slot,
-    unknowns, loops, equations, mobility, drivers (as `mech check`).
+    unknowns, loops, equations, mobility, drivers, gears (as `mech check`).
     Raises MechError when the file does not load or its structure does not
     check (mobility, connectivity)."""
     return _mech.load(path, set=set, check=True)

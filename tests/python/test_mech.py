@@ -131,7 +131,8 @@ def test_load_and_check():
     c = mech.check('mechanisms/fourbar.yaml')
     assert c['structure'] == {'links': 4, 'revolute': 4, 'prismatic': 0, 'pin_in_slot': 0,
                               'unknowns': 2, 'loops': 1, 'equations': 2, 'mobility': 1,
-                              'drivers': 1}
+                              'drivers': 1, 'gears': 0}
+    assert m['drivers'] == [] and m['gears'] == []
     for path in MECHANISMS:
         s = mech.check(path)['structure']
         assert s['mobility'] == s['drivers'], path
@@ -246,3 +247,23 @@ def test_threads_give_the_same_numbers():
     for r in got:
         for n in want.columns:
             assert_bits_equal(r[n], want[n], n)
+
+
+def test_gears_and_laws_of_time_in_the_model():
+    e = mech.check('mechanisms/epicyclic.yaml')
+    assert e['structure']['gears'] == 2 and e['structure']['loops'] == 0
+    g = {x['name']: x for x in e['gears']}
+    assert g['g_sp']['kind'] == 'pair' and g['g_sp']['links'] == ('sun', 'planet')
+    assert g['g_sp']['arm'] == 'carrier' and g['g_sp']['teeth'] == (20, 40)
+    assert g['g_sp']['radii'] == pytest.approx((0.020, 0.040))  # module 2 mm
+    assert g['g_pr']['internal'] is True and g['g_pr']['links'] == ('planet', 'ground')
+    assert g['g_pr']['pressure_angle'] == pytest.approx(math.radians(20))
+    f = mech.check('mechanisms/five-bar.yaml')
+    assert f['driver']['kind'] == 'time' and f['structure']['drivers'] == 2
+    assert [(d['kind'], d['link'], d['law']) for d in f['drivers']] == [
+        ('angle', 'crank1', '90 deg + 360 deg/s * t'),
+        ('angle', 'crank2', '60 deg + 20 deg * sin(2 * pi * t / 1 s)')]
+    r = mech.solve('mechanisms/five-bar.yaml')
+    assert r.columns[0] == 't'
+    # the driven angle follows its law (rad, t in s)
+    assert r['crank1.angle'] == pytest.approx(math.radians(90) + 2 * math.pi * r['t'], abs=1e-12)
