@@ -8,10 +8,9 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "describe.h"
 #include "drivers.h"
 #include "report.h"
-#include "gears.h"
-#include "springs.h"
 
 #define RAD2DEG_R 57.295779513082321
 
@@ -60,75 +59,32 @@ static void row_text(FILE *f, const char *key, const char *value)
     fputs("</td></tr>\n", f);
 }
 
-/* The driver as `mech check` says it (src/cmd_check.c); range: its range
- * and speed. */
-static void driver_text(const mech_model *m, int range, char *buf, size_t n)
+/* A crank's or slider's range and speed (laws of time: the sweep line says
+ * it). */
+static void driver_range_text(const mech_model *m, char *buf, size_t n)
 {
-    if (!m->has_driver) {
-        snprintf(buf, n, "none");
-        return;
-    }
     const mech_driver *dr = &m->driver;
-    if (dr->kind == MECH_DRIVE_TIME) {  /* laws of time: the sweep and the laws */
-        size_t at = (size_t)snprintf(buf, n, "time t from %.6g to %.6g s, %d position%s",
-                                     dr->values[0], dr->values[dr->nvalues - 1], dr->nvalues,
-                                     dr->nvalues == 1 ? "" : "s");
-        for (int i = 0; !range && i < m->nmotions && at < n; i++)
-            at += (size_t)snprintf(buf + at, n - at, "; %s = %s", drivers_name(m, i),
-                                   m->motions[i].text);
-        return;
-    }
     int angle = dr->kind == MECH_DRIVE_ANGLE;
     double k = angle ? RAD2DEG_R : 1e3;
-    if (range)
-        snprintf(buf, n, "from %.6g to %.6g %s, speed %.6g %s", dr->values[0] * k,
-                 dr->values[dr->nvalues - 1] * k, angle ? "deg" : "mm", dr->speed,
-                 angle ? "rad/s" : "m/s");
-    else
-        snprintf(buf, n, "%s '%s', %d position%s", angle ? "angle of link" :
-                 "displacement of slider", angle ? m->links[dr->index].name :
-                 m->joints[dr->index].name, dr->nvalues, dr->nvalues == 1 ? "" : "s");
+    snprintf(buf, n, "from %.6g to %.6g %s, speed %.6g %s", dr->values[0] * k,
+             dr->values[dr->nvalues - 1] * k, angle ? "deg" : "mm", dr->speed,
+             angle ? "rad/s" : "m/s");
 }
 
-/* The lines of `mech check` (src/cmd_check.c). */
+static void row_line(void *ctx, const char *label, const char *text)
+{
+    row_text(ctx, label, text);
+}
+
+/* The lines of `mech check` (model_describe), then the driver's range. */
 static void put_summary(FILE *f, const mech_model *m, const mech_summary *s)
 {
     char b[512];
-    int nsliders = s->nprismatic + s->npin_in_slot;
     fputs("<table class=\"kv\">\n", f);
-    snprintf(b, sizeof b, "%d (ground + %d moving)", s->nlinks, s->nlinks - 1);
-    row_text(f, "links", b);
-    snprintf(b, sizeof b, "%d (%d revolute, %d prismatic slider, %d pin-in-slot slider)",
-             s->nrevolute + nsliders, s->nrevolute, s->nprismatic, s->npin_in_slot);
-    row_text(f, "joints", b);
-    snprintf(b, sizeof b, "%d (%d link angles + %d slider displacements - 1 driver)",
-             s->nunknowns, s->nlinks - 1 - s->nprismatic, nsliders);
-    row_text(f, "unknowns", b);
-    snprintf(b, sizeof b, "%d independent%s, %d equations", s->nloops,
-             m->nloops ? " (listed in the file)" : " (found automatically)", s->nequations);
-    row_text(f, "loops", b);
-    char mesh[32] = "";  /* each gear pair or rack removes one freedom (gears.c) */
-    if (s->ngears)
-        snprintf(mesh, sizeof mesh, " - %d gear%s", s->ngears, s->ngears == 1 ? "" : "s");
-    snprintf(b, sizeof b, "%d = 3*(%d-1) - 2*%d - %d%s, drivers %d", s->mobility, s->nlinks,
-             s->nrevolute + s->nprismatic, s->npin_in_slot, mesh, s->ndrivers);
-    row_text(f, "mobility", b);
-    driver_text(m, 0, b, sizeof b);
-    row_text(f, "driver", b);
-    if (m->has_driver) {
-        driver_text(m, 1, b, sizeof b);
+    model_describe(m, s, row_line, f);
+    if (m->has_driver && m->driver.kind != MECH_DRIVE_TIME) {
+        driver_range_text(m, b, sizeof b);
         row_text(f, "driver range", b);
-    }
-    snprintf(b, sizeof b, "%d points, %d links, %d sliders%s", m->outputs.npoints,
-             m->outputs.nlinks, m->outputs.nsliders, m->outputs.forces ? ", forces" : "");
-    row_text(f, "outputs", b);
-    for (int i = 0; i < m->nsprings; i++) {
-        springs_describe(m, i, b, sizeof b);
-        row_text(f, "spring", b);
-    }
-    for (int i = 0; i < m->ngears; i++) {
-        gears_describe(m, i, b, sizeof b);
-        row_text(f, "gears", b);
     }
     fputs("</table>\n", f);
 }

@@ -180,6 +180,11 @@ page_of() {
 page_of fourbar $four
 page_of stirling mechanisms/stirling.yaml
 page_of springs mechanisms/spring-slider-crank.yaml
+# laws of time with two drivers, gears, loads that depend on the motion: the
+# page's structure lines are mech check's (model_describe)
+page_of five-bar mechanisms/five-bar.yaml
+page_of epicyclic mechanisms/epicyclic.yaml
+page_of shaper mechanisms/shaper.yaml --steps 90
 page_of conveyor-forces mechanisms/conveyor.yaml --forces --steps 90
 PLOT_ALL=0 page_of slider-range mechanisms/offset-slider-crank.yaml --from 10 --to 100 --steps 9
 page_of outputs mechanisms/watt-six-bar.yaml --outputs B,bellcrank
