@@ -137,19 +137,14 @@ static int fuse_sincos(tape *t)
 }
 
 /* Give back what compiling over-allocated: the instruction array grew by
- * doubling and the image was sized for every node of the DAG (a chain of
- * 10^5 loops: megabytes). A failed shrink keeps the larger block. */
+ * doubling (the image sized for every node of the DAG is already freed:
+ * constant_list). A failed shrink keeps the larger block. */
 static void trim(tape *t)
 {
     if (t->nins > 0) {
         tape_ins *ins = xrealloc_array(t->ins, (size_t)t->nins, sizeof *ins);
         if (ins)
             t->ins = ins;
-    }
-    if (t->nreg > 0 && t->reg0) {
-        double *reg0 = xrealloc_array(t->reg0, (size_t)t->nreg, sizeof *reg0);
-        if (reg0)
-            t->reg0 = reg0;
     }
 }
 
