@@ -385,6 +385,7 @@ int tape_compile(tape *t, expr_ctx *c, int nvars, int nphases, const ex *const *
     for (int k = 0; k < nphases; k++)
         t->phase_split[k] = t->phase_start[k];
     free(stack.v);
+    stack.v = NULL;  /* fail: frees it again */
     if (fuse_sincos(t) < 0 || constant_list(t) < 0)
         goto fail;
     trim(t);
