@@ -217,7 +217,7 @@ static int fuse_range(tape *t, const int *uses, const int *def, int from, int to
 
 /* Number the registers still in use 0, 1, ... in their order: the fused
  * instructions' results leave holes (a chain of four-bars: 34 registers per
- * loop, 24 in use), and every register file is nreg long. */
+ * loop, 26 in use: bench-scale), and every register file is nreg long. */
 static void renumber(tape *t, const ex *const *roots, const int *nroots)
 {
     int *map = xcalloc((size_t)t->nreg + 1, sizeof *map);  /* 0 unused, else new + 1 */
