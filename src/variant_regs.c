@@ -100,8 +100,9 @@ int vbase_new(mech_model *base, const char *const *names, int nnames, int forces
     if (!b || !which) {
         free(b);
         free(which);
+        diag_error(d, base->file, (mech_mark){0, 0}, "out of memory");
         mech_model_free(&base);
-        return diag_error(d, base ? base->file : NULL, (mech_mark){0, 0}, "out of memory"), MECH_ENOMEM;
+        return MECH_ENOMEM;
     }
     b->m = base;
     int rc = MECH_OK;
