@@ -123,6 +123,13 @@ int sys_coefficients_init(mech_system *s);
 void sys_named_body(mech_system *s, const loop_term *t, ex *x, ex *y);
 void sys_cartesian_body(mech_system *s, const loop_term *t, ex *x, ex *y);
 void sys_register_body(mech_system *s, const loop_term *t, ex *x, ex *y);
+/* SYS_REGISTERS: the variable of body term t's length (is_angle 0) or
+ * angle (1) when it is a register leaf, else -1 (variant_regs.c sets it). */
+int sys_coef_var(const mech_system *s, const loop_term *t, int is_angle);
+/* Body term t's vector in model m: components, length and angle, as the
+ * systems write it (variant_regs.c compares a variant's with the base's). */
+void sys_body_vector(const mech_model *m, const loop_term *t, double *dx, double *dy, double *r,
+                     double *a);
 
 /* Evaluation through the tape (no allocation). The velocity and
  * acceleration phases reuse the position phase's registers, so they must

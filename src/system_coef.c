@@ -260,14 +260,31 @@ int mech_system_new_named(const mech_model *m, mech_system **out, mech_diag *d)
 
 /* The variable of the length or angle of t's vector: one per vector and
  * kind (a loop crossing the vector again finds it). */
-static ex register_leaf(mech_system *s, const loop_term *t, int is_angle)
+int sys_coef_var(const mech_system *s, const loop_term *t, int is_angle)
 {
-    int k0 = SYS_NVARS(s->n), nc = s->nvars - k0;
-    for (int k = 0; k < nc; k++) {
+    for (int k = 0; k < s->nvars - SYS_NVARS(s->n); k++) {
         const sys_coef *c = &s->coef[k];
         if (c->link == t->link && c->p0 == t->p0 && c->p1 == t->p1 && c->is_angle == is_angle)
-            return expr_var(&s->ex, k0 + k);
+            return SYS_NVARS(s->n) + k;
     }
+    return -1;
+}
+
+void sys_body_vector(const mech_model *m, const loop_term *t, double *dx, double *dy, double *r,
+                     double *a)
+{
+    const mech_link *l = &m->links[t->link];
+    *dx = l->points[t->p1].x - l->points[t->p0].x;
+    *dy = l->points[t->p1].y - l->points[t->p0].y;
+    *r = hypot(*dx, *dy);
+    *a = atan2(*dy, *dx);
+}
+
+static ex register_leaf(mech_system *s, const loop_term *t, int is_angle)
+{
+    int var = sys_coef_var(s, t, is_angle), nc = s->nvars - SYS_NVARS(s->n);
+    if (var >= 0)
+        return expr_var(&s->ex, var);
     sys_coef *grown = xrealloc_array(s->coef, (size_t)nc + 1, sizeof *grown);
     if (!grown) {
         s->ex.failed = 1;  /* the system build then fails: out of memory */
@@ -287,10 +304,8 @@ static ex register_leaf(mech_system *s, const loop_term *t, int is_angle)
 static void body_with_leaves(mech_system *s, const loop_term *t, int registers, ex *x, ex *y)
 {
     expr_ctx *c = &s->ex;
-    const mech_link *l = &s->model->links[t->link];
-    double dx = l->points[t->p1].x - l->points[t->p0].x;
-    double dy = l->points[t->p1].y - l->points[t->p0].y;
-    double r = hypot(dx, dy), a = atan2(dy, dx);
+    double dx, dy, r, a;
+    sys_body_vector(s->model, t, &dx, &dy, &r, &a);
     int np = s->params->nparams;
     if (!registers && t->link == 0 && ground_components(s, t, dx, dy, x, y))
         return;

@@ -48,25 +48,6 @@ void vbase_free(variant_base **pb)
 
 const mech_model *vbase_model(const variant_base *b) { return b->m; }
 
-static int coef_var(const mech_system *s, const loop_term *t, int is_angle)
-{
-    for (int k = 0; k < s->nvars - SYS_NVARS(s->n); k++) {
-        const sys_coef *c = &s->coef[k];
-        if (c->link == t->link && c->p0 == t->p0 && c->p1 == t->p1 && c->is_angle == is_angle)
-            return SYS_NVARS(s->n) + k;
-    }
-    return -1;
-}
-
-static void vector_of(const mech_model *m, const loop_term *t, double *r, double *a)
-{
-    const mech_link *l = &m->links[t->link];
-    double dx = l->points[t->p1].x - l->points[t->p0].x;
-    double dy = l->points[t->p1].y - l->points[t->p0].y;
-    *r = hypot(dx, dy);  /* as system.c's numeric body vector */
-    *a = atan2(dy, dx);
-}
-
 static int index_terms(variant_base *b)
 {
     const loop_set *ls = &b->sys->loops;
@@ -84,9 +65,10 @@ static int index_terms(variant_base *b)
             continue;
         int i = b->nterms++;
         b->term[i] = t;
-        b->rvar[i] = coef_var(b->sys, t, 0);
-        b->avar[i] = coef_var(b->sys, t, 1);
-        vector_of(b->m, t, &b->r0[i], &b->a0[i]);
+        b->rvar[i] = sys_coef_var(b->sys, t, 0);
+        b->avar[i] = sys_coef_var(b->sys, t, 1);
+        double dx, dy;
+        sys_body_vector(b->m, t, &dx, &dy, &b->r0[i], &b->a0[i]);
     }
     return 0;
 }
@@ -227,7 +209,8 @@ static int set_coefficients(const variant_base *b, const mech_model *mv, mech_an
     const double two_pi = 6.28318530717958647692;
     for (int i = 0; i < b->nterms; i++) {
         double r, a;
-        vector_of(mv, b->term[i], &r, &a);
+        double dx, dy;
+        sys_body_vector(mv, b->term[i], &dx, &dy, &r, &a);
         if (b->rvar[i] >= 0) {
             if (r == 0.0)
                 return -1;
