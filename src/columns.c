@@ -146,10 +146,11 @@ static int force_columns(column_layout *cl, const mech_model *m, char **label, i
         snprintf(name, sizeof name, "%s%s", angle ? ".torque" : ".force", suffix);
         rc |= add(cl, SRC_DRIVE_LOAD, k, 0, drivers_name(m, k), name, angle ? "N*m" : "N");
     }
-    if (drivers_rows(m) == 0 && m->driver.kind == MECH_DRIVE_ANGLE)
-        rc |= add(cl, SRC_DRIVE_LOAD, 0, 0, "driver.torque", suffix, "N*m");
-    else if (drivers_rows(m) == 0)
-        rc |= add(cl, SRC_DRIVE_LOAD, 0, 0, "driver.force", suffix, "N");
+    if (drivers_rows(m) == 0) {  /* `driver:`: its one load */
+        int angle = m->driver.kind == MECH_DRIVE_ANGLE;
+        rc |= add(cl, SRC_DRIVE_LOAD, 0, 0, angle ? "driver.torque" : "driver.force", suffix,
+                  angle ? "N*m" : "N");
+    }
     rc |= add(cl, SRC_POWER_RESIDUAL, 0, 0, "power.residual", suffix, "-");
     for (int c = first; !rc && c < cl->ncols; c++)
         cl->cols[c].set = set;

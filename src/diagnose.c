@@ -13,6 +13,14 @@ static const double PI = 3.14159265358979323846;
 
 static int is_angle_driver(const mech_model *m) { return m->driver.kind == MECH_DRIVE_ANGLE; }
 
+/* The unit users read q in ("deg", "s" for laws of time, "mm") and the
+   factor from SI to it. */
+static const char *q_unit(const mech_model *m, double *scale)
+{
+    *scale = is_angle_driver(m) ? 180.0 / PI : m->driver.kind == MECH_DRIVE_TIME ? 1.0 : 1e3;
+    return is_angle_driver(m) ? "deg" : m->driver.kind == MECH_DRIVE_TIME ? "s" : "mm";
+}
+
 /* "123.4 deg" or "0.1834 m": the driver position as users think of it. */
 const char *diagnose_q_text(const mech_model *m, double q, char *buf, size_t size)
 {
@@ -28,11 +36,11 @@ const char *diagnose_q_text(const mech_model *m, double q, char *buf, size_t siz
 const char *diagnose_q_interval(const mech_model *m, double a, double b, char *buf,
                                 size_t size)
 {
-    double unit = is_angle_driver(m) ? 180.0 / PI : m->driver.kind == MECH_DRIVE_TIME ? 1.0 : 1e3;
+    double unit;
+    const char *u = q_unit(m, &unit);
     double lo = fmin(a, b) * unit, hi = fmax(a, b) * unit, width = hi - lo;
     int dec = width > 0.0 ? (int)ceil(-log10(width)) + 1 : 6;
     dec = dec < 0 ? 0 : dec > 12 ? 12 : dec;
-    const char *u = is_angle_driver(m) ? "deg" : m->driver.kind == MECH_DRIVE_TIME ? "s" : "mm";
     snprintf(buf, size, "%.*f %s and %.*f %s", dec, lo, u, dec, hi, u);
     return buf;
 }
@@ -506,13 +514,12 @@ static void limit_words(cont *c, double hrow, char *why, size_t size)
     in_line_text(&c->sv, upper, c->xc, line, sizeof line);
     if (!line[0])
         return;
-    int time = m->driver.kind == MECH_DRIVE_TIME;  /* laws of time: t in s */
-    double unit = is_angle_driver(m) ? 180.0 / PI : time ? 1.0 : 1e3;
+    double unit;
+    const char *u = q_unit(m, &unit);
     double acc = fmax(1e-9 * fabs(hrow), 1e-11 * fmax(fabs(upper), fabs(hrow))) * unit;
     int dec = (int)floor(-log10(acc)) - 1;
     snprintf(why, size, "; at %.*f %s, %s%s", dec < 0 ? 0 : dec > 12 ? 12 : dec, upper * unit,
-             is_angle_driver(m) ? "deg" : time ? "s" : "mm", line,
-             is_angle_driver(m) || time ? "" : ": dead centre of the slider");
+             u, line, m->driver.kind == MECH_DRIVE_SLIDER ? ": dead centre of the slider" : "");
 }
 
 /* The interval(s) where the mechanism assembles, from row 0 and the last

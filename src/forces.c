@@ -804,12 +804,6 @@ void forces_joint(const forces *fc, const solver *sv, int j, int with_friction, 
         *mo = y[c + 1];
 }
 
-double forces_drive(const forces *fc, int with_friction)
-{
-    const forces_plan *fp = fc->p;
-    return (with_friction ? fc->y : fc->y0)[fp->ncols - 1];
-}
-
 double forces_gear(const forces *fc, int i, int with_friction)
 {
     const forces_plan *fp = fc->p;

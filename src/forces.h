@@ -75,7 +75,6 @@ int forces_solve(forces *fc, const solver *sv);
  * friction solution (with_friction) or the frictionless one. */
 void forces_joint(const forces *fc, const solver *sv, int j, int with_friction, double *fx,
                   double *fy, double *n, double *mo);
-double forces_drive(const forces *fc, int with_friction);
 /* Tooth force of gear pair i along its line of action (gears.h), N: the
  * sign of its tangential part F (on link[1], along t). */
 double forces_gear(const forces *fc, int i, int with_friction);

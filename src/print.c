@@ -91,10 +91,8 @@ static void print_text(const mech_system *s, FILE *out)
         int g = r - 2 * s->loops.nloops;  /* gears.c's rows follow the loops' */
         if (r >= s->m - drivers_rows(m))  /* drivers as laws of time: the last rows */
             fprintf(out, "    [driver '%s']\n", drivers_name(m, r - (s->m - drivers_rows(m))));
-        else if (g >= 0 && g < s->model->ngears)
+        else if (g >= 0)  /* s->m = 2 nloops + ngears + drivers: a gear row */
             fprintf(out, "    [gear pair '%s']\n", s->model->gears[g].name);
-        else if (g >= 0)
-            fprintf(out, "    [row %d]\n", r + 1);
         else
             fprintf(out, "    [loop %d, %c]\n", r / 2 + 1, r % 2 ? 'y' : 'x');
     }
