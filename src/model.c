@@ -387,10 +387,10 @@ int mech_check(const mech_model *m, mech_summary *s, mech_diag *d)
         if (m->ngears)
             snprintf(mesh, sizeof mesh, " - %d gear%s", m->ngears, m->ngears == 1 ? "" : "s");
         snprintf(gruebler, sizeof gruebler, "%d degree%s of freedom (Gruebler: 3*(%d-1) - 2*%d "
-                 "- %d%s = %d) but %d driver, so %d unknown%s for %d loop equations",
+                 "- %d%s = %d) but %d driver%s, so %d unknown%s for %d loop equations",
                  s->mobility, s->mobility == 1 || s->mobility == -1 ? "" : "s", m->nlinks,
                  s->nrevolute + s->nprismatic, s->npin_in_slot, mesh, s->mobility, s->ndrivers,
-                 s->nunknowns, s->nunknowns == 1 ? "" : "s", s->nequations);
+                 s->ndrivers == 1 ? "" : "s", s->nunknowns, s->nunknowns == 1 ? "" : "s", s->nequations);
         if (excess > 0) {
             diag_error(d, m->file, at,
                        "under-constrained: the mechanism has %s; %d more degree%s of freedom "

@@ -95,10 +95,15 @@ fi
 sed 's|^outputs:|loads:\n  - {torque: "0.5 N*m/s * t", link: arm1}\noutputs:|' "$F" >"$tmp/tload.yaml"
 if run "solve with a load of t" 0 "$MECH" solve "$tmp/tload.yaml" -o "$tmp/tl.csv" &&
    run "solve without it" 0 "$MECH" solve "$F" -o "$tmp/t0.csv"; then
-    worst=$(paste -d, "$tmp/tl.csv" "$tmp/t0.csv" | awk -F, 'NR > 1 {
-        n = 49  # columns per file: t .. power.residual
-        dp = ($47 - $(n + 47)) * $21 + ($48 - $(n + 48)) * $30   # the drivers power, change
-        want = -0.5 * $1 * $24                                    # -T omega_arm1
+    # columns by name: NAME [unit] in the header of the first file
+    worst=$(paste -d, "$tmp/tl.csv" "$tmp/t0.csv" | awk -F, 'NR == 1 {
+        n = NF / 2
+        for (i = 1; i <= n; i++) { split($i, w, " "); c[w[1]] = i }
+        next
+    } {
+        t1 = c["crank1.torque"]; t2 = c["crank2.torque"]
+        dp = ($t1 - $(n + t1)) * $c["crank1.omega"] + ($t2 - $(n + t2)) * $c["crank2.omega"]
+        want = -0.5 * $c["t"] * $c["arm1.omega"]                 # -T omega_arm1
         e = dp - want; if (e < 0) e = -e
         sc = want < 0 ? -want : want; if (sc < 1e-3) sc = 1e-3
         if (e / sc > worst) worst = e / sc
