@@ -18,8 +18,8 @@ static const double PI = 3.14159265358979323846;
 void springs_point_motion(const solver *sv, int l, int i, double p[2], double v[2])
 {
     const mech_point *pt = &sv->p->m->links[l].points[i];
-    double r[2] = {pt->x, pt->y}, a[2];
-    kin_on_link(&sv->ks, l, r, p, v, a);
+    double r[2] = {pt->x, pt->y};
+    kin_on_link(&sv->ks, l, r, p, v, NULL);
 }
 
 void springs_line(const solver *sv, const int link[2], const int point[2], double p[2][2],
