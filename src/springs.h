@@ -19,7 +19,7 @@ typedef struct spring_state {
 void springs_eval(const mech_spring *s, const solver *sv, spring_state *st);
 
 /* What springs and the loads along a line (state_loads.c) share: point i of
- * link l at the published position (p, v: ground frame); the line from
+ * link l at the published position (p, v: ground frame; v may be NULL); the line from
  * point[0] of link[0] to point[1] of link[1] (ends p, v, unit vector u from
  * end 0 to end 1, along x when they coincide, length and its rate); a known
  * load (force f at p, moment t) on link l moved to the right-hand side of
