@@ -1,5 +1,5 @@
 /* src/state_loads.h: loads that depend on the motion (docs/format.md
- * section 10.2, docs/forces.md section 8). A load component written as an
+ * section 10.2, docs/forces.md section 7a). A load component written as an
  * expression of the state (B.vx, crank.angle, x_B.s, ...) is compiled at
  * load time (load_state_loads.c) into a flat register program: inputs read
  * from the solved motion, then one instruction per operation. Per step the
