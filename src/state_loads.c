@@ -183,8 +183,10 @@ void state_loads_eval(const state_loads *s, const solver *sv, double *reg)
     }
 }
 
-void state_loads_line(const sl_load *l, const solver *sv, double p[2][2], double v[2][2],
-                      double u[2], double *length, double *rate)
+/* A line load's ends, unit vector u from end 0 to end 1 (x when they
+ * coincide), length and its rate. */
+static void state_loads_line(const sl_load *l, const solver *sv, double p[2][2], double v[2][2],
+                             double u[2], double *length, double *rate)
 {
     const int link[2] = {l->link, l->link2}, point[2] = {l->point, l->point2};
     springs_line(sv, link, point, p, v, u, length, rate);

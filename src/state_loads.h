@@ -89,10 +89,6 @@ void state_loads_add(const state_loads *s, const solver *sv, const double *reg, 
  * velocities); *scale gets the size terms for the relative residual. */
 double state_loads_power(const state_loads *s, const solver *sv, const double *reg,
                          double *scale);
-/* A line load's ends, unit vector u from end 0 to end 1 (x when they
- * coincide), length and its rate. */
-void state_loads_line(const sl_load *l, const solver *sv, double p[2][2], double v[2][2],
-                      double u[2], double *length, double *rate);
 /* Load i in words, as mech check shows it: "force at T on link 'ram'". */
 void state_loads_describe(const mech_model *m, int i, char *buf, size_t size);
 
