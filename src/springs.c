@@ -86,11 +86,19 @@ void springs_add_loads(const mech_model *m, const solver *sv, const double *g, d
  * every power vanishes while the driver torque still carries the rounding
  * of forces of that size (a dead centre of the example: 3e-8 relative to the
  * vanishing powers alone, 1e-16 to this). */
+void springs_power_scales(const mech_model *m, const solver *sv, double *linear,
+                          double *turning)
+{
+    double lref = sv->p->lref, speed = fabs(m->driver.speed);
+    int angle = m->driver.kind == MECH_DRIVE_ANGLE;
+    *linear = angle ? speed * lref : speed;
+    *turning = angle ? speed : speed / lref;
+}
+
 double springs_power(const mech_model *m, const solver *sv, double *scale)
 {
-    double total = 0.0, lref = sv->p->lref, speed = fabs(m->driver.speed);
-    int angle = m->driver.kind == MECH_DRIVE_ANGLE;
-    double linear = angle ? speed * lref : speed, turning = angle ? speed : speed / lref;
+    double total = 0.0, linear, turning;
+    springs_power_scales(m, sv, &linear, &turning);
     for (int i = 0; i < m->nsprings; i++) {
         const mech_spring *s = &m->springs[i];
         spring_state st;

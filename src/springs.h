@@ -36,6 +36,12 @@ void springs_add_known_load(double *rhs, const double *g, int l, const double *p
  * g[2 l], g[2 l + 1]). */
 void springs_add_loads(const mech_model *m, const solver *sv, const double *g, double *rhs);
 
+/* The speeds that turn a load's size into a power scale: a force times
+ * `linear`, a torque times `turning` (the driver's speed, with the
+ * reference length lref between them); springs_power, state_loads_power. */
+void springs_power_scales(const mech_model *m, const solver *sv, double *linear,
+                          double *turning);
+
 /* Power the springs' forces deliver to the links, W (-force * rate summed:
  * negative while they store or dissipate energy); *scale gets the sum of
  * the absolute values. */

@@ -225,9 +225,8 @@ double state_loads_power(const state_loads *s, const solver *sv, const double *r
     if (!s)
         return 0.0;
     const mech_model *m = sv->p->m;
-    double total = 0.0, lref = sv->p->lref, speed = fabs(m->driver.speed);
-    int angle = m->driver.kind == MECH_DRIVE_ANGLE;
-    double linear = angle ? speed * lref : speed, turning = angle ? speed : speed / lref;
+    double total = 0.0, linear, turning;
+    springs_power_scales(m, sv, &linear, &turning);
     for (int i = 0; i < s->nloads; i++) {
         const sl_load *l = &s->loads[i];
         double pw;
