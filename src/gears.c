@@ -6,6 +6,7 @@
 #include <stdio.h>
 
 #include "gears.h"
+#include "springs.h"
 
 static const double PI = 3.14159265358979323846;
 
@@ -43,14 +44,6 @@ void gears_rows(mech_system *s, ex *rows)
     }
 }
 
-/* Ground position of point k of link l at the published position. */
-static void place(const solver *sv, int l, int k, double *p)
-{
-    const mech_point *pt = &sv->p->m->links[l].points[k];
-    double r[2] = {pt->x, pt->y};
-    kin_on_link(&sv->ks, l, r, p, NULL, NULL);
-}
-
 void gears_contact(const mech_model *m, const solver *sv, int i, double *p, double *t,
                    double *r)
 {
@@ -61,7 +54,7 @@ void gears_contact(const mech_model *m, const solver *sv, int i, double *p, doub
     if (!sv)
         return;
     double a[2], n[2];  /* a's centre; n: unit from a's centre through the pitch point */
-    place(sv, g->arm, g->arm_pivot[0], a);
+    springs_point_motion(sv, g->arm, g->arm_pivot[0], a, NULL);
     if (g->kind == MECH_GEAR_RACK) {
         /* the rack's line is r from the centre, to the right of the guide's
            direction u when side > 0: n = -side (-u_y, u_x) */
@@ -71,7 +64,7 @@ void gears_contact(const mech_model *m, const solver *sv, int i, double *p, doub
         n[1] = -g->side * cos(ang);
     } else {
         double b[2];
-        place(sv, g->arm, g->arm_pivot[1], b);
+        springs_point_motion(sv, g->arm, g->arm_pivot[1], b, NULL);
         double d = hypot(b[0] - a[0], b[1] - a[1]);
         n[0] = (b[0] - a[0]) / d;
         n[1] = (b[1] - a[1]) / d;

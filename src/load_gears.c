@@ -280,7 +280,8 @@ static void load_one_gear(loader *ld, const ynode *map, mech_gear *g, name_map *
     g->mark = map->mark;
     int rack = ymap_get(map, "pinion") != NULL;
     const char *const *bad = rack ? pair_only : rack_only;
-    for (size_t i = 0; i < COUNT(pair_only); i++) {
+    size_t nbad = rack ? COUNT(pair_only) : COUNT(rack_only);
+    for (size_t i = 0; i < nbad; i++) {
         const ynode *key = load_key_of(map, bad[i]);
         if (key)
             return (void)load_err(ld, key, "'%s' does not apply to a %s", bad[i],

@@ -18,8 +18,8 @@ static const double PI = 3.14159265358979323846;
 void springs_point_motion(const solver *sv, int l, int i, double p[2], double v[2])
 {
     const mech_point *pt = &sv->p->m->links[l].points[i];
-    double r[2] = {pt->x, pt->y}, a[2];
-    kin_on_link(&sv->ks, l, r, p, v, a);
+    double r[2] = {pt->x, pt->y};
+    kin_on_link(&sv->ks, l, r, p, v, NULL);
 }
 
 void springs_line(const solver *sv, const int link[2], const int point[2], double p[2][2],
@@ -86,11 +86,19 @@ void springs_add_loads(const mech_model *m, const solver *sv, const double *g, d
  * every power vanishes while the driver torque still carries the rounding
  * of forces of that size (a dead centre of the example: 3e-8 relative to the
  * vanishing powers alone, 1e-16 to this). */
+void springs_power_scales(const mech_model *m, const solver *sv, double *linear,
+                          double *turning)
+{
+    double lref = sv->p->lref, speed = fabs(m->driver.speed);
+    int angle = m->driver.kind == MECH_DRIVE_ANGLE;
+    *linear = angle ? speed * lref : speed;
+    *turning = angle ? speed : speed / lref;
+}
+
 double springs_power(const mech_model *m, const solver *sv, double *scale)
 {
-    double total = 0.0, lref = sv->p->lref, speed = fabs(m->driver.speed);
-    int angle = m->driver.kind == MECH_DRIVE_ANGLE;
-    double linear = angle ? speed * lref : speed, turning = angle ? speed : speed / lref;
+    double total = 0.0, linear, turning;
+    springs_power_scales(m, sv, &linear, &turning);
     for (int i = 0; i < m->nsprings; i++) {
         const mech_spring *s = &m->springs[i];
         spring_state st;

@@ -19,7 +19,7 @@ typedef struct spring_state {
 void springs_eval(const mech_spring *s, const solver *sv, spring_state *st);
 
 /* What springs and the loads along a line (state_loads.c) share: point i of
- * link l at the published position (p, v: ground frame); the line from
+ * link l at the published position (p, v: ground frame; v may be NULL); the line from
  * point[0] of link[0] to point[1] of link[1] (ends p, v, unit vector u from
  * end 0 to end 1, along x when they coincide, length and its rate); a known
  * load (force f at p, moment t) on link l moved to the right-hand side of
@@ -35,6 +35,12 @@ void springs_add_known_load(double *rhs, const double *g, int l, const double *p
  * the Newton-Euler rows (3 per moving link: x, y, moment about the centre
  * g[2 l], g[2 l + 1]). */
 void springs_add_loads(const mech_model *m, const solver *sv, const double *g, double *rhs);
+
+/* The speeds that turn a load's size into a power scale: a force times
+ * `linear`, a torque times `turning` (the driver's speed, with the
+ * reference length lref between them); springs_power, state_loads_power. */
+void springs_power_scales(const mech_model *m, const solver *sv, double *linear,
+                          double *turning);
 
 /* Power the springs' forces deliver to the links, W (-force * rate summed:
  * negative while they store or dissipate energy); *scale gets the sum of

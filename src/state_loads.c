@@ -183,8 +183,10 @@ void state_loads_eval(const state_loads *s, const solver *sv, double *reg)
     }
 }
 
-void state_loads_line(const sl_load *l, const solver *sv, double p[2][2], double v[2][2],
-                      double u[2], double *length, double *rate)
+/* A line load's ends, unit vector u from end 0 to end 1 (x when they
+ * coincide), length and its rate. */
+static void state_loads_line(const sl_load *l, const solver *sv, double p[2][2], double v[2][2],
+                             double u[2], double *length, double *rate)
 {
     const int link[2] = {l->link, l->link2}, point[2] = {l->point, l->point2};
     springs_line(sv, link, point, p, v, u, length, rate);
@@ -223,9 +225,8 @@ double state_loads_power(const state_loads *s, const solver *sv, const double *r
     if (!s)
         return 0.0;
     const mech_model *m = sv->p->m;
-    double total = 0.0, lref = sv->p->lref, speed = fabs(m->driver.speed);
-    int angle = m->driver.kind == MECH_DRIVE_ANGLE;
-    double linear = angle ? speed * lref : speed, turning = angle ? speed : speed / lref;
+    double total = 0.0, linear, turning;
+    springs_power_scales(m, sv, &linear, &turning);
     for (int i = 0; i < s->nloads; i++) {
         const sl_load *l = &s->loads[i];
         double pw;

@@ -1,5 +1,5 @@
 /* src/state_loads.h: loads that depend on the motion (docs/format.md
- * section 10.2, docs/forces.md section 8). A load component written as an
+ * section 10.2, docs/forces.md section 7a). A load component written as an
  * expression of the state (B.vx, crank.angle, x_B.s, ...) is compiled at
  * load time (load_state_loads.c) into a flat register program: inputs read
  * from the solved motion, then one instruction per operation. Per step the
@@ -89,10 +89,6 @@ void state_loads_add(const state_loads *s, const solver *sv, const double *reg, 
  * velocities); *scale gets the size terms for the relative residual. */
 double state_loads_power(const state_loads *s, const solver *sv, const double *reg,
                          double *scale);
-/* A line load's ends, unit vector u from end 0 to end 1 (x when they
- * coincide), length and its rate. */
-void state_loads_line(const sl_load *l, const solver *sv, double p[2][2], double v[2][2],
-                      double u[2], double *length, double *rate);
 /* Load i in words, as mech check shows it: "force at T on link 'ram'". */
 void state_loads_describe(const mech_model *m, int i, char *buf, size_t size);
 
