@@ -41,7 +41,8 @@ count() {
     valgrind --tool=callgrind --toggle-collect="$fn" --callgrind-out-file=/dev/null "$@" \
         2>&1 >/dev/null | awk '/Collected/ { print $4 }'
 }
-# per_step FN PROGRAM ARGS-BEFORE-N -- ARGS-AFTER-N: (count(3600) - count(360)) / 3240
+# per_step FN hand NAME SIDE [forces] | per_step FN GENBENCH: instructions per
+# step inside FN, (count(3600) - count(360)) / 3240
 per_step() {
     fn=$1 prog=$2 name=$3 side=$4 extra=$5
     if [ "$prog" = hand ]; then

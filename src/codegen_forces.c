@@ -217,8 +217,19 @@ static void emit_motion(const codegen *g, FILE *f)
     fprintf(f, "}\n\n");
 }
 
+/* rhs[3 (l - 1) ..] for a force fx, fy at p on link l (forces.c load_force). */
 static void emit_load_force(FILE *f, int l, const char *rhs, const char *p, const char *fx,
-                            const char *fy, const char *indent);
+                            const char *fy, const char *indent)
+{
+    if (l == 0)
+        return;
+    int row = 3 * (l - 1);
+    fprintf(f, "%s{\n%s    double r0 = %s[0] - s->cg[%d], r1 = %s[1] - s->cg[%d];\n"
+               "%s    %s[%d] -= %s;\n%s    %s[%d] -= %s;\n"
+               "%s    %s[%d] -= r0 * (%s) - r1 * (%s);\n%s}\n",
+            indent, indent, p, 2 * l, p, 2 * l + 1, indent, rhs, row, fx, indent, rhs, row + 1, fy,
+            indent, rhs, row + 2, fy, fx, indent);
+}
 
 /* double p[2], t[2], r[2] = gear pair i's pitch point, tangent and
  * separating direction at the position of the frames F (gears.c
@@ -412,20 +423,6 @@ static int emit_matrix(const codegen *g, FILE *f)
     }
     fprintf(f, "}\n\n");
     return 0;
-}
-
-/* rhs[3 (l - 1) ..] for a force fx, fy at p on link l (forces.c load_force). */
-static void emit_load_force(FILE *f, int l, const char *rhs, const char *p, const char *fx,
-                            const char *fy, const char *indent)
-{
-    if (l == 0)
-        return;
-    int row = 3 * (l - 1);
-    fprintf(f, "%s{\n%s    double r0 = %s[0] - s->cg[%d], r1 = %s[1] - s->cg[%d];\n"
-               "%s    %s[%d] -= %s;\n%s    %s[%d] -= %s;\n"
-               "%s    %s[%d] -= r0 * (%s) - r1 * (%s);\n%s}\n",
-            indent, indent, p, 2 * l, p, 2 * l + 1, indent, rhs, row, fx, indent, rhs, row + 1, fy,
-            indent, rhs, row + 2, fy, fx, indent);
 }
 
 /* The resultant of load i: double lf[2], lp[2], lv[2] (forces.c

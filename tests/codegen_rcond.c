@@ -17,15 +17,16 @@
  *
  *   rows N bound B exact E loosest L
  *
+ * (B rows where the solve kept the bound, E where it computed the
+ * condition, L the largest exact value / bound of the two), exit 0 when every
+ * row holds, 1 otherwise, 2 for a malformed DIAG.
+ *
  * With MIN (the generated source compiled with its MIN_RCOND set to MIN),
  * each row must be GEN_SINGULAR exactly where the interpreter's rcond is
  * below MIN (rows within 1e-9 of MIN are not judged), the others GEN_OK
  * with the interpreter's rcond within 1e-9 relatively (a row after a
  * singular one starts from another guess): the bound never hides a
- * singular position. It also prints "singular S".
- * (B rows where the solve kept the bound, E where it computed the
- * condition, L the largest exact value / bound of the two), exit 0 when every
- * row holds, 1 otherwise, 2 for a malformed DIAG. */
+ * singular position. It then prints "rows N singular S" instead. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
