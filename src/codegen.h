@@ -103,5 +103,7 @@ void codegen_sl_power(const codegen *g, FILE *f);
 
 /* "1.5", "(-2)", as a C double literal that reads back to v. */
 void codegen_number(char *buf, size_t size, double v);
+/* "x, y" of point i of link l, as literals (codegen_forces.c). */
+void codegen_point_xy(const mech_model *m, int l, int i, char *buf, size_t size);
 
 #endif

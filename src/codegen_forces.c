@@ -46,8 +46,7 @@ int codegen_forces_plan(codegen *g, mech_diag *d)
 
 static void num(char *buf, size_t size, double v) { codegen_number(buf, size, v); }
 
-/* "x, y" of point i of link l, as literals. */
-static void point_xy(const mech_model *m, int l, int i, char *buf, size_t size)
+void codegen_point_xy(const mech_model *m, int l, int i, char *buf, size_t size)
 {
     char x[40], y[40];
     num(x, sizeof x, m->links[l].points[i].x);
@@ -201,8 +200,8 @@ static void emit_motion(const codegen *g, FILE *f)
             continue;
         }
         char p0[96], p1[96];
-        point_xy(m, sp->link[0], sp->point[0], p0, sizeof p0);
-        point_xy(m, sp->link[1], sp->point[1], p1, sizeof p1);
+        codegen_point_xy(m, sp->link[0], sp->point[0], p0, sizeof p0);
+        codegen_point_xy(m, sp->link[1], sp->point[1], p1, sizeof p1);
         fprintf(f, "        double v0[2], v1[2], a[2];\n"
                    "        on_link(&F[%d], %s, st + 5, v0, a);\n"
                    "        on_link(&F[%d], %s, st + 7, v1, a);\n"
@@ -239,7 +238,7 @@ static void emit_gear_contact(const codegen *g, FILE *f, int i, const char *in)
     const mech_model *m = g->m;
     const mech_gear *gr = &m->gears[i];
     char pa[96], rad[40], sep[40];
-    point_xy(m, gr->arm, gr->arm_pivot[0], pa, sizeof pa);
+    codegen_point_xy(m, gr->arm, gr->arm_pivot[0], pa, sizeof pa);
     num(rad, sizeof rad, gr->radius[0]);
     fprintf(f, "%sdouble p[2], t[2], r[2], a[2], n[2], av[2], aa[2];\n"
                "%son_link(&F[%d], %s, a, av, aa);\n", in, in, gr->arm, pa);
@@ -254,7 +253,7 @@ static void emit_gear_contact(const codegen *g, FILE *f, int i, const char *in)
                 in, in, jt->link[1], ang, in, sd, in, msd, in);
     } else {
         char pb[96];
-        point_xy(m, gr->arm, gr->arm_pivot[1], pb, sizeof pb);
+        codegen_point_xy(m, gr->arm, gr->arm_pivot[1], pb, sizeof pb);
         fprintf(f, "%s{\n%s    double b[2], bv[2], ba[2];\n"
                    "%s    on_link(&F[%d], %s, b, bv, ba);\n"
                    "%s    double d = hypot(b[0] - a[0], b[1] - a[1]);\n"
@@ -361,7 +360,7 @@ static int emit_column_entries(const codegen *g, FILE *f, int c, int *rows)
         return n;
     }
     char pt[96];
-    point_xy(m, jt->link[0], jt->point[0], pt, sizeof pt);
+    codegen_point_xy(m, jt->link[0], jt->point[0], pt, sizeof pt);
     fprintf(f, "        double p[2], pv[2], pa[2], d[2];\n"
                "        on_link(&F[%d], %s, p, pv, pa);\n", jt->link[0], pt);
     switch (fp->kind[c]) {
@@ -433,7 +432,7 @@ static void emit_resultant(const codegen *g, FILE *f, int i)
     const mech_load *ld = &m->loads[i];
     char pt[96], a[40], b[40];
     if (ld->kind == MECH_LOAD_FORCE) {
-        point_xy(m, ld->link, ld->point[0], pt, sizeof pt);
+        codegen_point_xy(m, ld->link, ld->point[0], pt, sizeof pt);
         num(a, sizeof a, ld->force[0]);
         num(b, sizeof b, ld->force[1]);
         fprintf(f, "        double lf[2] = {%s, %s}, lp[2], lv[2], la[2];\n"
@@ -442,8 +441,8 @@ static void emit_resultant(const codegen *g, FILE *f, int i)
         return;
     }
     char pt1[96], w[40], dir[40];
-    point_xy(m, ld->link, ld->point[0], pt, sizeof pt);
-    point_xy(m, ld->link, ld->point[1], pt1, sizeof pt1);
+    codegen_point_xy(m, ld->link, ld->point[0], pt, sizeof pt);
+    codegen_point_xy(m, ld->link, ld->point[1], pt1, sizeof pt1);
     num(w, sizeof w, ld->intensity);
     num(dir, sizeof dir, ld->direction);
     fprintf(f, "        double lf[2], lp[2], lv[2], la[2], p0[2], p1[2], v0[2], v1[2];\n"
@@ -666,7 +665,7 @@ static void emit_friction(const codegen *g, FILE *f)
         } else {
             char rel[48], pt[96];
             slider_rate(g, j, rel, sizeof rel);
-            point_xy(m, jt->link[0], jt->point[0], pt, sizeof pt);
+            codegen_point_xy(m, jt->link[0], jt->point[0], pt, sizeof pt);
             fprintf(f, "        double rel = %s;\n"
                        "        double ff = %s * fabs(y[%d]) * smooth_sign(rel, eps * LREF);\n",
                     rel, mu, c);

@@ -22,15 +22,6 @@ static void reg_text(const state_loads *sl, int r, char *buf, size_t size)
         snprintf(buf, size, "s->slr[%d]", r);
 }
 
-/* "x, y" of point i of link l, as literals. */
-static void point_xy(const mech_model *m, int l, int i, char *buf, size_t size)
-{
-    char x[40], y[40];
-    codegen_number(x, sizeof x, m->links[l].points[i].x);
-    codegen_number(y, sizeof y, m->links[l].points[i].y);
-    snprintf(buf, size, "%s, %s", x, y);
-}
-
 static const state_loads *program(const codegen *g)
 {
     const state_loads *sl = g->m->state_loads;
@@ -57,7 +48,7 @@ static int input_text(const codegen *g, const sl_input *in, char *buf, size_t si
         if (l < 0)
             return -1;
         char r[96];
-        point_xy(g->m, l, t->point_index[in->index], r, sizeof r);
+        codegen_point_xy(g->m, l, t->point_index[in->index], r, sizeof r);
         snprintf(buf, size, "on_link(&F[%d], %s, p, p + 2, p + 4), p[%d]", l, r,
                  in->kind - SLIN_PX);
         return 0;
@@ -186,8 +177,8 @@ static void emit_add(FILE *f, int l, const char *p0, const char *p1, const char 
 static void emit_line(const mech_model *m, const sl_load *l, FILE *f)
 {
     char p0[96], p1[96];
-    point_xy(m, l->link, l->point, p0, sizeof p0);
-    point_xy(m, l->link2, l->point2, p1, sizeof p1);
+    codegen_point_xy(m, l->link, l->point, p0, sizeof p0);
+    codegen_point_xy(m, l->link2, l->point2, p1, sizeof p1);
     fprintf(f, "        double pe[2][2], ve[2][2], ae[2], u[2];\n"
                "        on_link(&F[%d], %s, pe[0], ve[0], ae);\n"
                "        on_link(&F[%d], %s, pe[1], ve[1], ae);\n"
@@ -222,7 +213,7 @@ void codegen_sl_known(const codegen *g, FILE *f)
             emit_add(f, l->link2, "pe[1][0]", "pe[1][1]", "fb[0]", "fb[1]", "0.0");
         } else {
             reg_text(sl, l->reg[1], r1, sizeof r1);
-            point_xy(m, l->link, l->point, pt, sizeof pt);
+            codegen_point_xy(m, l->link, l->point, pt, sizeof pt);
             fprintf(f, "        double lf[2] = {%s, %s}, lp[2], lv[2], la[2];\n"
                        "        on_link(&F[%d], %s, lp, lv, la);\n"
                        "        (void)lf, (void)lp;\n", r0, r1, l->link, pt);
@@ -259,7 +250,7 @@ void codegen_sl_power(const codegen *g, FILE *f)
                        "        scale += fabs(t) * linear;\n", r0);
         } else {
             reg_text(sl, l->reg[1], r1, sizeof r1);
-            point_xy(m, l->link, l->point, pt, sizeof pt);
+            codegen_point_xy(m, l->link, l->point, pt, sizeof pt);
             fprintf(f, "        double lf[2] = {%s, %s}, lp[2], lv[2], la[2];\n"
                        "        on_link(&F[%d], %s, lp, lv, la);\n"
                        "        pw = lf[0] * lv[0] + lf[1] * lv[1];\n"
