@@ -443,6 +443,31 @@ int drivers_move_link(const mech_model *m, int l)
     return 0;
 }
 
+/* The same tree, its numbers bit for bit. */
+static int same_law(const struct mech_law *p, const struct mech_law *q)
+{
+    if (!p || !q || p->n != q->n || p->root != q->root)
+        return p == q;
+    for (int i = 0; i < p->n; i++) {
+        const law_node *x = &p->nodes[i], *y = &q->nodes[i];
+        if (x->op != y->op || x->a != y->a || x->b != y->b || memcmp(&x->k, &y->k, sizeof x->k))
+            return 0;
+    }
+    return 1;
+}
+
+int drivers_same(const mech_model *a, const mech_model *b)
+{
+    if (a->ndrivers != b->ndrivers)
+        return 0;
+    for (int k = 0; k < a->ndrivers; k++) {
+        const mech_motion *x = &a->drivers[k], *y = &b->drivers[k];
+        if (x->kind != y->kind || x->index != y->index || !same_law(x->law, y->law))
+            return 0;
+    }
+    return 1;
+}
+
 void drivers_free(mech_model *m)
 {
     for (int i = 0; i < m->ndrivers; i++) {

@@ -79,6 +79,9 @@ int drivers_of_link(const mech_model *m, int l);
 int drivers_of_slider(const mech_model *m, int j);
 /* Does a driver move link l (its angle, or its slide along a guide)? */
 int drivers_move_link(const mech_model *m, int l);
+/* Do a and b (two loads of one file) have the same drivers with the same
+ * laws, every number bit for bit? (The system folds the laws' numbers.) */
+int drivers_same(const mech_model *a, const mech_model *b);
 
 /* model.c: the error of a mechanism with `mobility` degrees of freedom and
  * a different number of drivers: the drivers in conflict, or the links
