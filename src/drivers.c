@@ -371,13 +371,19 @@ int drivers_is_sweep(const mech_model *m, int k)
     return l && l->root >= 0 && l->root < l->n && l->nodes[l->root].op == LAW_T;
 }
 
+int drivers_sweep(const mech_model *m)
+{
+    for (int k = 0; k < m->ndrivers; k++)
+        if (drivers_is_sweep(m, k))
+            return k;
+    return -1;
+}
+
 /* The coordinate of kind `kind` that is the sweep variable, or -1. */
 static int sweep_coordinate(const mech_model *m, mech_drive_kind kind)
 {
-    for (int k = 0; k < m->ndrivers; k++)
-        if (m->drivers[k].kind == kind && drivers_is_sweep(m, k))
-            return m->drivers[k].index;
-    return -1;
+    int k = drivers_sweep(m);
+    return k >= 0 && m->drivers[k].kind == kind ? m->drivers[k].index : -1;
 }
 
 int drivers_sweep_link(const mech_model *m) { return sweep_coordinate(m, MECH_DRIVE_ANGLE); }

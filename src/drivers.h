@@ -58,6 +58,8 @@ ex law_expr(const struct mech_law *l, expr_ctx *c, ex t);
 int drivers_add_sweep(mech_model *m);
 /* Is driver k's law the sweep variable itself? */
 int drivers_is_sweep(const mech_model *m, int k);
+/* The driver that is the sweep, or -1 (q is the time). */
+int drivers_sweep(const mech_model *m);
 /* The link whose angle, or the slider whose displacement, is the sweep
  * variable; -1 when none is. */
 int drivers_sweep_link(const mech_model *m);
