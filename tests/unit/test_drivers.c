@@ -157,7 +157,9 @@ static const char *const FOUR_BAR =
     "initial: {coupler: 60, rocker: 100}\n"
     "%s";
 
-Test(drivers, single_law_reproduces_the_driver_form)
+/* The four-bar in both forms: the crank swept at 10 rad/s through 72 steps
+ * of a turn (`driver:`), and the law 10 rad/s * t over the same 2 pi / 10 s. */
+static void four_bar_both_forms(mech_model **driver, mech_model **law)
 {
     char a[1024], b[1024];
     snprintf(a, sizeof a, FOUR_BAR,
@@ -165,7 +167,14 @@ Test(drivers, single_law_reproduces_the_driver_form)
     snprintf(b, sizeof b, FOUR_BAR,
              "sweep: {time: {from: 0 s, to: 0.6283185307179586 s, steps: 72}}\n"
              "drivers: [{link: crank, angle: \"10 rad/s * t\"}]\n");
-    mech_model *ma = load_text(a), *mb = load_text(b);
+    *driver = load_text(a);
+    *law = load_text(b);
+}
+
+Test(drivers, single_law_reproduces_the_driver_form)
+{
+    mech_model *ma, *mb;
+    four_bar_both_forms(&ma, &mb);
     mech_table ta = must_solve(ma, NULL), tb = must_solve(mb, NULL);
     cr_assert_eq(ta.nrows, 73);
     cr_assert_eq(tb.nrows, 73);
@@ -414,6 +423,17 @@ Test(drivers, law_derivatives)
     mech_model_free(&m);
 }
 
+/* m solved with the default options into *t (zeroed first), its messages
+ * into *d (initialised here); the status. */
+static int solve_noting(const mech_model *m, mech_table *t, mech_diag *d)
+{
+    mech_solve_options o;
+    mech_solve_options_default(&o);
+    mech_diag_init(d);
+    *t = (mech_table){0};
+    return mech_solve(m, &o, t, NULL, d);
+}
+
 /* As many drivers as degrees of freedom, but both on the four-bar of a
  * four-bar plus a separate dyad: the solve names the conflicting drivers
  * and the links left free (a maximum matching of the equations). */
@@ -435,12 +455,9 @@ Test(drivers, conflicting_drivers_named)
         "  - {link: crank, angle: \"10 rad/s * t\"}\n"
         "  - {link: rocker, angle: \"100 deg\"}\n";
     mech_model *m = load_text(text);  /* the counts agree: mech_check passes */
-    mech_solve_options o;
-    mech_solve_options_default(&o);
     mech_diag d;
-    mech_diag_init(&d);
-    mech_table t = {0};
-    cr_assert_eq(mech_solve(m, &o, &t, NULL, &d), MECH_EINPUT);
+    mech_table t;
+    cr_assert_eq(solve_noting(m, &t, &d), MECH_EINPUT);
     cr_assert_geq(d.count, 1);
     const mech_diag_entry *e = &d.entries[0];
     cr_assert(strstr(e->message, "the drivers of 'crank', 'rocker' over-determine") &&
@@ -459,13 +476,8 @@ Test(drivers, conflicting_drivers_named)
  * of `drivers:` are the same list, each with a row after the loop rows. */
 Test(drivers, one_list_of_drivers)
 {
-    char a[1024], b[1024];
-    snprintf(a, sizeof a, FOUR_BAR,
-             "driver: {link: crank, angle: {from: 0, to: 360, steps: 72}, speed: 10 rad/s}\n");
-    snprintf(b, sizeof b, FOUR_BAR,
-             "sweep: {time: {from: 0 s, to: 1 s, steps: 10}}\n"
-             "drivers: [{link: crank, angle: \"10 rad/s * t\"}]\n");
-    mech_model *ma = load_text(a), *mb = load_text(b);
+    mech_model *ma, *mb;
+    four_bar_both_forms(&ma, &mb);
     int crank = mech_find_link(ma, "crank");
     cr_assert_eq(ma->ndrivers, 1);
     cr_assert_eq(ma->drivers[0].kind, MECH_DRIVE_ANGLE);
@@ -574,12 +586,9 @@ Test(drivers, dead_point_names_the_driver_row)
         "drivers: [{link: rocker, angle: \"90 deg + 36.869897645844021 deg/s * t\"}]\n"
         "initial: {crank: 90, coupler: 20}\n";
     mech_model *m = load_text(text);
-    mech_solve_options o;
-    mech_solve_options_default(&o);
     mech_diag d;
-    mech_diag_init(&d);
-    mech_table t = {0};
-    cr_assert_eq(mech_solve(m, &o, &t, NULL, &d), MECH_ESOLVE);
+    mech_table t;
+    cr_assert_eq(solve_noting(m, &t, &d), MECH_ESOLVE);
     const char *msg = NULL;
     for (size_t e = 0; e < d.count; e++)
         if (strstr(d.entries[e].message, "singular position at time = 1 s"))
