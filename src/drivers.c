@@ -273,10 +273,15 @@ int law_parse(const char *text, quantity want, const expr_env *env, struct mech_
     return 0;
 }
 
+/* The law q of `driver:`: one tree shared by every model (read only). */
+static law_node sweep_node = {LAW_T, -1, -1, 0.0};
+static struct mech_law sweep_law = {&sweep_node, 1, 1, 0};
+
 void law_free(struct mech_law *l)
 {
-    if (l)
-        free(l->nodes);
+    if (!l || l == &sweep_law)
+        return;
+    free(l->nodes);
     free(l);
 }
 
@@ -348,23 +353,16 @@ ex law_expr(const struct mech_law *l, expr_ctx *c, ex t)
 
 int drivers_add_sweep(mech_model *m)
 {
-    struct mech_law *l = xcalloc(1, sizeof *l);
-    law_node *q = xcalloc(1, sizeof *q);
     mech_motion *d = xcalloc(1, sizeof *d);
-    if (!l || !q || !d) {
-        free(l);
-        free(q);
-        free(d);
+    if (!d)
         return -1;
-    }
-    *q = (law_node){LAW_T, -1, -1, 0.0};
-    *l = (struct mech_law){q, 1, 1, 0};
-    *d = (mech_motion){m->driver.kind, m->driver.index, NULL, l, m->driver.mark};
+    *d = (mech_motion){m->driver.kind, m->driver.index, NULL, &sweep_law, m->driver.mark};
     m->drivers = d;
     m->ndrivers = 1;
     return 0;
 }
 
+/* The law q itself: the shared one, or any tree that is t alone. */
 int drivers_is_sweep(const mech_model *m, int k)
 {
     const struct mech_law *l = m->drivers[k].law;
