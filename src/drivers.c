@@ -273,7 +273,8 @@ int law_parse(const char *text, quantity want, const expr_env *env, struct mech_
     return 0;
 }
 
-/* The law q of `driver:`: one tree shared by every model (read only). */
+/* The law q of `driver:`: one tree shared by every model (read only), the
+ * mark of the driver that is the sweep (drivers_is_sweep). */
 static law_node sweep_node = {LAW_T, -1, -1, 0.0};
 static struct mech_law sweep_law = {&sweep_node, 1, 1, 0};
 
@@ -362,12 +363,10 @@ int drivers_add_sweep(mech_model *m)
     return 0;
 }
 
-/* The law q itself: the shared one, or any tree that is t alone. */
-int drivers_is_sweep(const mech_model *m, int k)
-{
-    const struct mech_law *l = m->drivers[k].law;
-    return l && l->root >= 0 && l->root < l->n && l->nodes[l->root].op == LAW_T;
-}
+/* The law of `driver:` itself, not any law that reads as t: a law of time
+ * `1 rad/s * t` folds to the tree t too, but its driver keeps its row, its
+ * columns and its name. */
+int drivers_is_sweep(const mech_model *m, int k) { return m->drivers[k].law == &sweep_law; }
 
 int drivers_sweep(const mech_model *m)
 {

@@ -56,7 +56,7 @@ ex law_expr(const struct mech_law *l, expr_ctx *c, ex t);
 /* Add the driver of `driver:`: the law q for the link or slider of
  * m->driver. 0, or -1 when out of memory. */
 int drivers_add_sweep(mech_model *m);
-/* Is driver k's law the sweep variable itself? */
+/* Is driver k the one of `driver:`, whose law is the sweep variable itself? */
 int drivers_is_sweep(const mech_model *m, int k);
 /* The driver that is the sweep, or -1 (q is the time). */
 int drivers_sweep(const mech_model *m);

@@ -510,6 +510,29 @@ Test(drivers, one_list_of_drivers)
     mech_model_free(&mb);
 }
 
+/* A law of time that folds to t itself (1 rad/s * t) is still a law: its
+ * driver keeps its unknown, its row, its columns and its load's name; only
+ * `driver:` is the sweep. */
+Test(drivers, a_law_equal_to_t_is_still_a_law)
+{
+    char text[1024];
+    snprintf(text, sizeof text, FOUR_BAR,
+             "sweep: {time: {from: 0 s, to: 1 s, steps: 4}}\n"
+             "drivers: [{link: crank, angle: \"1 rad/s * t\"}]\n"
+             "outputs: {points: [P], forces: true}\n");
+    mech_model *m = load_text(text);
+    cr_assert(!drivers_is_sweep(m, 0) && drivers_rows(m) == 1 && drivers_sweep(m) < 0);
+    mech_table t = must_solve(m, NULL);
+    cr_assert_geq(mech_table_column(&t, "crank.angle"), 0);
+    cr_assert_geq(mech_table_column(&t, "crank.torque"), 0);
+    cr_assert_lt(mech_table_column(&t, "driver.torque"), 0);
+    int ct = mech_table_column(&t, "t"), ca = mech_table_column(&t, "crank.angle");
+    for (int r = 0; r < t.nrows; r++)  /* th = 1 rad/s * t */
+        cr_assert_float_eq(mech_table_get(&t, r, ca), mech_table_get(&t, r, ct), 1e-15);
+    mech_table_free(&t);
+    mech_model_free(&m);
+}
+
 /* The descriptor of a gear train with a law and a listed loop: the rows in
  * order (loop x, loop y, the gear pair, the driver), each owner named, and
  * mech equations' tags from it. */
