@@ -127,7 +127,8 @@ typedef struct mech_motion {
     mech_drive_kind kind; /* MECH_DRIVE_ANGLE: link index; MECH_DRIVE_SLIDER: joint index */
     int index;
     char *text;           /* owned: the law as written; NULL for `driver:` (the law q) */
-    struct mech_law *law; /* owned: its expression tree (src/drivers.h) */
+    struct mech_law *law; /* its expression tree (src/drivers.h): owned, but for the law q
+                             of `driver:`, one tree shared by all models */
     mech_mark mark;
 } mech_motion;
 
