@@ -100,28 +100,35 @@ typedef struct mech_joint {
     mech_mark mark;
 } mech_joint;
 
-/* MECH_DRIVE_TIME: the sweep variable is time; the motion is given by the
- * model's `motions` (the `drivers:` list, docs/format.md section 7.3). */
+/* The kind of a driven coordinate (MECH_DRIVE_ANGLE: a link angle,
+ * MECH_DRIVE_SLIDER: a slider displacement), and of the sweep variable q:
+ * a driver's own angle or displacement (`driver:`), or MECH_DRIVE_TIME, the
+ * time t of the laws of `drivers:` (docs/format.md section 7.3). */
 typedef enum { MECH_DRIVE_ANGLE, MECH_DRIVE_SLIDER, MECH_DRIVE_TIME } mech_drive_kind;
 
+/* The sweep: the variable q every row of a table is solved at. */
 typedef struct mech_driver {
-    mech_drive_kind kind;
-    int index;         /* link index (ANGLE) or joint index (SLIDER) */
-    double *values;    /* [nvalues] driver positions, rad or m */
+    mech_drive_kind kind; /* q's kind: its unit (rad, m, s), column name and words */
+    int index;         /* ANGLE, SLIDER: the link or joint whose coordinate q is (a view
+                          of drivers[0].index); TIME: 0 */
+    double *values;    /* [nvalues] sweep positions, rad, m or s */
     int nvalues;
-    double speed;      /* rad/s or m/s */
-    double accel;      /* rad/s^2 or m/s^2 */
+    double speed;      /* rad/s or m/s (1 for the time) */
+    double accel;      /* rad/s^2 or m/s^2 (0 for the time) */
     mech_mark mark;
 } mech_driver;
 
-/* One entry of `drivers:` (docs/format.md section 7.3): a link angle or a
- * slider displacement given as a law of the time t, compiled symbolically
- * (src/drivers.h). */
+/* One driver (docs/format.md section 7.3): a link angle (MECH_DRIVE_ANGLE,
+ * link index) or a slider displacement (MECH_DRIVE_SLIDER, joint index)
+ * held to a law of the sweep variable q, compiled symbolically
+ * (src/drivers.h). `driver:` is the driver whose law is q itself; each
+ * entry of `drivers:` is a law of the time. */
 typedef struct mech_motion {
     mech_drive_kind kind; /* MECH_DRIVE_ANGLE: link index; MECH_DRIVE_SLIDER: joint index */
     int index;
-    char *text;           /* owned: the law as written */
-    struct mech_law *law; /* owned: its expression tree (src/drivers.h) */
+    char *text;           /* owned: the law as written; NULL for `driver:` (the law q) */
+    struct mech_law *law; /* its expression tree (src/drivers.h): owned, but for the law q
+                             of `driver:`, one tree shared by all models */
     mech_mark mark;
 } mech_motion;
 
@@ -273,9 +280,13 @@ typedef struct mech_model {
                                         (src/state_loads.h), NULL when there are none */
     mech_gear *gears;     /* [ngears] gear pairs and racks (docs/format.md) */
     int ngears;
-    mech_motion *motions; /* [nmotions] drivers as laws of time (driver.kind ==
-                             MECH_DRIVE_TIME: driver.values are the times), or none */
+    mech_motion *motions; /* [nmotions] a view of `drivers` for the callers of 0.1: the
+                             drivers when they are laws of time (driver.kind ==
+                             MECH_DRIVE_TIME), else NULL and 0; not owned */
     int nmotions;
+    mech_motion *drivers; /* [ndrivers] every driver, whichever form the file used:
+                             `driver:` is one (the law q), `drivers:` one per law */
+    int ndrivers;
 } mech_model;
 
 /* Read and validate a mechanism file. On success *out is the model and the

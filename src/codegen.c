@@ -476,9 +476,9 @@ static void emit_init(const codegen *g, FILE *f)
             fprintf(f, "    s->x[%d] = %s;\n", g->unk_col[var], v);
         }
     }
-    /* drivers as laws of time: the driven unknowns start at their laws at the
-       file's first time, as cont_start does (drivers_guess) */
-    if (drivers_rows(m) > 0 && m->driver.nvalues > 0) {
+    /* the driven unknowns start at their laws at the file's first position,
+       as cont_start does (drivers_guess; the sweep's own coordinate is q) */
+    if (m->driver.nvalues > 0) {
         double *guess = xcalloc((size_t)g->sp.n + 1, sizeof *guess);
         for (int v = 0; guess && v < g->sp.n; v++)
             guess[v] = NAN;

@@ -327,13 +327,10 @@ static int emit_column_entries(const codegen *g, FILE *f, int c, int *rows)
     const forces_plan *fp = &g->fp;
     const mech_model *m = g->m;
     int n = 0;
-    /* a driver's column: joint -1 (the `driver:`) or -1 - k (law k of `drivers:`) */
-    mech_drive_kind dkind = m->driver.kind;
-    int dindex = m->driver.index;
-    if (fp->joint[c] < 0 && drivers_rows(m) > 0) {
-        dkind = m->motions[-1 - fp->joint[c]].kind;
-        dindex = m->motions[-1 - fp->joint[c]].index;
-    }
+    /* driver k's column: joint -1 - k */
+    const mech_motion *dr = fp->joint[c] < 0 ? &m->drivers[-1 - fp->joint[c]] : NULL;
+    mech_drive_kind dkind = dr ? dr->kind : MECH_DRIVE_SLIDER;
+    int dindex = dr ? dr->index : -1;
     if (fp->joint[c] < 0 && dkind == MECH_DRIVE_ANGLE) {
         if (dindex != 0) {
             fprintf(f, "        e[0] = 1.0;\n");
@@ -537,9 +534,8 @@ static void slider_rate(const codegen *g, int j, char *buf, size_t size)
         snprintf(buf, size, "s->xd[%d]", g->unk_col[var]);
 }
 
-/* The drivers' power for reactions y (forces.c drive_power): the driver's
- * load times its speed, or the sum over the laws of each load times the
- * rate of its coordinate. */
+/* The drivers' power for reactions y (forces.c drive_power): the sum over
+ * the drivers of each load times the rate of its coordinate. */
 static void emit_drive_power(const codegen *g, FILE *f)
 {
     const forces_plan *fp = &g->fp;
@@ -549,13 +545,9 @@ static void emit_drive_power(const codegen *g, FILE *f)
                "static double force_drive_power(const cg_state *s, const cg_frame *F, "
                "const double *y,\n                                double qd)\n{\n"
                "    (void)s, (void)F, (void)qd;\n");
-    if (drivers_rows(m) == 0) {
-        fprintf(f, "    return y[%d] * qd;\n}\n\n", first);
-        return;
-    }
     fprintf(f, "    double p = 0.0;\n");
     for (int k = 0; k < fp->ndrive; k++) {
-        const mech_motion *mo = &m->motions[k];
+        const mech_motion *mo = &m->drivers[k];
         char rate[48];
         if (mo->kind == MECH_DRIVE_ANGLE)
             snprintf(rate, sizeof rate, "F[%d].om", mo->index);

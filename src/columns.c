@@ -74,11 +74,11 @@ static int kinematic_columns(column_layout *cl, const mech_model *m, const mech_
     for (int i = 0; i < o->nsliders; i++)
         rc |= add_levels(cl, level, SRC_SLIDER, o->sliders[i], m->joints[o->sliders[i]].name,
                          slide_sfx, slide_unit);
-    /* drivers as laws of time: each driven coordinate, as q is for `driver:`,
-       after the outputs when they do not list it */
-    for (int k = 0; k < drivers_rows(m); k++) {
-        const mech_motion *mo = &m->motions[k];
-        int angle = mo->kind == MECH_DRIVE_ANGLE, listed = 0;
+    /* each driven coordinate, after the outputs when they do not list it
+       (the sweep's own coordinate is q) */
+    for (int k = 0; k < m->ndrivers; k++) {
+        const mech_motion *mo = &m->drivers[k];
+        int angle = mo->kind == MECH_DRIVE_ANGLE, listed = drivers_is_sweep(m, k);
         for (int i = 0; angle && i < o->nlinks; i++)
             listed |= o->links[i] == mo->index;
         for (int i = 0; !angle && i < o->nsliders; i++)
@@ -141,15 +141,11 @@ static int force_columns(column_layout *cl, const mech_model *m, char **label, i
             rc |= add(cl, SRC_REACTION, j, k, label[j], name, k == 3 ? "N*m" : "N");
         }
     }
-    for (int k = 0; k < drivers_rows(m); k++) {  /* laws of time: one load per driver */
-        int angle = m->motions[k].kind == MECH_DRIVE_ANGLE;
+    for (int k = 0; k < m->ndrivers; k++) {  /* one load per driver: the sweep's own is */
+        int angle = m->drivers[k].kind == MECH_DRIVE_ANGLE;  /* "driver.torque" */
         snprintf(name, sizeof name, "%s%s", angle ? ".torque" : ".force", suffix);
-        rc |= add(cl, SRC_DRIVE_LOAD, k, 0, drivers_name(m, k), name, angle ? "N*m" : "N");
-    }
-    if (drivers_rows(m) == 0) {  /* `driver:`: its one load */
-        int angle = m->driver.kind == MECH_DRIVE_ANGLE;
-        rc |= add(cl, SRC_DRIVE_LOAD, 0, 0, angle ? "driver.torque" : "driver.force", suffix,
-                  angle ? "N*m" : "N");
+        rc |= add(cl, SRC_DRIVE_LOAD, k, 0, drivers_is_sweep(m, k) ? "driver" : drivers_name(m, k),
+                  name, angle ? "N*m" : "N");
     }
     rc |= add(cl, SRC_POWER_RESIDUAL, 0, 0, "power.residual", suffix, "-");
     for (int c = first; !rc && c < cl->ncols; c++)

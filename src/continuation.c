@@ -124,10 +124,10 @@ static void note_crossing(cont *c, double qn)
     int sign = c->try_sign;  /* of the step being accepted (cont_try) */
     if (sign != 0 && c->det_sign != 0 && sign != c->det_sign && !c->searching &&
         c->crossings++ < 10) {
-        char qab[128], loops[400], where[420] = "";
-        diagnose_dependent_loops(&c->sv, loops, sizeof loops);  /* J nearly singular here */
-        if (loops[0])
-            snprintf(where, sizeof where, " of %s", loops);
+        char qab[128], owners[400], where[420] = "";
+        diagnose_dependent_rows(&c->sv, owners, sizeof owners);  /* J nearly singular here */
+        if (owners[0])
+            snprintf(where, sizeof where, " of %s", owners);
         diag_warning(c->d, c->m->file, c->m->driver.mark,
                      "between %s = %s the Jacobian's determinant changes sign: the "
                      "sweep passed a change point%s, where assembly branches cross, and may "
@@ -240,7 +240,7 @@ step_status cont_advance(cont *c, double q, double hmin)
         }
         if (c->fail_status == STEP_OK) {
             c->fail_resid = vec_norm_inf(c->sv.f, c->sv.p->nr);
-            c->fail_loop = diagnose_worst_loop(&c->sv);
+            c->fail_row = diagnose_worst_row(&c->sv);
         }
         c->fail_q = qn;
         c->fail_status = s;
@@ -293,14 +293,14 @@ int cont_start(cont *c, double q)
     int attempts = has_unguessed(c) ? START_ATTEMPTS : 1, branch = -1;
     step_status s = STEP_NO_ASSEMBLY, first = STEP_OK;
     double first_resid = 0.0;
-    int first_loop = 0;
+    int first_row = 0;
     for (int a = 0; a < attempts; a++) {
         cont_start_values(c, a, &rng);
         s = cont_try(c, q, 0);
         if (a == 0) {
             first = s;
             first_resid = sv->resid;
-            first_loop = diagnose_worst_loop(sv);
+            first_row = diagnose_worst_row(sv);
         }
         if (s == STEP_OK)
             break;
@@ -309,7 +309,7 @@ int cont_start(cont *c, double q)
     }
     if (s != STEP_OK) {
         c->fail_status = first == STEP_SINGULAR ? STEP_SINGULAR : s;
-        diagnose_start(c, q, first, first_resid, first_loop, branch, attempts);
+        diagnose_start(c, q, first, first_resid, first_row, branch, attempts);
         return MECH_ESOLVE;
     }
     note_stats(c, q);

@@ -44,8 +44,9 @@ typedef struct cont {
     int searching;             /* looking for assembly limits: no crossing reports */
     double fail_q;             /* where the last rejected attempt was */
     step_status fail_status;
-    double fail_resid;         /* residual and worst loop of the first rejected attempt */
-    int fail_loop;
+    double fail_resid;         /* residual and worst row (rows.h) of the first rejected
+                                  attempt */
+    int fail_row;
     int fail_change_point;     /* the last singular position diagnosed was a change point */
 } cont;
 

@@ -8,6 +8,8 @@
 #include "springs.h"
 #include "state_loads.h"
 
+/* The sweep of the time when q is the time, then one line per driver: the
+ * sweep's own with its positions, a law as written. */
 static void driver_lines(const mech_model *m, char *b, size_t n, describe_emit emit, void *ctx)
 {
     const mech_driver *dr = &m->driver;
@@ -15,25 +17,22 @@ static void driver_lines(const mech_model *m, char *b, size_t n, describe_emit e
         emit(ctx, "driver", "none");
         return;
     }
-    if (dr->kind == MECH_DRIVE_TIME) {  /* laws of time: the sweep, then each law */
+    if (dr->kind == MECH_DRIVE_TIME) {
         snprintf(b, n, "time t from %g s to %g s, %d position%s", dr->values[0],
                  dr->values[dr->nvalues - 1], dr->nvalues, dr->nvalues == 1 ? "" : "s");
         emit(ctx, "sweep", b);
-        for (int i = 0; i < m->nmotions; i++) {
-            int angle = m->motions[i].kind == MECH_DRIVE_ANGLE;
-            snprintf(b, n, "%s of %s '%s' = %s", angle ? "angle" : "displacement",
-                     angle ? "link" : "slider", drivers_name(m, i), m->motions[i].text);
-            emit(ctx, "driver", b);
-        }
-        return;
     }
-    if (dr->kind == MECH_DRIVE_ANGLE)
-        snprintf(b, n, "angle of link '%s', %d position%s", m->links[dr->index].name,
-                 dr->nvalues, dr->nvalues == 1 ? "" : "s");
-    else
-        snprintf(b, n, "displacement of slider '%s', %d position%s", m->joints[dr->index].name,
-                 dr->nvalues, dr->nvalues == 1 ? "" : "s");
-    emit(ctx, "driver", b);
+    for (int i = 0; i < m->ndrivers; i++) {
+        int angle = m->drivers[i].kind == MECH_DRIVE_ANGLE;
+        if (drivers_is_sweep(m, i))
+            snprintf(b, n, "%s of %s '%s', %d position%s", angle ? "angle" : "displacement",
+                     angle ? "link" : "slider", drivers_name(m, i), dr->nvalues,
+                     dr->nvalues == 1 ? "" : "s");
+        else
+            snprintf(b, n, "%s of %s '%s' = %s", angle ? "angle" : "displacement",
+                     angle ? "link" : "slider", drivers_name(m, i), m->drivers[i].text);
+        emit(ctx, "driver", b);
+    }
 }
 
 void model_describe(const mech_model *m, const mech_summary *s, describe_emit emit, void *ctx)

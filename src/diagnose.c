@@ -6,8 +6,6 @@
 #include <string.h>
 
 #include "diagnose.h"
-#include "drivers.h"
-#include "gears.h"
 
 static const double PI = 3.14159265358979323846;
 
@@ -51,50 +49,15 @@ const char *diagnose_driver_word(const mech_model *m)
            : m->driver.kind == MECH_DRIVE_TIME ? "time" : "driver displacement";
 }
 
-/* "loop 2 (A-B-C-D-A)" */
-const char *diagnose_loop_label(const solver *sv, int k, char *buf, size_t size)
-{
-    const mech_model *m = sv->p->m;
-    const loop_set *ls = &sv->p->sys->loops;
-    if (k >= ls->nloops)  /* a gear pair's row (after the loops'; k is a row / 2) */
-        return gears_row_label(m, buf, size);
-    size_t at = (size_t)snprintf(buf, size, "loop %d (", k + 1);
-    if (ls->from_file && k < m->nloops) {
-        for (int i = 0; i < m->loops[k].npoints && at < size; i++)
-            at += (size_t)snprintf(buf + at, size - at, "%s%s", i ? "-" : "",
-                                   m->point_names[m->loops[k].points[i]]);
-    } else {
-        const char *first = NULL;  /* the point each term starts from */
-        for (int t = ls->start[k]; t < ls->start[k + 1] && at < size; t++) {
-            const loop_term *lt = &ls->terms[t];
-            const char *p;
-            if (lt->kind == TERM_BODY) {
-                p = m->links[lt->link].points[lt->p0].name;
-            } else {
-                const mech_joint *j = &m->joints[lt->joint];
-                int side = lt->sign > 0 ? 1 : 0;  /* + runs guide point -> mover */
-                p = m->links[j->link[side]].points[j->point[side]].name;
-            }
-            first = first ? first : p;
-            at += (size_t)snprintf(buf + at, size - at, "%s-", p);
-        }
-        if (at < size)
-            at += (size_t)snprintf(buf + at, size - at, "%s", first ? first : "?");
-    }
-    if (at < size)
-        snprintf(buf + at, size - at, ")");
-    return buf;
-}
-
-/* The loop that closes worst at the current iterate. */
-int diagnose_worst_loop(const solver *sv)
+/* The row that closes worst at the current iterate (a row of the system). */
+int diagnose_worst_row(const solver *sv)
 {
     int worst = 0;
     double big = -1.0;
     for (int i = 0; i < sv->p->nr; i++)
         if (fabs(sv->f[i]) > big) {
             big = fabs(sv->f[i]);
-            worst = sv->p->row[i] / 2;
+            worst = sv->p->row[i];
         }
     return worst;
 }
@@ -164,24 +127,24 @@ static int dense_null(const solver *sv, double *right, double *left)
     return 0;
 }
 
-/* Append the names of the unknowns (or loops) with a large null-vector
- * component to buf. */
-static void list_large(const solver *sv, const double *v, int loops, char *buf, size_t size)
+/* Append the names of the unknowns (or the owners of the rows) with a large
+ * null-vector component to buf. */
+static void list_large(const solver *sv, const double *v, int rows, char *buf, size_t size)
 {
     double big = vec_norm_inf(v, sv->p->ns);
     size_t at = strlen(buf);
-    int count = 0, last_loop = -1;
+    int count = 0, last_row = -1;
     char lb[256];
     for (int i = 0; i < sv->p->ns && at < size; i++) {
         if (!(fabs(v[i]) > 0.05 * big))
             continue;
-        if (loops) {
-            int k = sv->p->row[i] / 2;
-            if (k == last_loop)
+        if (rows) {  /* the rows' owners: a loop once for its x and y rows */
+            int r = sv->p->row[i];
+            if (last_row >= 0 && rows_same_owner(sv->p->sys, r, last_row))
                 continue;
-            last_loop = k;
+            last_row = r;
             at += (size_t)snprintf(buf + at, size - at, "%s%s", count++ ? ", " : "",
-                                   diagnose_loop_label(sv, k, lb, sizeof lb));
+                                   rows_owner(sv->p->sys, r, lb, sizeof lb));
         } else {  /* the unknown, and where it is: "th_crank (at 0 deg)" */
             int c = sv->p->col[i];
             int angle = sv->p->sys->unk_kind[c] == UNK_ANGLE;
@@ -260,7 +223,7 @@ static int is_change_point(solver *sv, const double *left)
     return nw > 0.0 && nf > 0.0 && fabs(dot) <= 1e-3 * sqrt(nw * nf);
 }
 
-void diagnose_dependent_loops(const solver *sv, char *buf, size_t size)
+void diagnose_dependent_rows(const solver *sv, char *buf, size_t size)
 {
     double *right = xcalloc((size_t)sv->p->ns + 1, sizeof *right);
     double *left = xcalloc((size_t)sv->p->nr + 1, sizeof *left);
@@ -377,19 +340,12 @@ void diagnose_redundant(cont *c, double q)
     char list[600] = "", lb[256], qb[64];
     size_t at = 0;
     for (int i = 0; i < count && at < sizeof list; i++) {
-        int row = sv->p->row[named[i]], g = row - 2 * sv->p->sys->loops.nloops;
-        const mech_system *sys = sv->p->sys;
-        if (row >= sys->m - drivers_rows(sv->p->m))  /* a law of time's row (drivers.c) */
-            at += (size_t)snprintf(list + at, sizeof list - at, "%srow of driver '%s'",
-                                   i ? ", " : "",
-                                   drivers_name(sv->p->m, row - (sys->m - drivers_rows(sv->p->m))));
-        else if (g >= 0 && g < sv->p->m->ngears)  /* a gear pair's row (gears.c) */
-            at += (size_t)snprintf(list + at, sizeof list - at, "%srow of gear pair '%s'",
-                                   i ? ", " : "", sv->p->m->gears[g].name);
-        else
-            at += (size_t)snprintf(list + at, sizeof list - at, "%s%s equation of %s",
-                                   i ? ", " : "", row % 2 ? "y" : "x",
-                                   diagnose_loop_label(sv, row / 2, lb, sizeof lb));
+        int row = sv->p->row[named[i]];
+        row_kind kind = sv->p->sys->rows[row].kind;
+        const char *what = kind == ROW_LOOP_X ? "x equation" : kind == ROW_LOOP_Y ? "y equation"
+                                                                                 : "row";
+        at += (size_t)snprintf(list + at, sizeof list - at, "%s%s of %s", i ? ", " : "", what,
+                               rows_owner(sv->p->sys, row, lb, sizeof lb));
     }
     free(a);
     free(cf);
@@ -421,7 +377,7 @@ const char *diagnose_branch_text(const mech_model *m, const mech_branch *b, char
     return buf;
 }
 
-void diagnose_start(cont *c, double q, step_status first, double resid, int loop, int branch,
+void diagnose_start(cont *c, double q, step_status first, double resid, int row, int branch,
                     int attempts)
 {
     const mech_model *m = c->m;
@@ -446,7 +402,7 @@ void diagnose_start(cont *c, double q, step_status first, double resid, int loop
                "Newton from the initial guesses%s); check the dimensions, or give "
                "`initial:` guesses near the intended assembly",
                diagnose_driver_word(m), diagnose_q_text(m, q, qb, sizeof qb),
-               diagnose_loop_label(&c->sv, loop, lb, sizeof lb), resid,
+               rows_owner(c->sv.p->sys, row, lb, sizeof lb), resid,
                attempts > 1 ? " and other starts" : "");
 }
 
@@ -551,7 +507,7 @@ void diagnose_failure(cont *c, double q_row, double hrow)
     char qa[64], qb[64], lb[256], range[600];
     double upper = c->qc, fq = c->fail_q;
     step_status s = c->fail_status;
-    int loop = c->fail_loop;
+    int row = c->fail_row;
     double resid = c->fail_resid;
     /* stuck at a limit short of the row: the row itself cannot assemble
        (a row on the limit itself is a singular position, below) */
@@ -565,7 +521,7 @@ void diagnose_failure(cont *c, double q_row, double hrow)
                    "(reciprocal condition %.2g), past which %s does not close; %s",
                    diagnose_driver_word(m), diagnose_q_text(m, q_row, qa, sizeof qa),
                    diagnose_q_text(m, fq, qb, sizeof qb), rcond,
-                   diagnose_loop_label(sv, loop, lb, sizeof lb), range);
+                   rows_owner(sv->p->sys, row, lb, sizeof lb), range);
         return;
     }
     if (s == STEP_SINGULAR) {
@@ -579,7 +535,7 @@ void diagnose_failure(cont *c, double q_row, double hrow)
         diag_error(c->d, m->file, m->driver.mark,
                    "cannot assemble at %s = %s: %s does not close (residual %.3g m); %s",
                    diagnose_driver_word(m), diagnose_q_text(m, q_row, qa, sizeof qa),
-                   diagnose_loop_label(sv, loop, lb, sizeof lb), resid, range);
+                   rows_owner(sv->p->sys, row, lb, sizeof lb), resid, range);
         return;
     }
     if (s == STEP_JUMP)

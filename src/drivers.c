@@ -273,10 +273,16 @@ int law_parse(const char *text, quantity want, const expr_env *env, struct mech_
     return 0;
 }
 
+/* The law q of `driver:`: one tree shared by every model (read only), the
+ * mark of the driver that is the sweep (drivers_is_sweep). */
+static law_node sweep_node = {LAW_T, -1, -1, 0.0};
+static struct mech_law sweep_law = {&sweep_node, 1, 1, 0};
+
 void law_free(struct mech_law *l)
 {
-    if (l)
-        free(l->nodes);
+    if (!l || l == &sweep_law)
+        return;
+    free(l->nodes);
     free(l);
 }
 
@@ -344,28 +350,64 @@ ex law_expr(const struct mech_law *l, expr_ctx *c, ex t)
     return r;
 }
 
-/* ---- hooks -------------------------------------------------------------- */
+/* ---- the one model of drivers ------------------------------------------- */
+
+int drivers_add_sweep(mech_model *m)
+{
+    mech_motion *d = xcalloc(1, sizeof *d);
+    if (!d)
+        return -1;
+    *d = (mech_motion){m->driver.kind, m->driver.index, NULL, &sweep_law, m->driver.mark};
+    m->drivers = d;
+    m->ndrivers = 1;
+    return 0;
+}
+
+/* The law of `driver:` itself, not any law that reads as t: a law of time
+ * `1 rad/s * t` folds to the tree t too, but its driver keeps its row, its
+ * columns and its name. */
+int drivers_is_sweep(const mech_model *m, int k) { return m->drivers[k].law == &sweep_law; }
+
+int drivers_sweep(const mech_model *m)
+{
+    for (int k = 0; k < m->ndrivers; k++)
+        if (drivers_is_sweep(m, k))
+            return k;
+    return -1;
+}
+
+/* The coordinate of kind `kind` that is the sweep variable, or -1. */
+static int sweep_coordinate(const mech_model *m, mech_drive_kind kind)
+{
+    int k = drivers_sweep(m);
+    return k >= 0 && m->drivers[k].kind == kind ? m->drivers[k].index : -1;
+}
+
+int drivers_sweep_link(const mech_model *m) { return sweep_coordinate(m, MECH_DRIVE_ANGLE); }
+
+int drivers_sweep_slider(const mech_model *m) { return sweep_coordinate(m, MECH_DRIVE_SLIDER); }
 
 int drivers_rows(const mech_model *m)
 {
-    return m->has_driver && m->driver.kind == MECH_DRIVE_TIME ? m->nmotions : 0;
+    int n = 0;
+    for (int k = 0; k < m->ndrivers; k++)
+        n += !drivers_is_sweep(m, k);
+    return n;
 }
 
-void drivers_residual(const mech_model *m, expr_ctx *c, const ex *link_angle, const ex *slide,
-                      ex q, ex *f)
+ex drivers_row(const mech_model *m, int k, expr_ctx *c, const ex *link_angle, const ex *slide,
+               ex q)
 {
-    for (int i = 0; i < drivers_rows(m); i++) {
-        const mech_motion *mo = &m->motions[i];
-        ex coord = mo->kind == MECH_DRIVE_ANGLE ? link_angle[mo->index] : slide[mo->index];
-        f[i] = expr_sub(c, coord, law_expr(mo->law, c, q));
-    }
+    const mech_motion *mo = &m->drivers[k];
+    ex coord = mo->kind == MECH_DRIVE_ANGLE ? link_angle[mo->index] : slide[mo->index];
+    return expr_sub(c, coord, law_expr(mo->law, c, q));
 }
 
 void drivers_guess(const mech_model *m, const int *link_var, const int *joint_var, double q,
                    double *guess)
 {
-    for (int i = 0; i < drivers_rows(m); i++) {
-        const mech_motion *mo = &m->motions[i];
+    for (int i = 0; i < m->ndrivers; i++) {  /* the sweep's own coordinate is no unknown */
+        const mech_motion *mo = &m->drivers[i];
         int var = mo->kind == MECH_DRIVE_ANGLE ? link_var[mo->index] : joint_var[mo->index];
         if (var >= 0)
             guess[var] = law_eval(mo->law, q, NULL, NULL);
@@ -374,35 +416,70 @@ void drivers_guess(const mech_model *m, const int *link_var, const int *joint_va
 
 const char *drivers_name(const mech_model *m, int i)
 {
-    const mech_motion *mo = &m->motions[i];
+    const mech_motion *mo = &m->drivers[i];
     return mo->kind == MECH_DRIVE_ANGLE ? m->links[mo->index].name : m->joints[mo->index].name;
 }
 
 int drivers_of_link(const mech_model *m, int l)
 {
-    for (int i = 0; i < drivers_rows(m); i++)
-        if (m->motions[i].kind == MECH_DRIVE_ANGLE && m->motions[i].index == l)
+    for (int i = 0; i < m->ndrivers; i++)
+        if (m->drivers[i].kind == MECH_DRIVE_ANGLE && m->drivers[i].index == l)
             return i;
     return -1;
 }
 
 int drivers_of_slider(const mech_model *m, int j)
 {
-    for (int i = 0; i < drivers_rows(m); i++)
-        if (m->motions[i].kind == MECH_DRIVE_SLIDER && m->motions[i].index == j)
+    for (int i = 0; i < m->ndrivers; i++)
+        if (m->drivers[i].kind == MECH_DRIVE_SLIDER && m->drivers[i].index == j)
             return i;
     return -1;
 }
 
+int drivers_move_link(const mech_model *m, int l)
+{
+    for (int i = 0; i < m->ndrivers; i++) {
+        const mech_motion *mo = &m->drivers[i];
+        if (mo->kind == MECH_DRIVE_ANGLE ? mo->index == l : m->joints[mo->index].link[0] == l)
+            return 1;
+    }
+    return 0;
+}
+
+/* The same tree, its numbers bit for bit. */
+static int same_law(const struct mech_law *p, const struct mech_law *q)
+{
+    if (!p || !q || p->n != q->n || p->root != q->root)
+        return p == q;
+    for (int i = 0; i < p->n; i++) {
+        const law_node *x = &p->nodes[i], *y = &q->nodes[i];
+        if (x->op != y->op || x->a != y->a || x->b != y->b || memcmp(&x->k, &y->k, sizeof x->k))
+            return 0;
+    }
+    return 1;
+}
+
+int drivers_same(const mech_model *a, const mech_model *b)
+{
+    if (a->ndrivers != b->ndrivers)
+        return 0;
+    for (int k = 0; k < a->ndrivers; k++) {
+        const mech_motion *x = &a->drivers[k], *y = &b->drivers[k];
+        if (x->kind != y->kind || x->index != y->index || !same_law(x->law, y->law))
+            return 0;
+    }
+    return 1;
+}
+
 void drivers_free(mech_model *m)
 {
-    for (int i = 0; i < m->nmotions; i++) {
-        free(m->motions[i].text);
-        law_free(m->motions[i].law);
+    for (int i = 0; i < m->ndrivers; i++) {
+        free(m->drivers[i].text);
+        law_free(m->drivers[i].law);
     }
-    free(m->motions);
-    m->motions = NULL;
-    m->nmotions = 0;
+    free(m->drivers);
+    m->drivers = m->motions = NULL;
+    m->ndrivers = m->nmotions = 0;
 }
 
 void drivers_report_count(const mech_model *m, int mobility, mech_diag *d)
@@ -415,7 +492,7 @@ void drivers_report_count(const mech_model *m, int mobility, mech_diag *d)
         for (int i = mobility; i < nd && at < sizeof list; i++)
             at += (size_t)snprintf(list + at, sizeof list - at, "%s'%s'", i > mobility ? ", " : "",
                                    drivers_name(m, i));
-        diag_error(d, m->file, m->motions[mobility].mark,
+        diag_error(d, m->file, m->drivers[mobility].mark,
                    "over-driven: the mechanism has %d degree%s of freedom but %d drivers; the "
                    "driver%s of %s conflict%s with the others (remove %s)",
                    mobility, mobility == 1 ? "" : "s", nd, nd - mobility == 1 ? "" : "s", list,
@@ -438,7 +515,7 @@ void drivers_report_count(const mech_model *m, int mobility, mech_diag *d)
         at += (size_t)snprintf(list + at, sizeof list - at, "%s%s '%s'", count++ ? ", " : "",
                                jt->kind == MECH_JOINT_SLIDER ? "slider" : "link", name);
     }
-    diag_error(d, m->file, m->motions[0].mark,
+    diag_error(d, m->file, m->drivers[0].mark,
                "under-driven: the mechanism has %d degrees of freedom but %d driver%s, so %d "
                "motion%s %s free%s%s%s; add a driver for each (a link angle or a slider "
                "displacement as a law of t)",
@@ -504,7 +581,7 @@ static void alternate(int nr, int nc, const int *Ap, const int *Ai, const int *r
 int drivers_report_structure(const mech_system *s, mech_diag *d)
 {
     const mech_model *m = s->model;
-    int nr = s->m, nc = s->n, nd = drivers_rows(m), first = nr - nd;
+    int nr = s->m, nc = s->n;
     size_t big = (size_t)(nr > nc ? nr : nc) + 1;
     int *row_match = xcalloc(big, sizeof *row_match), *col_match = xcalloc(big, sizeof *col_match);
     int *work = xcalloc(5 * big, sizeof *work), *queue = xcalloc(big, sizeof *queue);
@@ -539,10 +616,10 @@ int drivers_report_structure(const mech_system *s, mech_diag *d)
     /* the drivers among the over-determined rows, the unknowns left free */
     int nconf = 0, nfree = 0, at_driver = -1;
     char conf[512], freed[512];
-    for (int r = first; r < nr; r++)
-        if (rs[r]) {
-            names[nconf++] = drivers_name(m, r - first);
-            at_driver = at_driver < 0 ? r - first : at_driver;
+    for (int r = 0; r < nr; r++)
+        if (rs[r] && s->rows[r].kind == ROW_DRIVER) {
+            names[nconf++] = drivers_name(m, s->rows[r].owner);
+            at_driver = at_driver < 0 ? r : at_driver;
         }
     name_list(conf, sizeof conf, names, nconf);
     for (int c = 0; c < nc; c++)  /* the link or slider of each free unknown */
@@ -550,7 +627,7 @@ int drivers_report_structure(const mech_system *s, mech_diag *d)
             names[nfree++] = s->unk_kind[c] == UNK_ANGLE ? m->links[s->unk_index[c]].name
                                                          : m->joints[s->unk_index[c]].name;
     name_list(freed, sizeof freed, names, nfree);
-    mech_mark at = at_driver >= 0 ? m->motions[at_driver].mark : m->driver.mark;
+    mech_mark at = at_driver >= 0 ? s->rows[at_driver].mark : m->driver.mark;
     if (nconf > 0 && nfree > 0)
         diag_error(d, m->file, at,
                    "the drivers do not match the mechanism's freedoms: the driver%s of %s "

@@ -157,13 +157,10 @@ static int column_entries(const forces_plan *fp, const solver *sv, const double 
         n = push_force(e, n, g, gr->link[1], p, t, 1.0);
         return push_force(e, n, g, gr->link[0], p, t, -1.0);
     }
-    /* a driver's column: joint -1 (the `driver:`) or -1 - k (law k of `drivers:`) */
-    mech_drive_kind dkind = m->driver.kind;
-    int dindex = m->driver.index;
-    if (fp->joint[c] < 0 && drivers_rows(m) > 0) {
-        dkind = m->motions[-1 - fp->joint[c]].kind;
-        dindex = m->motions[-1 - fp->joint[c]].index;
-    }
+    /* driver k's column: joint -1 - k */
+    const mech_motion *dr = fp->joint[c] < 0 ? &m->drivers[-1 - fp->joint[c]] : NULL;
+    mech_drive_kind dkind = dr ? dr->kind : MECH_DRIVE_SLIDER;
+    int dindex = dr ? dr->index : -1;
     if (fp->joint[c] < 0 && dkind == MECH_DRIVE_ANGLE) {
         n = push_moment(e, n, dindex, 1.0);
     } else {
@@ -210,7 +207,7 @@ static void make_columns(forces_plan *fp)
     fp->gcol = fp->ncols;
     for (int g = 0; g < m->ngears; g++)
         add_column(fp, FC_GEAR, g);
-    fp->ndrive = drivers_rows(m) > 0 ? drivers_rows(m) : 1;
+    fp->ndrive = m->ndrivers;
     for (int k = 0; k < fp->ndrive; k++)
         add_column(fp, FC_DRIVE, -1 - k);
 }
@@ -266,7 +263,7 @@ int forces_plan_init(forces_plan *fp, const solver_plan *sp, int friction, mech_
     memset(fp, 0, sizeof *fp);
     fp->m = m;
     fp->nrows = 3 * (m->nlinks - 1);
-    size_t nc = 2 * (size_t)m->njoints + (size_t)m->ngears + 2 + (size_t)drivers_rows(m);
+    size_t nc = 2 * (size_t)m->njoints + (size_t)m->ngears + 1 + (size_t)m->ndrivers;
     fp->kind = xcalloc(nc, sizeof *fp->kind);
     fp->joint = xcalloc(nc, sizeof *fp->joint);
     fp->jcol = xcalloc((size_t)m->njoints + 1, sizeof *fp->jcol);
@@ -529,19 +526,16 @@ static void solve_rhs(forces *fc, const double *rhs, double *y)
         y[c] *= fc->cscale[c];
 }
 
-/* The drivers' power for the reactions y: the driver's load times its
- * speed, or (laws of time) the sum over the drivers of each load times the
- * rate of its coordinate. */
+/* The drivers' power for the reactions y: the sum over the drivers of each
+ * load times the rate of its coordinate (for the sweep's own, q's speed). */
 static double drive_power(const forces *fc, const solver *sv, const double *y)
 {
     const forces_plan *fp = fc->p;
     const mech_model *m = fp->m;
     int first = fp->ncols - fp->ndrive;
-    if (drivers_rows(m) == 0)
-        return y[first] * m->driver.speed;
     double p = 0.0;
     for (int k = 0; k < fp->ndrive; k++) {
-        const mech_motion *mo = &m->motions[k];
+        const mech_motion *mo = &m->drivers[k];
         int var = mo->kind == MECH_DRIVE_SLIDER ? sv->p->tree.slide_var[mo->index] : -1;
         double rate = mo->kind == MECH_DRIVE_ANGLE ? sv->ks.om[mo->index]
                       : var >= 0 ? sv->vel[var] : 0.0;
@@ -739,13 +733,29 @@ int forces_solve(forces *fc, const solver *sv)
     return fc->iterations < 0 ? -2 : 0;
 }
 
-/* Where column c is marked in forces_singular_joints: its joint, the driver
- * (njoints), or its gear pair (njoints + 1 + the pair). */
+/* Where column c is marked in forces_singular_joints: its joint, its driver
+ * k (njoints + k), or its gear pair (njoints + ndrivers + the pair). */
 static int singular_slot(const forces_plan *fp, int c)
 {
     if (fp->kind[c] == FC_GEAR)
-        return fp->m->njoints + 1 + fp->joint[c];
-    return fp->joint[c] >= 0 ? fp->joint[c] : fp->m->njoints;
+        return fp->m->njoints + fp->m->ndrivers + fp->joint[c];
+    return fp->joint[c] >= 0 ? fp->joint[c] : fp->m->njoints - 1 - fp->joint[c];
+}
+
+/* Slot j of forces_singular_joints in words: the joint's name, "the driver"
+ * (the only one) or "driver crank", "gear pair g12". */
+static const char *slot_name(const mech_model *m, int j, char *buf, size_t size)
+{
+    int first_gear = m->njoints + m->ndrivers;
+    if (j < m->njoints)
+        return m->joints[j].name;
+    if (j < first_gear && m->ndrivers == 1)
+        return "the driver";
+    if (j < first_gear)
+        snprintf(buf, size, "driver %s", drivers_name(m, j - m->njoints));
+    else
+        snprintf(buf, size, "gear pair %s", m->gears[j - first_gear].name);
+    return buf;
 }
 
 /* The joints whose reactions are not determined at a singular position:
@@ -757,7 +767,8 @@ void forces_singular_joints(forces *fc, char *buf, size_t size)
     const mech_model *m = fp->m;
     size_t at = 0;
     buf[0] = '\0';
-    int ncols = fp->ncols, count = 0, nslots = m->njoints + 1 + m->ngears;
+    int ncols = fp->ncols, count = 0, nslots = m->njoints + m->ndrivers + m->ngears;
+    char name[160];
     unsigned char *mark = xcalloc((size_t)nslots + 1, 1);
     if (!mark)
         return;
@@ -774,11 +785,8 @@ void forces_singular_joints(forces *fc, char *buf, size_t size)
     }
     for (int j = 0; j < nslots && at < size; j++)
         if (mark[j])
-            at += (size_t)snprintf(buf + at, size - at, "%s%s%s", count++ ? ", " : "",
-                                   j > m->njoints ? "gear pair " : "",
-                                   j < m->njoints ? m->joints[j].name
-                                   : j == m->njoints ? "the driver"
-                                                     : m->gears[j - m->njoints - 1].name);
+            at += (size_t)snprintf(buf + at, size - at, "%s%s", count++ ? ", " : "",
+                                   slot_name(m, j, name, sizeof name));
     free(mark);
 }
 

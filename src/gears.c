@@ -16,32 +16,29 @@ static ex term(expr_ctx *c, double k, ex x)
     return k == 0.0 ? c->zero : expr_mul(c, expr_const(c, k), x);
 }
 
-/* The rows in expanded form, sum of k_i x_i + constant: the driver's term
+/* The row in expanded form, sum of k_i x_i + constant: the driver's term
  * is then a product of its own, computed once per driver position (the
  * tape's hoisted part), and `mech equations` prints each angle once. */
-void gears_rows(mech_system *s, ex *rows)
+ex gears_row(mech_system *s, int i)
 {
     const mech_model *m = s->model;
     expr_ctx *c = &s->ex;
-    for (int i = 0; i < m->ngears; i++) {
-        const mech_gear *g = &m->gears[i];
-        const ex *th = s->link_angle;
-        double ra = g->radius[0];
-        ex sum;
-        if (g->kind == MECH_GEAR_RACK) {
-            /* s - s0 - side r (th_p - th_arm - o_p) */
-            double k = g->side * ra;
-            sum = expr_add(c, s->slide[g->rack], term(c, -k, th[g->link[0]]));
-            sum = expr_add(c, sum, term(c, k, th[g->arm]));
-            rows[i] = expr_add(c, sum, expr_const(c, k * g->offset[0] - g->offset[1]));
-            continue;
-        }
-        /* r_a (th_a - th_arm - o_a) + sign r_b (th_b - th_arm - o_b) */
-        double rb = (g->internal ? -1.0 : 1.0) * g->radius[1];
-        sum = expr_add(c, term(c, ra, th[g->link[0]]), term(c, rb, th[g->link[1]]));
-        sum = expr_add(c, sum, term(c, -(ra + rb), th[g->arm]));
-        rows[i] = expr_add(c, sum, expr_const(c, -(ra * g->offset[0] + rb * g->offset[1])));
+    const mech_gear *g = &m->gears[i];
+    const ex *th = s->link_angle;
+    double ra = g->radius[0];
+    ex sum;
+    if (g->kind == MECH_GEAR_RACK) {
+        /* s - s0 - side r (th_p - th_arm - o_p) */
+        double k = g->side * ra;
+        sum = expr_add(c, s->slide[g->rack], term(c, -k, th[g->link[0]]));
+        sum = expr_add(c, sum, term(c, k, th[g->arm]));
+        return expr_add(c, sum, expr_const(c, k * g->offset[0] - g->offset[1]));
     }
+    /* r_a (th_a - th_arm - o_a) + sign r_b (th_b - th_arm - o_b) */
+    double rb = (g->internal ? -1.0 : 1.0) * g->radius[1];
+    sum = expr_add(c, term(c, ra, th[g->link[0]]), term(c, rb, th[g->link[1]]));
+    sum = expr_add(c, sum, term(c, -(ra + rb), th[g->arm]));
+    return expr_add(c, sum, expr_const(c, -(ra * g->offset[0] + rb * g->offset[1])));
 }
 
 void gears_contact(const mech_model *m, const solver *sv, int i, double *p, double *t,
@@ -104,14 +101,4 @@ void gears_describe(const mech_model *m, int i, char *buf, size_t size)
              m->links[g->link[1]].name, g->internal ? "internal" : "external",
              m->links[g->arm].name, g->radius[0] * 1e3, g->radius[1] * 1e3, teeth,
              (g->internal ? 1.0 : -1.0) * g->radius[0] / g->radius[1], g->pressure_angle * deg);
-}
-
-const char *gears_row_label(const mech_model *m, char *buf, size_t size)
-{
-    size_t at = (size_t)snprintf(buf, size, "the gearing (");
-    for (int i = 0; i < m->ngears && at < size; i++)
-        at += (size_t)snprintf(buf + at, size - at, "%s%s", i ? ", " : "", m->gears[i].name);
-    if (at < size)
-        snprintf(buf + at, size - at, ")");
-    return buf;
 }

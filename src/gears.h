@@ -7,12 +7,12 @@
 
 #include "solve.h"
 
-/* The constraint row of each gear pair into rows[0 .. m->ngears - 1] (an
- * expression in the link angles and slider displacements of s), metres:
+/* The constraint row of gear pair i (an expression in the link angles and
+ * slider displacements of s; its place among the rows: rows.h), metres:
  *   PAIR: r_a (th_a - th_arm - o_a) + sign r_b (th_b - th_arm - o_b)
  *         (sign +1 external, -1 internal)
  *   RACK: s - o_s - side r (th_p - th_arm - o_p) */
-void gears_rows(mech_system *s, ex *rows);
+ex gears_row(mech_system *s, int i);
 
 /* The tooth force of gear pair i at the published position of sv: its
  * pitch point p, the common tangent t there (n rotated +90 deg, n the unit
@@ -26,9 +26,5 @@ void gears_contact(const mech_model *m, const solver *sv, int i, double *p, doub
 
 /* Gear pair i in words, as mech check shows it. */
 void gears_describe(const mech_model *m, int i, char *buf, size_t size);
-
-/* "the gearing (g12, g23)": what a row after the loop rows is, in messages
- * that name a loop by a row's index / 2 (diagnose.c). */
-const char *gears_row_label(const mech_model *m, char *buf, size_t size);
 
 #endif

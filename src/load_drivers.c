@@ -107,29 +107,31 @@ void load_sweep_drivers(loader *ld, const ynode *sweep, const ynode *drivers)
                                            "freedom");
     if (drivers->n > 1000)
         return (void)load_err(ld, drivers, "at most 1000 drivers");
-    m->motions = xcalloc(drivers->n, sizeof *m->motions);
-    if (!m->motions)
+    m->drivers = xcalloc(drivers->n, sizeof *m->drivers);
+    if (!m->drivers)
         return (void)load_err(ld, drivers, "out of memory");
     load_sweep(ld, sweep);
     int ok = 1;
     for (size_t i = 0; i < drivers->n; i++) {
-        mech_motion *mo = &m->motions[m->nmotions++];
+        mech_motion *mo = &m->drivers[m->ndrivers++];
         load_motion(ld, drivers->items[i], mo);
         if (mo->index < 0 || !mo->law) {
             ok = 0;
             continue;
         }
-        for (int k = 0; k + 1 < m->nmotions; k++) {
-            const mech_motion *o = &m->motions[k];
+        for (int k = 0; k + 1 < m->ndrivers; k++) {
+            const mech_motion *o = &m->drivers[k];
             if (o->law && o->kind == mo->kind && o->index == mo->index) {
                 load_err(ld, drivers->items[i], "%s '%s' has two drivers (the first at line "
                          "%d): one law per link or slider",
                          mo->kind == MECH_DRIVE_ANGLE ? "link" : "slider",
-                         drivers_name(m, m->nmotions - 1), o->mark.line);
+                         drivers_name(m, m->ndrivers - 1), o->mark.line);
                 ok = 0;
                 break;
             }
         }
     }
     m->has_driver = ok && m->driver.kind == MECH_DRIVE_TIME && m->driver.nvalues > 0;
+    m->motions = m->drivers;  /* the view of 0.1's callers: the laws of time */
+    m->nmotions = m->ndrivers;
 }

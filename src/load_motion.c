@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "drivers.h"
 #include "load.h"
 
 /* ---- driver, guesses, branches, loops ------------------------------ */
@@ -196,6 +197,9 @@ void load_driver(loader *ld, const ynode *map)
         load_get_quantity(ld, acc, ln ? Q_ANGULAR_ACCELERATION : Q_ACCELERATION, "driver acceleration",
                           &dr->accel);
     m->has_driver = dr->nvalues > 0;
+    /* the one driver: its coordinate held to the law q (drivers.c) */
+    if (m->has_driver && drivers_add_sweep(m) < 0)
+        load_err(ld, map, "out of memory");
 }
 
 void load_initial(loader *ld, const ynode *map)

@@ -6,6 +6,7 @@
 
 #include "drivers.h"
 #include "internal.h"
+#include "rows.h"
 #include "state_loads.h"
 
 int model_point_in_link(const mech_link *l, int name_id)
@@ -125,14 +126,7 @@ static int report_dangling(const mech_model *m, const int *njoints_of, mech_diag
 {
     int found = 0;
     for (int i = 1; i < m->nlinks; i++) {
-        int driven = m->has_driver && m->driver.kind == MECH_DRIVE_ANGLE && m->driver.index == i;
-        if (m->has_driver && m->driver.kind == MECH_DRIVE_SLIDER &&
-            m->joints[m->driver.index].link[0] == i)
-            driven = 1;
-        for (int k = 0; k < drivers_rows(m); k++)
-            driven |= m->motions[k].kind == MECH_DRIVE_ANGLE ? m->motions[k].index == i
-                      : m->joints[m->motions[k].index].link[0] == i;
-        if (njoints_of[i] == 1 && !driven) {
+        if (njoints_of[i] == 1 && !drivers_move_link(m, i)) {
             diag_error(d, m->file, m->links[i].mark,
                        "link '%s' is attached by a single joint, so nothing fixes its position: "
                        "join it to another link or drive it", m->links[i].name);
@@ -352,7 +346,7 @@ int mech_check(const mech_model *m, mech_summary *s, mech_diag *d)
 {
     memset(s, 0, sizeof *s);
     s->nlinks = m->nlinks;
-    s->ndrivers = drivers_rows(m) ? drivers_rows(m) : m->has_driver ? 1 : 0;
+    s->ndrivers = m->has_driver ? m->ndrivers : 0;
     int *work = xcalloc((size_t)m->nlinks, sizeof *work);
     int *njoints_of = xcalloc((size_t)m->nlinks, sizeof *njoints_of);
     if (!work || !njoints_of) {
@@ -370,14 +364,21 @@ int mech_check(const mech_model *m, mech_summary *s, mech_diag *d)
     int nsliders = s->nprismatic + s->npin_in_slot;
     s->nunknowns = nangles + nsliders - s->ndrivers;
     s->nloops = joints - m->nlinks + 1;
-    s->nequations = 2 * s->nloops + m->ngears;
+    /* a driver counts as the coordinate it fixes ("- 1 driver" among the
+       unknowns), not as its row */
+    int rows[ROW_KINDS];
+    rows_count(m, s->nloops, rows);
+    s->nequations = rows[ROW_LOOP_X] + rows[ROW_LOOP_Y] + rows[ROW_GEAR];
     s->mobility = 3 * (m->nlinks - 1) - 2 * (s->nrevolute + s->nprismatic) - s->npin_in_slot -
                   m->ngears;
     size_t before = d->nerrors;
     int connected = check_connected(m, work, d);
     int dangling = report_dangling(m, njoints_of, d);
+    /* drivers with rows (laws) name the drivers in excess or the links left
+       free; a sweep of the driver's own value has only that one driver, so a
+       wrong count is the linkage's (below) */
     if (connected && !dangling && s->mobility != s->ndrivers && s->mobility > 0 &&
-        drivers_rows(m) > 0) {
+        rows[ROW_DRIVER] > 0) {
         drivers_report_count(m, s->mobility, d);
     } else if (connected && !dangling && s->mobility != s->ndrivers) {
         mech_mark at = m->has_driver ? m->driver.mark : (mech_mark){0, 0};

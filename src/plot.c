@@ -192,15 +192,16 @@ static void plan_forces(plan *p, const mech_model *m)
     }
 }
 
-/* Drivers as laws of time: their torques in one figure, their forces in
- * another, each with and without friction when both exist. */
+/* The drivers with rows (laws of time), their loads named by the driver:
+ * their torques in one figure, their forces in another, each with and
+ * without friction when both exist. */
 static void plan_drivers(plan *p, const mech_model *m)
 {
-    const char **it = xcalloc((size_t)m->nmotions + 1, sizeof *it);
+    const char **it = xcalloc((size_t)m->ndrivers + 1, sizeof *it);
     for (int kind = 0; it && kind < 2; kind++) {  /* 0 torques (links), 1 forces (sliders) */
         int n = 0;
-        for (int i = 0; i < m->nmotions; i++)
-            if ((m->motions[i].kind == MECH_DRIVE_SLIDER) == kind)
+        for (int i = 0; i < m->ndrivers; i++)
+            if ((m->drivers[i].kind == MECH_DRIVE_SLIDER) == kind && !drivers_is_sweep(m, i))
                 it[n++] = drivers_name(m, i);
         static const char *const sfx[2][2] = {{".torque", ".torque.nofriction"},
                                               {".force", ".force.nofriction"}};
@@ -217,14 +218,15 @@ static void plan_drivers(plan *p, const mech_model *m)
     free(it);
 }
 
-/* The driver torque (or force), with and without friction when both exist. */
+/* The load of the driver that is the sweep ("driver.torque" or
+ * "driver.force"), with and without friction when both exist. */
 static void plan_driver(plan *p, const mech_model *m)
 {
     const mech_table *t = p->t;
-    if (m->nmotions > 0 && m->driver.kind == MECH_DRIVE_TIME) {
-        plan_drivers(p, m);
+    plan_drivers(p, m);
+    int sweep = drivers_sweep(m);
+    if (sweep < 0)
         return;
-    }
     const char *drv = mech_table_column(t, "driver.torque") >= 0 ? "driver.torque"
                       : mech_table_column(t, "driver.force") >= 0 ? "driver.force" : NULL;
     if (!drv)
@@ -245,8 +247,8 @@ static void plan_driver(plan *p, const mech_model *m)
               1, sfx, both ? sfx_both : sfx_one, both ? 2 : 1);
     /* applied by the ground to the driver link (docs/forces.md); a driving
        slider's force acts along its guide on the sliding link */
-    int on = !m->has_driver ? -1 : torque ? m->driver.index
-             : m->joints[m->driver.index].link[0];
+    const mech_motion *dr = &m->drivers[sweep];
+    int on = dr->kind == MECH_DRIVE_ANGLE ? dr->index : m->joints[dr->index].link[0];
     for (int k = n0; k < p->n && on >= 0; k++) {
         snprintf(p->figs[k].note[0], sizeof p->figs[k].note[0], "%s on %s",
                  torque ? "torque" : "force", m->links[on].name);
@@ -301,11 +303,11 @@ static void x_title(const fig_ctx *c, FILE *f)
         fputs("time t [s]", f);
     } else if (m->has_driver && m->driver.kind == MECH_DRIVE_SLIDER) {
         fputs("displacement of slider ", f);
-        plot_put_text(f, m->joints[m->driver.index].name);
+        plot_put_text(f, drivers_name(m, drivers_sweep(m)));
         fputs(" [mm]", f);
     } else {
         fputs("angle of ", f);
-        plot_put_text(f, m->has_driver ? m->links[m->driver.index].name : "the driver");
+        plot_put_text(f, m->has_driver ? drivers_name(m, drivers_sweep(m)) : "the driver");
         fputs(" [deg]", f);
     }
 }

@@ -3,7 +3,6 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "drivers.h"
 #include "system.h"
 
 static void describe_unknown(const mech_system *s, int i, FILE *out)
@@ -55,6 +54,18 @@ static void print_coefficients(const mech_system *s, FILE *out)
     fputc('\n', out);
 }
 
+/* What row r is: "    [loop 1, x]", "    [gear pair 'g']", "    [driver 'crank']". */
+static void row_tag(const mech_system *s, int r, FILE *out)
+{
+    const row_desc *rd = &s->rows[r];
+    char owner[160];
+    if (rd->kind == ROW_LOOP_X || rd->kind == ROW_LOOP_Y)
+        fprintf(out, "    [loop %d, %c]\n", rd->owner + 1, rd->kind == ROW_LOOP_Y ? 'y' : 'x');
+    else
+        fprintf(out, "    [%s]\n", rows_constraint(s->model, rd->kind, rd->owner, owner,
+                                                  sizeof owner));
+}
+
 static expr_names names_of(const mech_system *s)
 {
     return (expr_names){(const char *const *)s->names, (const char *const *)s->latex};
@@ -88,13 +99,7 @@ static void print_text(const mech_system *s, FILE *out)
     for (int r = 0; r < s->m; r++) {
         fprintf(out, "  f%d = ", r + 1);
         expr_print(&s->ex, s->f[r], &nm, 0, out);
-        int g = r - 2 * s->loops.nloops;  /* gears.c's rows follow the loops' */
-        if (r >= s->m - drivers_rows(m))  /* drivers as laws of time: the last rows */
-            fprintf(out, "    [driver '%s']\n", drivers_name(m, r - (s->m - drivers_rows(m))));
-        else if (g >= 0)  /* s->m = 2 nloops + ngears + drivers: a gear row */
-            fprintf(out, "    [gear pair '%s']\n", s->model->gears[g].name);
-        else
-            fprintf(out, "    [loop %d, %c]\n", r / 2 + 1, r % 2 ? 'y' : 'x');
+        row_tag(s, r, out);
     }
     fprintf(out, "\njacobian df/dx (%d nonzeros):\n", s->nnz);
     for (int j = 0; j < n; j++)

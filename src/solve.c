@@ -76,11 +76,11 @@ static void needed_unknowns(solver_plan *sp, unsigned char *need)
         if (var >= 0 && var < sp->n)
             need[var] = 1;
     }
-    for (int k = 0; k < drivers_rows(m); k++) {  /* their columns are always output */
-        int var = m->motions[k].kind == MECH_DRIVE_SLIDER
-                      ? sp->tree.slide_var[m->motions[k].index] : -1;
-        if (m->motions[k].kind == MECH_DRIVE_ANGLE)
-            kin_need_link(&sp->tree, m->motions[k].index, need);
+    for (int k = 0; k < m->ndrivers; k++) {  /* their columns are always output */
+        const mech_motion *mo = &m->drivers[k];
+        int var = mo->kind == MECH_DRIVE_SLIDER ? sp->tree.slide_var[mo->index] : -1;
+        if (mo->kind == MECH_DRIVE_ANGLE)
+            kin_need_link(&sp->tree, mo->index, need);
         else if (var >= 0 && var < sp->n)
             need[var] = 1;
     }
@@ -454,7 +454,8 @@ int solver_plan_init_with(solver_plan *sp, const mech_model *m, const mech_solve
         } else {
             b = choose_blocks(sp, need, row_on, col_on);
         }
-        if (b > 0 && drivers_rows(m) > 0)  /* name the conflicting drivers, the free unknowns */
+        /* with drivers' rows: name the conflicting drivers, the free unknowns */
+        if (b > 0 && sp->sys->nrows_of[ROW_DRIVER] > 0)
             rc = drivers_report_structure(sp->sys, d);
         else if (b > 0)
             rc = diag_error(d, m->file, m->driver.mark,

@@ -68,20 +68,13 @@ done:
     return src;
 }
 
-static int driver_link(const mech_model *m)
-{
-    return m->has_driver && m->driver.kind == MECH_DRIVE_ANGLE ? m->driver.index : -1;
-}
-
-static int driver_slider(const mech_model *m)
-{
-    return m->has_driver && m->driver.kind == MECH_DRIVE_SLIDER ? m->driver.index : -1;
-}
-
+/* Every link angle and slider displacement is an unknown, but for the ground,
+ * the links that locked sliders hold (their angle is their guide's), and the
+ * coordinate that is the sweep variable q itself (drivers.h). */
 static int assign_unknowns(mech_system *s)
 {
     const mech_model *m = s->model;
-    int n = 0;
+    int n = 0, qlink = drivers_sweep_link(m), qslider = drivers_sweep_slider(m);
     s->unk_kind = xcalloc((size_t)(m->nlinks + m->njoints), sizeof *s->unk_kind);
     s->unk_index = xcalloc((size_t)(m->nlinks + m->njoints), sizeof *s->unk_index);
     s->link_var = xcalloc((size_t)m->nlinks, sizeof *s->link_var);
@@ -93,7 +86,7 @@ static int assign_unknowns(mech_system *s)
     }
     for (int l = 0; l < m->nlinks; l++) {
         s->link_var[l] = -1;
-        if (l == 0 || l == driver_link(m) || lock[l] >= 0)
+        if (l == 0 || l == qlink || lock[l] >= 0)
             continue;
         s->unk_kind[n] = UNK_ANGLE;
         s->unk_index[n] = l;
@@ -101,7 +94,7 @@ static int assign_unknowns(mech_system *s)
     }
     for (int j = 0; j < m->njoints; j++) {
         s->joint_var[j] = -1;
-        if (m->joints[j].kind != MECH_JOINT_SLIDER || j == driver_slider(m))
+        if (m->joints[j].kind != MECH_JOINT_SLIDER || j == qslider)
             continue;
         s->unk_kind[n] = UNK_SLIDE;
         s->unk_index[n] = j;
@@ -129,21 +122,23 @@ static char *latex_word(const char *w)
     return out;
 }
 
-/* Text and LaTeX names of a position variable (an unknown or the driver). */
+/* Text and LaTeX names of a position variable: an unknown, or q (the
+ * coordinate that is the sweep variable, or else the time t of the laws). */
 static int position_names(const mech_system *s, int var, char **text, char **latex)
 {
     const mech_model *m = s->model;
     const char *symbol, *name;
     int is_angle;
-    if (var == SYS_VAR_Q(s->n) && m->driver.kind == MECH_DRIVE_TIME) {
-        *text = xstrdup("t");  /* drivers as laws of time: q is t */
-        *latex = xstrdup("t");
-        return *text && *latex ? 0 : -1;
-    } else if (var == SYS_VAR_Q(s->n)) {
-        is_angle = m->driver.kind == MECH_DRIVE_ANGLE;
-        const int i = m->driver.index;
-        symbol = is_angle ? m->links[i].symbol : m->joints[i].symbol;
-        name = is_angle ? m->links[i].name : m->joints[i].name;
+    if (var == SYS_VAR_Q(s->n)) {
+        int ql = drivers_sweep_link(m), qj = drivers_sweep_slider(m);
+        if (ql < 0 && qj < 0) {
+            *text = xstrdup("t");
+            *latex = xstrdup("t");
+            return *text && *latex ? 0 : -1;
+        }
+        is_angle = ql >= 0;
+        symbol = is_angle ? m->links[ql].symbol : m->joints[qj].symbol;
+        name = is_angle ? m->links[ql].name : m->joints[qj].name;
     } else {
         is_angle = s->unk_kind[var] == UNK_ANGLE;
         const int i = s->unk_index[var];
@@ -207,7 +202,7 @@ static int link_angles(mech_system *s, mech_diag *d)
     expr_ctx *c = &s->ex;
     s->link_angle = xcalloc((size_t)m->nlinks, sizeof *s->link_angle);
     s->slide = xcalloc((size_t)m->njoints + 1, sizeof *s->slide);
-    int *src = angle_sources(m);
+    int *src = angle_sources(m), qlink = drivers_sweep_link(m), qslider = drivers_sweep_slider(m);
     if (!s->link_angle || !s->slide || !src) {
         free(src);
         return diag_error(d, m->file, (mech_mark){0, 0}, "out of memory");
@@ -222,13 +217,13 @@ static int link_angles(mech_system *s, mech_diag *d)
                               m->links[l].name);
         }
         s->link_angle[l] = k == 0 ? c->zero
-                           : k == driver_link(m) ? expr_var(c, SYS_VAR_Q(s->n))
+                           : k == qlink ? expr_var(c, SYS_VAR_Q(s->n))
                                                   : expr_var(c, s->link_var[k]);
     }
     free(src);
     for (int j = 0; j < m->njoints; j++)
         s->slide[j] = m->joints[j].kind != MECH_JOINT_SLIDER ? -1
-                      : j == driver_slider(m) ? expr_var(c, SYS_VAR_Q(s->n))
+                      : j == qslider ? expr_var(c, SYS_VAR_Q(s->n))
                                               : expr_var(c, s->joint_var[j]);
     return MECH_OK;
 }
@@ -293,6 +288,17 @@ static ex balanced_sum(expr_ctx *c, ex *v, int n)
     return v[0];
 }
 
+/* Loop k's x and y closure sums (xs, ys: room for its terms). */
+static void loop_sums(mech_system *s, int k, ex *xs, ex *ys, ex *x, ex *y)
+{
+    const loop_set *ls = &s->loops;
+    int nt = 0;
+    for (int t = ls->start[k]; t < ls->start[k + 1]; t++, nt++)
+        term_vector(s, &ls->terms[t], &xs[nt], &ys[nt]);
+    *x = balanced_sum(&s->ex, xs, nt);
+    *y = balanced_sum(&s->ex, ys, nt);
+}
+
 static int build_residual(mech_system *s, mech_diag *d)
 {
     const mech_model *m = s->model;
@@ -308,18 +314,24 @@ static int build_residual(mech_system *s, mech_diag *d)
         free(ys);
         return diag_error(d, m->file, (mech_mark){0, 0}, "out of memory");
     }
-    for (int k = 0; k < ls->nloops; k++) {
-        int nt = 0;
-        for (int t = ls->start[k]; t < ls->start[k + 1]; t++, nt++)
-            term_vector(s, &ls->terms[t], &xs[nt], &ys[nt]);
-        s->f[2 * k] = balanced_sum(&s->ex, xs, nt);
-        s->f[2 * k + 1] = balanced_sum(&s->ex, ys, nt);
+    ex q = expr_var(&s->ex, SYS_VAR_Q(s->n)), loop_x = s->ex.zero, loop_y = loop_x;
+    for (int r = 0, loop = -1; r < rows; r++) {  /* each row as rows[] describes it */
+        const row_desc *rd = &s->rows[r];
+        switch (rd->kind) {
+        case ROW_LOOP_X:
+        case ROW_LOOP_Y:
+            if (rd->owner != loop) {  /* the loop's two sums, once */
+                loop = rd->owner;
+                loop_sums(s, loop, xs, ys, &loop_x, &loop_y);
+            }
+            s->f[r] = rd->kind == ROW_LOOP_X ? loop_x : loop_y;
+            break;
+        case ROW_GEAR: s->f[r] = gears_row(s, rd->owner); break;
+        case ROW_DRIVER:
+            s->f[r] = drivers_row(m, rd->owner, &s->ex, s->link_angle, s->slide, q);
+            break;
+        }
     }
-    gears_rows(s, s->f + 2 * ls->nloops);  /* gear pairs: one row each, after the loops */
-    /* drivers as laws of time: one row each, the last rows (after the loops
-       and any other rows) */
-    drivers_residual(m, &s->ex, s->link_angle, s->slide, expr_var(&s->ex, SYS_VAR_Q(s->n)),
-                     s->f + s->m - drivers_rows(m));
     free(xs);
     free(ys);
     return MECH_OK;
@@ -495,6 +507,7 @@ void mech_system_free(mech_system **ps)
     free(s->grad);
     free(s->names);
     free(s->latex);
+    free(s->rows);
     free(s->unk_kind);
     free(s->unk_index);
     free(s->link_var);
@@ -546,7 +559,10 @@ int sys_new_with(const mech_model *m, sys_mode mode, const sys_params *params,
     }
     if ((rc = loops_build(m, &s->span, &s->loops, d)) != MECH_OK)
         goto fail;
-    s->m = 2 * s->loops.nloops + m->ngears + drivers_rows(m);
+    s->m = rows_count(m, s->loops.nloops, s->nrows_of);
+    rc = MECH_ENOMEM;
+    if (!(s->rows = rows_build(m, s->loops.nloops, s->loops.from_file)))
+        goto fail;
     /* more equations than unknowns: redundant constraints, which the solver
        treats in the least-squares sense and checks for consistency */
     if (s->m < s->n) {

@@ -6,6 +6,7 @@
 #include "expr.h"
 #include "spantree.h"
 #include "internal.h"
+#include "rows.h"
 #include "tape.h"
 
 /* A piece of one loop's vector sum. */
@@ -76,8 +77,11 @@ typedef enum { UNK_ANGLE, UNK_SLIDE } unknown_kind;
 struct mech_system {
     const mech_model *model;   /* borrowed; must outlive the system */
     int n;                     /* unknowns */
-    int m;                     /* equations, 2 per loop: n, or more with redundant
+    int m;                     /* equations (rows.h: 2 per loop, 1 per gear pair, 1 per
+                                  driver that is not the sweep): n, or more with redundant
                                   constraints (solved in the least-squares sense) */
+    row_desc *rows;            /* [m] what each row is, whose and where (rows.h) */
+    int nrows_of[ROW_KINDS];   /* rows of each kind */
     unknown_kind *unk_kind;    /* [n] */
     int *unk_index;            /* [n] link index (ANGLE) or joint index (SLIDE) */
     int *link_var;             /* [nlinks] unknown of the link's angle, or -1 */
@@ -89,7 +93,7 @@ struct mech_system {
     span_tree span;            /* breadth-first spanning tree of the links */
     loop_set loops;
     expr_ctx ex;
-    ex *f;                     /* [m] residual rows; row 2k, 2k+1 = loop k, x and y */
+    ex *f;                     /* [m] residual rows, as rows[] describes them */
     int *Jp;                   /* [n+1] column pointers of the m x n Jacobian df/dx (CSC) */
     int *Ji;                   /* [nnz] row indices, ascending within a column */
     ex *Jx;                    /* [nnz] nonzero expressions */

@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "drivers.h"
 #include "param_grad.h"
 #include "variant_regs.h"
 
@@ -194,6 +195,7 @@ static int same_lists(const mech_model *a, const mech_model *v)
 static int same_structure(const mech_model *a, const mech_model *v)
 {
     return SAME(nlinks) && SAME(njoints) && SAME(npoint_names) && SAME(has_driver) &&
+           drivers_same(a, v) &&  /* the laws' numbers are folded into the tape */
            SAME(nguesses) && SAME(nbranches) && SAME(nloops) && SAME(nloads) &&
            SAME(nsprings) && same_links(a, v) && same_lists(a, v) &&
            !a->state_loads && !v->state_loads;  /* see docs/batch.md */

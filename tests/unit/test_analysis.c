@@ -162,6 +162,7 @@ Test(analysis, outputs_are_options_not_model_changes)
  * them sharing a name with another: quadratic would be 4e10 comparisons,
  * minutes; linear is milliseconds. The timeout is the check. */
 #include "columns.h"
+#include "drivers.h"
 
 Test(analysis, joint_labels_are_linear, .timeout = 20)
 {
@@ -181,13 +182,17 @@ Test(analysis, joint_labels_are_linear, .timeout = 20)
     m.joints = joints;
     m.njoints = NJ;
     m.driver.kind = MECH_DRIVE_ANGLE;
+    m.driver.index = 1;
+    cr_assert_eq(drivers_add_sweep(&m), 0);  /* the one driver: bar's angle is q */
     column_request rq = {&m.outputs, MECH_WANT_ALL, 1, 0, 0};
     column_layout cl;
     cr_assert_eq(columns_build(&cl, &m, &rq), MECH_OK);
     cr_assert_eq(cl.ncols, 1 + 3 * NJ + 2);
     /* J0 and J0 share a name (joints 0, 1): both get the links */
     cr_assert_str_eq(cl.cols[1].name, "J0(ground,bar).Fx");
+    cr_assert_str_eq(cl.cols[cl.ncols - 2].name, "driver.torque");
     columns_free(&cl);
+    drivers_free(&m);
     free(joints);
     free(names);
 }

@@ -9,13 +9,16 @@
  *     with the old `driver:` at 10 rad/s, row by row, to 1e-13;
  *   - the five-bar with masses: the sum of the drivers' powers against the
  *     rate of kinetic energy minus the power of gravity, each link's centre
- *     of mass motion computed here from the pivots and link angles. */
+ *     of mass motion computed here from the pivots and link angles;
+ *   - one model of drivers (`driver:` is the law q, with no row) and the
+ *     row descriptor (rows.h): each row's kind, owner, mark and name, and a
+ *     dead point whose message names the driver's row, against the
+ *     geometry of the fold. */
 #include <math.h>
 
 #include "helpers.h"
-
-/* src/drivers.c (declared here: drivers.h brings in the library's internals) */
-double law_eval(const struct mech_law *l, double t, double *dt, double *dtt);
+#include "drivers.h"
+#include "system.h"
 
 #define PI 3.14159265358979323846
 #define DEG (PI / 180.0)
@@ -154,7 +157,9 @@ static const char *const FOUR_BAR =
     "initial: {coupler: 60, rocker: 100}\n"
     "%s";
 
-Test(drivers, single_law_reproduces_the_driver_form)
+/* The four-bar in both forms: the crank swept at 10 rad/s through 72 steps
+ * of a turn (`driver:`), and the law 10 rad/s * t over the same 2 pi / 10 s. */
+static void four_bar_both_forms(mech_model **driver, mech_model **law)
 {
     char a[1024], b[1024];
     snprintf(a, sizeof a, FOUR_BAR,
@@ -162,7 +167,14 @@ Test(drivers, single_law_reproduces_the_driver_form)
     snprintf(b, sizeof b, FOUR_BAR,
              "sweep: {time: {from: 0 s, to: 0.6283185307179586 s, steps: 72}}\n"
              "drivers: [{link: crank, angle: \"10 rad/s * t\"}]\n");
-    mech_model *ma = load_text(a), *mb = load_text(b);
+    *driver = load_text(a);
+    *law = load_text(b);
+}
+
+Test(drivers, single_law_reproduces_the_driver_form)
+{
+    mech_model *ma, *mb;
+    four_bar_both_forms(&ma, &mb);
     mech_table ta = must_solve(ma, NULL), tb = must_solve(mb, NULL);
     cr_assert_eq(ta.nrows, 73);
     cr_assert_eq(tb.nrows, 73);
@@ -411,6 +423,17 @@ Test(drivers, law_derivatives)
     mech_model_free(&m);
 }
 
+/* m solved with the default options into *t (zeroed first), its messages
+ * into *d (initialised here); the status. */
+static int solve_noting(const mech_model *m, mech_table *t, mech_diag *d)
+{
+    mech_solve_options o;
+    mech_solve_options_default(&o);
+    mech_diag_init(d);
+    *t = (mech_table){0};
+    return mech_solve(m, &o, t, NULL, d);
+}
+
 /* As many drivers as degrees of freedom, but both on the four-bar of a
  * four-bar plus a separate dyad: the solve names the conflicting drivers
  * and the links left free (a maximum matching of the equations). */
@@ -432,12 +455,9 @@ Test(drivers, conflicting_drivers_named)
         "  - {link: crank, angle: \"10 rad/s * t\"}\n"
         "  - {link: rocker, angle: \"100 deg\"}\n";
     mech_model *m = load_text(text);  /* the counts agree: mech_check passes */
-    mech_solve_options o;
-    mech_solve_options_default(&o);
     mech_diag d;
-    mech_diag_init(&d);
-    mech_table t = {0};
-    cr_assert_eq(mech_solve(m, &o, &t, NULL, &d), MECH_EINPUT);
+    mech_table t;
+    cr_assert_eq(solve_noting(m, &t, &d), MECH_EINPUT);
     cr_assert_geq(d.count, 1);
     const mech_diag_entry *e = &d.entries[0];
     cr_assert(strstr(e->message, "the drivers of 'crank', 'rocker' over-determine") &&
@@ -446,5 +466,165 @@ Test(drivers, conflicting_drivers_named)
     cr_assert(e->mark.line == 13 && e->mark.col == 5, "at %d:%d", e->mark.line, e->mark.col);
     mech_diag_free(&d);
     mech_table_free(&t);
+    mech_model_free(&m);
+}
+
+/* ---- one driver model, one row descriptor ---------------------------------- */
+
+/* `driver:` is the driver whose law is q itself: one entry of the model's
+ * drivers, its coordinate the sweep variable (no unknown, no row); the laws
+ * of `drivers:` are the same list, each with a row after the loop rows. */
+Test(drivers, one_list_of_drivers)
+{
+    mech_model *ma, *mb;
+    four_bar_both_forms(&ma, &mb);
+    int crank = mech_find_link(ma, "crank");
+    cr_assert_eq(ma->ndrivers, 1);
+    cr_assert_eq(ma->drivers[0].kind, MECH_DRIVE_ANGLE);
+    cr_assert_eq(ma->drivers[0].index, crank);
+    cr_assert_null(ma->drivers[0].text);
+    cr_assert(drivers_is_sweep(ma, 0));
+    double d1, d2;  /* the law q: value q, rate 1, no curvature */
+    cr_assert_eq(law_eval(ma->drivers[0].law, 0.7, &d1, &d2), 0.7);
+    cr_assert(d1 == 1.0 && d2 == 0.0);
+    cr_assert(ma->nmotions == 0 && !ma->motions, "0.1's view lists laws of time only");
+    cr_assert_eq(drivers_sweep_link(ma), crank);
+    cr_assert_eq(drivers_rows(ma), 0);
+    cr_assert(mb->ndrivers == 1 && mb->motions == mb->drivers && mb->nmotions == 1);
+    cr_assert(!drivers_is_sweep(mb, 0));
+    cr_assert_eq(drivers_sweep_link(mb), -1);
+    cr_assert_eq(drivers_rows(mb), 1);
+    mech_system *sa = NULL, *sb = NULL;
+    mech_diag d;
+    mech_diag_init(&d);
+    cr_assert_eq(mech_system_new(ma, &sa, &d), MECH_OK);
+    cr_assert_eq(mech_system_new(mb, &sb, &d), MECH_OK);
+    cr_assert(sa->n == 2 && sa->m == 2, "driver: the crank is q, %d x %d", sa->m, sa->n);
+    cr_assert(sb->n == 3 && sb->m == 3, "a law: the crank is an unknown, %d x %d", sb->m, sb->n);
+    cr_assert(sb->rows[2].kind == ROW_DRIVER && sb->rows[2].owner == 0);
+    cr_assert_eq(sb->rows[2].mark.line, 10);  /* the entry of `drivers:` */
+    mech_system_free(&sa);
+    mech_system_free(&sb);
+    mech_diag_free(&d);
+    mech_model_free(&ma);
+    mech_model_free(&mb);
+}
+
+/* A law of time that folds to t itself (1 rad/s * t) is still a law: its
+ * driver keeps its unknown, its row, its columns and its load's name; only
+ * `driver:` is the sweep. */
+Test(drivers, a_law_equal_to_t_is_still_a_law)
+{
+    char text[1024];
+    snprintf(text, sizeof text, FOUR_BAR,
+             "sweep: {time: {from: 0 s, to: 1 s, steps: 4}}\n"
+             "drivers: [{link: crank, angle: \"1 rad/s * t\"}]\n"
+             "outputs: {points: [P], forces: true}\n");
+    mech_model *m = load_text(text);
+    cr_assert(!drivers_is_sweep(m, 0) && drivers_rows(m) == 1 && drivers_sweep(m) < 0);
+    mech_table t = must_solve(m, NULL);
+    cr_assert_geq(mech_table_column(&t, "crank.angle"), 0);
+    cr_assert_geq(mech_table_column(&t, "crank.torque"), 0);
+    cr_assert_lt(mech_table_column(&t, "driver.torque"), 0);
+    int ct = mech_table_column(&t, "t"), ca = mech_table_column(&t, "crank.angle");
+    for (int r = 0; r < t.nrows; r++)  /* th = 1 rad/s * t */
+        cr_assert_float_eq(mech_table_get(&t, r, ca), mech_table_get(&t, r, ct), 1e-15);
+    mech_table_free(&t);
+    mech_model_free(&m);
+}
+
+/* The descriptor of a gear train with a law and a listed loop: the rows in
+ * order (loop x, loop y, the gear pair, the driver), each owner named, and
+ * mech equations' tags from it. */
+Test(drivers, row_descriptor_names_each_owner)
+{
+    static const char *const text =
+        "name: a four-bar and a gear pair\n"
+        "units: {length: mm, angle: deg}\n"
+        "ground: {O: [0, 0], C: [70, 0], G: [0, 100], H: [60, 100]}\n"
+        "links:\n"
+        "  crank:   {points: {O: [0, 0], A: [20, 0]}}\n"
+        "  coupler: {points: {A: [0, 0], B: [60, 0]}}\n"
+        "  rocker:  {points: {C: [0, 0], B: [50, 0]}}\n"
+        "  wa: {points: {G: [0, 0]}}\n"
+        "  wb: {points: {H: [0, 0]}}\n"
+        "loops: [[O, A, B, C, O]]\n"
+        "initial: {coupler: 60, rocker: 100}\n"
+        "sweep: {time: {from: 0 s, to: 1 s, steps: 4}}\n"
+        "drivers:\n"
+        "  - {link: crank, angle: \"10 rad/s * t\"}\n"
+        "  - {link: wa, angle: \"2 rad/s * t\"}\n"
+        "gears:\n"
+        "  - {name: mesh, gear: wa, with: wb, radii: [30, 30]}\n";
+    mech_model *m = load_text(text);
+    mech_system *s = NULL;
+    mech_diag d;
+    mech_diag_init(&d);
+    cr_assert_eq(mech_system_new(m, &s, &d), MECH_OK, "%s", d.count ? d.entries[0].message : "");
+    static const row_kind kinds[] = {ROW_LOOP_X, ROW_LOOP_Y, ROW_GEAR, ROW_DRIVER, ROW_DRIVER};
+    static const int owners[] = {0, 0, 0, 0, 1}, lines[] = {10, 10, 17, 14, 15};
+    static const char *const names[] = {"loop 1 (O-A-B-C-O)", "loop 1 (O-A-B-C-O)",
+                                        "gear pair 'mesh'", "driver 'crank'", "driver 'wa'"};
+    cr_assert_eq(s->m, 5);
+    int count[ROW_KINDS];
+    cr_assert_eq(rows_count(m, 1, count), 5);
+    cr_assert(count[ROW_LOOP_X] == 1 && count[ROW_GEAR] == 1 && count[ROW_DRIVER] == 2);
+    for (int r = 0; r < s->m; r++) {
+        char buf[160];
+        cr_assert_eq(s->rows[r].kind, kinds[r], "row %d", r);
+        cr_assert_eq(s->rows[r].owner, owners[r], "row %d", r);
+        cr_assert_eq(s->rows[r].mark.line, lines[r], "row %d", r);
+        cr_assert_str_eq(rows_owner(s, r, buf, sizeof buf), names[r]);
+    }
+    cr_assert(rows_same_owner(s, 0, 1) && !rows_same_owner(s, 1, 2) && !rows_same_owner(s, 3, 4));
+    char *out = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&out, &len);
+    mech_system_print(s, MECH_FORMAT_TEXT, f);
+    fclose(f);
+    cr_assert(strstr(out, "    [loop 1, y]\n") && strstr(out, "    [gear pair 'mesh']\n") &&
+                  strstr(out, "    [driver 'wa']\n"), "%s", out);
+    free(out);
+    mech_system_free(&s);
+    mech_diag_free(&d);
+    mech_model_free(&m);
+}
+
+/* A crank-rocker (20, 70, 50 on 60 mm of ground) driven by its rocker to
+ * its limit: crank and coupler fold in line when |OB| = 70 - 20, at B =
+ * (30, 40) mm, the rocker at atan2(40, -30) = 126.8699 deg. There the
+ * unknowns are not determined by the loop and by the rocker's own row,
+ * which the message names as that driver's. */
+Test(drivers, dead_point_names_the_driver_row)
+{
+    static const char *const text =
+        "name: a crank-rocker driven by its rocker\n"
+        "units: {length: mm, angle: deg}\n"
+        "ground: {O: [0, 0], C: [60, 0]}\n"
+        "links:\n"
+        "  crank:   {points: {O: [0, 0], A: [20, 0]}}\n"
+        "  coupler: {points: {A: [0, 0], B: [70, 0]}}\n"
+        "  rocker:  {points: {C: [0, 0], B: [50, 0]}}\n"
+        "sweep: {time: {from: 0 s, to: 1 s, steps: 4}}\n"
+        "drivers: [{link: rocker, angle: \"90 deg + 36.869897645844021 deg/s * t\"}]\n"
+        "initial: {crank: 90, coupler: 20}\n";
+    mech_model *m = load_text(text);
+    mech_diag d;
+    mech_table t;
+    cr_assert_eq(solve_noting(m, &t, &d), MECH_ESOLVE);
+    const char *msg = NULL;
+    for (size_t e = 0; e < d.count; e++)
+        if (strstr(d.entries[e].message, "singular position at time = 1 s"))
+            msg = d.entries[e].message;
+    cr_assert_not_null(msg, "%s", d.count ? d.entries[d.count - 1].message : "");
+    double crank = atan2(-40.0, -30.0) / DEG;  /* A = -(20/50) B: folded back */
+    char at[64];
+    snprintf(at, sizeof at, "th_crank (at %.3f deg)", crank);
+    cr_assert(strstr(msg, at) && strstr(msg, "crank and coupler folded in line") &&
+                  strstr(msg, "not determined by loop 1 (B-C-O-A-B), driver 'rocker'; "),
+              "%s", msg);
+    cr_assert_eq(t.nrows, 4);
+    mech_table_free(&t);
+    mech_diag_free(&d);
     mech_model_free(&m);
 }

@@ -210,6 +210,36 @@ Test(sweep_shared, structure_changes_are_reanalysed)
     cr_assert_eq(alone, 2, "%ld through the shared analysis, %ld alone", shared, alone);
 }
 
+/* A parameter in a driver's law of time: the system folds the law's
+ * numbers, so a variant that changes them is analysed on its own (the
+ * shared analysis would keep the base's law), with the result of solving
+ * it alone. */
+Test(sweep_shared, law_parameter_is_reanalysed)
+{
+    static const char text[] =
+        "name: four-bar with a parameter in its law\n"
+        "units: {length: mm, angle: deg}\n"
+        "parameters: {w: 10 rad/s}\n"
+        "ground: {O: [0, 0], C: [70, 0]}\n"
+        "links:\n"
+        "  crank:   {points: {O: [0, 0], A: [20, 0]}}\n"
+        "  coupler: {points: {A: [0, 0], B: [60, 0], P: [30, 15]}}\n"
+        "  rocker:  {points: {C: [0, 0], B: [50, 0]}}\n"
+        "initial: {coupler: 60, rocker: 100}\n"
+        "sweep: {time: {from: 0 s, to: 0.1 s, steps: 4}}\n"
+        "drivers: [{link: crank, angle: \"w * t\"}]\n"
+        "outputs: {points: [P]}\n";
+    const char *file = write_temp(text);
+    static const char *const names[] = {"w"};
+    static const char *const texts[] = {"10 rad/s", "20 rad/s"};
+    compare_variants(file, names, 1, texts, 2, 0);
+    long shared, alone;
+    sweep_variant_counts(&shared, &alone);
+    remove(file);
+    cr_assert(shared == 1 && alone == 1, "%ld through the shared analysis, %ld alone", shared,
+              alone);
+}
+
 /* Every parameter of every mechanism in mechanisms/, at 0.97, 1.01 and 1.03
  * times its value, with forces: the same status and every column to 1e-12.
  * One child process per parameter (a process keeps one sweep's analysis);
