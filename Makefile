@@ -2,9 +2,11 @@
 #   make            build build/libmech.a and build/mech (warnings are errors)
 #   make deps       install missing Debian packages (apt-get; tools/deps.sh)
 #   make run        deps + build + the main job: solve the Stirling engine
-#   make test       deps + build + the full test suite
+#   make test       deps + build + the full test suite, each suite timed
+#   make check      the fast tier (about a minute): the same suites, each
+#                   shell suite's fast subset (MECH_QUICK=1; docs/testing.md)
 #   make test-san   the test suite built with -fsanitize=address,undefined
-#   make test-browser  figures, animation and report rendered by headless chromium
+#   make test-browser  figures, animation, report and mech watch in headless chromium
 #   make test-slurm    docs/batch.md's Slurm recipes on a single-node Slurm (root)
 #   make bench      optimised benchmarks, printed as tables
 #   make golden     regenerate tests/golden/*.csv (review the diff by hand)
@@ -27,55 +29,87 @@ KLU_LIBS   := $(shell pkg-config --libs klu 2>/dev/null || echo -lklu -lbtf -lam
 YAML_CFLAGS := $(shell pkg-config --cflags yaml-0.1 2>/dev/null)
 YAML_LIBS   := $(shell pkg-config --libs yaml-0.1 2>/dev/null || echo -lyaml)
 CRIT_LIBS   := $(shell pkg-config --libs criterion 2>/dev/null || echo -lcriterion)
-# Debian's Python (python3-dev, python3-numpy), not a python3 earlier in PATH
+# The Python the module is built for: Debian's python3 (python3-dev,
+# python3-numpy), not a python3 earlier in PATH, unless PYTHON names another
+# (a pyenv or venv python with its own numpy). python/buildinfo.py asks that
+# interpreter for its headers, numpy, extension suffix and module directory
+# (docs/api.md, "Python").
 PYTHON      ?= $(shell test -x /usr/bin/python3 && echo /usr/bin/python3 || echo python3)
-PY_CFLAGS    = $(shell $(PYTHON)-config --includes 2>/dev/null) \
-               -I$(shell $(PYTHON) -c 'import numpy; print(numpy.get_include())' 2>/dev/null)
-PY_EXT      := $(shell $(PYTHON)-config --extension-suffix 2>/dev/null || echo .so)
-PYDIR        = lib/python3/dist-packages
+PY_INFO      = $(PYTHON) python/buildinfo.py
+PY_CFLAGS    = $(shell $(PY_INFO) cflags 2>/dev/null) $(shell $(PY_INFO) defines 2>/dev/null)
+PY_EXT      := $(shell $(PY_INFO) suffix 2>/dev/null || echo .so)
+PYDIR       ?= $(shell $(PY_INFO) pydir 2>/dev/null || echo lib/python3/dist-packages)
 WITH_PYTHON ?= 1
 
-# The library's version is MECH_VERSION in mech.h; the soname carries its
-# first number (the ABI: bumped when a struct or signature changes).
-VERSION := $(shell sed -n 's/^\#define MECH_VERSION "\(.*\)"/\1/p' include/mech.h)
-SOMAJOR := $(firstword $(subst ., ,$(VERSION)))
-SONAME   = libmech.so.$(SOMAJOR)
+# The library's version is MECH_VERSION in mech.h; the soname carries the
+# ABI (docs/api.md, "Versions and the ABI"): libmech.so.0.MINOR before 1.0,
+# libmech.so.MAJOR from 1.0. libmech.map names the symbols' version node.
+VERSION := $(shell sed -n 's/^\#define MECH_VERSION "\([0-9][0-9.]*\)"$$/\1/p' include/mech.h)
+# one word or nothing would name other targets (a path pattern in the
+# version was once a target list reaching outside the tree)
+ifneq ($(words $(VERSION)),1)
+$(error include/mech.h: no '#define MECH_VERSION "MAJOR.MINOR.PATCH"' line alone)
+endif
+SOMAJOR := $(word 1,$(subst ., ,$(VERSION)))
+SOMINOR := $(word 2,$(subst ., ,$(VERSION)))
+SOABI    = $(if $(filter 0,$(SOMAJOR)),0.$(SOMINOR),$(SOMAJOR))
+SONAME   = libmech.so.$(SOABI)
 
-CFLAGS  = $(CFLAGS_BASE) $(OPT) $(SAN) -Iinclude $(YAML_CFLAGS) $(KLU_CFLAGS)
+SRC_INC = $(addprefix -I,$(SRC_DIRS))
+CFLAGS  = $(CFLAGS_BASE) $(OPT) $(SAN) -Iinclude $(SRC_INC) $(YAML_CFLAGS) $(KLU_CFLAGS)
 LDLIBS  = $(YAML_LIBS) $(KLU_LIBS) -lm -pthread
 LDFLAGS = $(SAN) -pthread
 
-CMD_SRC  = src/main.c $(wildcard src/cmd_*.c)
-CMD_OBJ  = $(CMD_SRC:src/%.c=$(BUILD)/obj/%.o)
-LIB_SRC  = $(filter-out $(CMD_SRC),$(wildcard src/*.c))
-LIB_OBJ  = $(LIB_SRC:src/%.c=$(BUILD)/pic/%.o)
+# src/ is one folder per stage of the pipeline, each with one header
+# (docs/architecture.md, "Stages"): a stage uses only those before it in
+# STAGES (tools/stages.py checks the objects' symbols). runtime/ is the C
+# that libmech and the generated code share.
+STAGES   = runtime base symbolic load equations solve forces study output codegen cli
+SRC_DIRS = $(addprefix src/,$(STAGES))
+vpath %.c $(SRC_DIRS)
+CMD_SRC  = $(wildcard src/cli/*.c)
+CMD_OBJ  = $(patsubst %.c,$(BUILD)/obj/%.o,$(notdir $(CMD_SRC)))
+LIB_SRC  = $(filter-out $(CMD_SRC),$(wildcard src/*/*.c))
+LIB_OBJ  = $(patsubst %.c,$(BUILD)/pic/%.o,$(notdir $(LIB_SRC))) $(BUILD)/pic/rt_text.o
+# The runtime libmech and the generated code share (docs/codegen.md): real C,
+# compiled into libmech through its includers, and its text carried by `mech
+# codegen` (build/gen/rt_text.c, in the order the generated source needs it).
+RT_SRC   = $(addprefix src/runtime/,rt_base.h rt_blocklu.h rt_newton.h rt_frame.h rt_forces.h rt_solver.h)
 TEST_SRC = $(wildcard tests/unit/*.c)
 TEST_OBJ = $(TEST_SRC:tests/unit/%.c=$(BUILD)/tests/%.o)
 
-.PHONY: all lib python deps run test test-san test-valgrind test-browser test-install test-python test-slurm \
+.PHONY: all lib python deps run test check test-san test-valgrind test-browser test-install test-python test-slurm \
         fuzz fuzz-replay bench golden install clean
 
 all: $(BUILD)/mech lib
 
 lib: $(BUILD)/libmech.a $(BUILD)/libmech.so
 
-HEADERS = include/mech.h $(wildcard src/*.h)
+HEADERS = include/mech.h $(wildcard src/*/*.h)
 
-$(BUILD)/obj/%.o: src/%.c $(HEADERS) | $(BUILD)/obj
+$(BUILD)/obj/%.o: %.c $(HEADERS) | $(BUILD)/obj
 	$(CC) $(CFLAGS) -c $< -o $@
 
 # Library objects are position independent (their own directory, so a tree
 # built before is not mixed in): the same objects make the static library
 # and the shared one, which Python's extension (or ctypes) loads.
-$(BUILD)/pic/%.o: src/%.c $(HEADERS) | $(BUILD)/pic
+$(BUILD)/pic/%.o: %.c $(HEADERS) | $(BUILD)/pic
+	$(CC) $(CFLAGS) -fPIC -c $< -o $@
+
+# The runtime's text as C arrays of lines (codegen_rt_NAME[]) for the generator.
+$(BUILD)/gen/rt_text.c: $(RT_SRC) tools/c_lines.awk | $(BUILD)/gen
+	awk -f tools/c_lines.awk $(RT_SRC) >$@.tmp && mv $@.tmp $@
+
+$(BUILD)/pic/rt_text.o: $(BUILD)/gen/rt_text.c $(HEADERS) | $(BUILD)/pic
 	$(CC) $(CFLAGS) -fPIC -c $< -o $@
 
 $(BUILD)/libmech.a: $(LIB_OBJ)
 	rm -f $@
 	ar rcs $@ $^
 
-# libmech.so -> libmech.so.0 -> libmech.so.0.1.0; only the mech_* names are
-# exported (libmech.map), the modules' internal functions stay local.
+# libmech.so -> libmech.so.0.2 -> libmech.so.0.2.0; only the mech_* names are
+# exported (libmech.map, version node MECH_0.2), the modules' internal
+# functions stay local.
 $(BUILD)/libmech.so.$(VERSION): $(LIB_OBJ) libmech.map
 	$(CC) $(LDFLAGS) -shared -Wl,-soname,$(SONAME) -Wl,--version-script=libmech.map \
 	    -Wl,--no-undefined -o $@ $(LIB_OBJ) $(LDLIBS)
@@ -85,10 +119,21 @@ $(BUILD)/libmech.so: $(BUILD)/libmech.so.$(VERSION)
 	ln -sf $(SONAME) $@
 
 # The Python extension mech._mech (python/mech_module.c), linked with the
-# shared library; its run path finds libmech.so.0 from P/lib/python3/dist-packages/mech.
+# shared library; its run path finds $(SONAME) from P/lib/python3/dist-packages/mech.
 python: $(BUILD)/python/mech/_mech$(PY_EXT) $(BUILD)/python/mech/__init__.py
 
-$(BUILD)/python/mech/_mech$(PY_EXT): python/mech_module.c include/mech.h $(BUILD)/libmech.so
+# What the extension is built for (PYTHON, its version and numpy's): the
+# file changes when they do, and the extension is built again; the build
+# stops here, saying why, when PYTHON cannot build it (no numpy, no headers).
+$(BUILD)/python/built-for: FORCE
+	@mkdir -p $(@D)
+	@$(PY_INFO) check >$@.new || { rm -f $@.new; exit 1; }
+	@if cmp -s $@.new $@; then rm -f $@.new; else mv $@.new $@; fi
+
+FORCE:
+
+$(BUILD)/python/mech/_mech$(PY_EXT): python/mech_module.c include/mech.h $(BUILD)/libmech.so \
+    $(BUILD)/python/built-for
 	@mkdir -p $(@D)
 	$(CC) $(CFLAGS_BASE) -Wno-missing-prototypes $(OPT) $(SAN) -fPIC -shared -Iinclude \
 	    $(PY_CFLAGS) -o $@ $< -L$(BUILD) -lmech -Wl,-rpath,'$$ORIGIN/../../..'
@@ -101,22 +146,30 @@ $(BUILD)/mech: $(CMD_OBJ) $(BUILD)/libmech.a
 	$(CC) $(LDFLAGS) -o $@ $^ $(LDLIBS)
 
 $(BUILD)/tests/%.o: tests/unit/%.c $(HEADERS) $(wildcard tests/unit/*.h) | $(BUILD)/tests
-	$(CC) $(CFLAGS) -Isrc -c $< -o $@
+	$(CC) $(CFLAGS) -c $< -o $@
 
-# test_compare.c also runs the command line of mech compare (cmd_compare.c)
-$(BUILD)/unit-tests: $(TEST_OBJ) $(BUILD)/obj/cmd_compare.o $(BUILD)/libmech.a
+# test_compare.c also runs the command line of mech compare (cmd_compare.c),
+# test_cmd_opts.c the option parser (cmd_opts.c) and every command's table,
+# test_rowcheck.c the row checks (cmd_rowcheck.c) and digests (cmd_manifest.c)
+# test_http.c the request parser of mech watch (cmd_http.c)
+CMD_TESTED = $(filter-out $(BUILD)/obj/main.o,$(CMD_OBJ))
+$(BUILD)/unit-tests: $(TEST_OBJ) $(CMD_TESTED) $(BUILD)/libmech.a
 	$(CC) $(LDFLAGS) -o $@ $^ $(CRIT_LIBS) $(LDLIBS)
 
-# cmd_run_parallel with a pthread_create failing half-way (tests/pool/pool_fail.c
+# parallel_run with a pthread_create failing half-way (tests/pool/pool_fail.c
 # replaces pthread_create and pthread_join)
 $(BUILD)/pool-fail: tests/pool/pool_fail.c $(BUILD)/obj/cmd_common.o $(BUILD)/libmech.a $(HEADERS)
-	$(CC) $(CFLAGS) -Isrc -o $@ $< $(BUILD)/obj/cmd_common.o $(BUILD)/libmech.a $(LDLIBS)
+	$(CC) $(CFLAGS) -o $@ $< $(BUILD)/obj/cmd_common.o $(BUILD)/libmech.a $(LDLIBS)
 
 # the default -j of batch and sweep under a restricted CPU affinity mask
 $(BUILD)/affinity: tests/pool/affinity.c $(BUILD)/obj/cmd_common.o $(BUILD)/libmech.a $(HEADERS)
-	$(CC) $(CFLAGS) -Isrc -o $@ $< $(BUILD)/obj/cmd_common.o $(BUILD)/libmech.a $(LDLIBS)
+	$(CC) $(CFLAGS) -o $@ $< $(BUILD)/obj/cmd_common.o $(BUILD)/libmech.a $(LDLIBS)
 
-$(BUILD)/obj $(BUILD)/pic $(BUILD)/tests:
+# a command run with known signal dispositions (tests/lib.sh, tests/signals.sh)
+$(BUILD)/sigexec: tests/sigexec.c | $(BUILD)/obj
+	$(CC) $(CFLAGS) -o $@ $<
+
+$(BUILD)/obj $(BUILD)/pic $(BUILD)/tests $(BUILD)/gen:
 	mkdir -p $@
 
 deps:
@@ -130,24 +183,57 @@ run: deps
 	$(BUILD)/mech solve mechanisms/stirling.yaml -o $(BUILD)/stirling.csv --stats
 	@echo "wrote $(BUILD)/stirling.csv"
 
+# SUITES: what make test runs in full and make check (QUICK=1) in its fast
+# subset: the unit tests but UNIT_SLOW, each shell suite under MECH_QUICK=1
+# (docs/testing.md). A line per suite (a new suite is one more line), each
+# timed by tests/timed.sh: "time: NAME ..." when it ends, a table at the end.
+# UNIT_SLOW: the longest unit tests (a chain of 100 000 four-bars, every
+# parameter of every mechanism swept, ...: two thirds of the unit tests' time)
+UNIT_SLOW = limits/chain_of_100000_fourbars sweep_shared/every_parameter_of_every_mechanism \
+            limits/one_pin_on_many_links hard/chain_10000_solves_in_linear_time \
+            sensitivity/stackup_bounds_a_monte_carlo_sweep_of_10000_samples
+space    := $() $()
+TEST_BIN  = $(BUILD)/mech $(BUILD)/unit-tests $(BUILD)/pool-fail $(BUILD)/affinity $(BUILD)/sigexec
+TIMED     = sh tests/timed.sh $(BUILD)/$@-times.txt
+SUITE_ENV = env MECH=$(BUILD)/mech MECH_QUICK=$(QUICK)
+SAN_ENV   = MECH_SANITIZE=$(if $(SAN),1,)
+define SUITES
+	@$(MAKE) --no-print-directory $(TEST_BIN)
+	@$(TIMED) begin
+	$(TIMED) stages python3 tools/stages.py $(BUILD)
+	$(TIMED) unit $(BUILD)/unit-tests --jobs 2 $(if $(QUICK),--filter '!($(subst $(space),|,$(strip $(UNIT_SLOW))))')
+	$(TIMED) pool-fail $(BUILD)/pool-fail
+	$(TIMED) affinity $(BUILD)/affinity
+	$(TIMED) cli $(SUITE_ENV) sh tests/cli.sh
+	$(TIMED) cli_compare $(SUITE_ENV) sh tests/cli_compare.sh
+	$(TIMED) files $(SUITE_ENV) sh tests/files.sh
+	$(TIMED) signals $(SUITE_ENV) sh tests/signals.sh
+	$(TIMED) golden $(SUITE_ENV) sh tests/golden.sh
+	$(TIMED) sweep $(SUITE_ENV) $(SAN_ENV) sh tests/sweep.sh
+	$(TIMED) sweep_random $(SUITE_ENV) $(SAN_ENV) sh tests/sweep_random.sh
+	$(TIMED) merge $(SUITE_ENV) $(SAN_ENV) sh tests/merge.sh
+	$(TIMED) codegen $(SUITE_ENV) $(SAN_ENV) sh tests/codegen.sh
+	$(TIMED) jit $(SUITE_ENV) sh tests/jit.sh
+	$(TIMED) report $(SUITE_ENV) sh tests/report.sh
+	$(TIMED) draw $(SUITE_ENV) sh tests/draw.sh
+	$(TIMED) watch $(SUITE_ENV) sh tests/watch.sh
+	$(TIMED) drivers $(SUITE_ENV) sh tests/drivers.sh
+	$(TIMED) drawn $(SUITE_ENV) sh tests/drawn.sh
+	$(TIMED) warn $(SUITE_ENV) sh tests/warn.sh
+	$(TIMED) parallel $(SUITE_ENV) sh tests/parallel/recipes.sh
+	$(TIMED) install $(MAKE) --no-print-directory test-install
+	$(TIMED) python $(MAKE) --no-print-directory test-python QUICK=$(QUICK)
+	@$(TIMED) table
+endef
+
 test: deps
-	@$(MAKE) --no-print-directory $(BUILD)/mech $(BUILD)/unit-tests
-	$(BUILD)/unit-tests --jobs 2
-	@$(MAKE) --no-print-directory $(BUILD)/pool-fail
-	$(BUILD)/pool-fail
-	@$(MAKE) --no-print-directory $(BUILD)/affinity
-	$(BUILD)/affinity
-	MECH=$(BUILD)/mech sh tests/cli.sh
-	MECH=$(BUILD)/mech sh tests/cli_compare.sh
-	MECH=$(BUILD)/mech sh tests/files.sh
-	MECH=$(BUILD)/mech sh tests/golden.sh
-	MECH=$(BUILD)/mech MECH_SANITIZE=$(if $(SAN),1,) sh tests/sweep.sh
-	MECH=$(BUILD)/mech MECH_SANITIZE=$(if $(SAN),1,) sh tests/sweep_random.sh
-	MECH=$(BUILD)/mech MECH_SANITIZE=$(if $(SAN),1,) sh tests/codegen.sh
-	MECH=$(BUILD)/mech sh tests/report.sh
-	MECH=$(BUILD)/mech sh tests/drivers.sh
-	MECH=$(BUILD)/mech sh tests/parallel/recipes.sh
-	@$(MAKE) --no-print-directory test-install test-python
+	$(SUITES)
+
+# The fast tier, between edits: the same suites, each shell suite's fast
+# subset (about a minute on two cores, built; docs/testing.md).
+check: QUICK = 1
+check:
+	$(SUITES)
 
 # The Slurm recipes of docs/batch.md run as written against a single-node
 # Slurm that tests/slurm/recipes.sh starts on localhost and stops (root,
@@ -156,21 +242,29 @@ test-slurm: $(BUILD)/mech
 	@sh tools/deps.sh slurm-wlm munge
 	MECH=$(BUILD)/mech sh tests/slurm/recipes.sh
 
-# make install into a temporary prefix, then the example of docs/api.md
-# built with pkg-config alone (shared and --static), its numbers against
-# mech solve's CSV, and the man page rendered.
+# The C API's contract through the shared library (tests/api.sh: NULL
+# arguments, the options' size, the soname and version node); make install
+# into a temporary prefix, then the example of docs/api.md built with
+# pkg-config alone (shared and --static), its numbers against mech solve's
+# CSV, and the man page rendered.
 test-install: lib python $(BUILD)/mech
+	BUILD=$(BUILD) CC="$(CC)" SAN="$(SAN)" sh tests/api.sh
 	BUILD=$(BUILD) CC="$(CC)" OPT="$(OPT)" SAN="$(SAN)" MAKE="$(MAKE)" sh tests/install.sh
 
-# pytest on the Python module installed into a temporary prefix. Under the
-# sanitizers the extension and the library are instrumented and python3 is
-# not: the sanitizers' run-time libraries are preloaded (leak detection off:
-# the interpreter keeps its memory at exit).
+# pytest on the Python module installed into a temporary prefix, then the
+# module built for other interpreters (tests/python/interpreters.sh: not in
+# make check's quick tier, and not under the sanitizers, whose run-time the
+# other interpreters would lack). Under the sanitizers the extension and the
+# library are instrumented and python3 is not: the sanitizers' run-time
+# libraries are preloaded (leak detection off: the interpreter keeps its
+# memory at exit).
 SAN_PRELOAD = $(if $(findstring address,$(SAN)),$(shell $(CC) -print-file-name=libasan.so)) \
               $(if $(findstring undefined,$(SAN)),$(shell $(CC) -print-file-name=libubsan.so))
 test-python: lib python $(BUILD)/mech
 	BUILD=$(BUILD) PYTHON=$(PYTHON) MAKE="$(MAKE)" OPT="$(OPT)" SAN="$(SAN)" \
 	    SAN_PRELOAD="$(strip $(if $(SAN),$(SAN_PRELOAD)))" sh tests/python/run.sh
+	$(if $(SAN)$(QUICK),,BUILD=$(BUILD) PYTHON=$(PYTHON) MAKE="$(MAKE)" OPT="$(OPT)" \
+	    sh tests/python/interpreters.sh)
 
 test-san:
 	@$(MAKE) --no-print-directory test BUILD=build/san OPT="-O1 -g -fno-omit-frame-pointer" \
@@ -187,11 +281,12 @@ fuzz-replay:
 test-valgrind: $(BUILD)/mech
 	MECH=$(BUILD)/mech sh tests/valgrind.sh
 
-# Figures, animation and the HTML report seen by headless chromium
-# (docs/plots.md, docs/report.md).
+# Figures, animation, the HTML report and mech watch's live page seen by
+# headless chromium (docs/plots.md, docs/report.md, docs/cli.md).
 test-browser: $(BUILD)/mech
 	MECH=$(BUILD)/mech OUT=$(BUILD)/browser sh tests/browser/run.sh
 	MECH=$(BUILD)/mech OUT=$(BUILD)/browser-report sh tests/browser/report.sh
+	MECH=$(BUILD)/mech OUT=$(BUILD)/browser-watch sh tests/browser/watch.sh
 
 # Benchmarks: optimised, no sanitizers; prints tables and writes them, with
 # the plots, into docs/performance.md (bench/report.sh).
@@ -212,13 +307,13 @@ bench:
 	sh bench/report.sh build/bench/report.txt
 
 $(BUILD)/bench-eval: bench/bench_eval.c $(BUILD)/libmech.a $(HEADERS)
-	$(CC) $(CFLAGS) -Isrc -o $@ $< $(BUILD)/libmech.a $(LDLIBS)
+	$(CC) $(CFLAGS) -o $@ $< $(BUILD)/libmech.a $(LDLIBS)
 
 $(BUILD)/bench-solve: bench/bench_solve.c bench/bench_util.h $(BUILD)/libmech.a $(HEADERS)
-	$(CC) $(CFLAGS) -Isrc -o $@ $< $(BUILD)/libmech.a $(LDLIBS)
+	$(CC) $(CFLAGS) -o $@ $< $(BUILD)/libmech.a $(LDLIBS)
 
 $(BUILD)/bench-sweep: bench/bench_sweep.c $(BUILD)/libmech.a $(HEADERS)
-	$(CC) $(CFLAGS) -Isrc -o $@ $< $(BUILD)/libmech.a $(LDLIBS)
+	$(CC) $(CFLAGS) -o $@ $< $(BUILD)/libmech.a $(LDLIBS)
 
 $(BUILD)/bench-alloc: bench/bench_alloc.c $(BUILD)/libmech.a $(HEADERS)
 	$(CC) $(CFLAGS) -o $@ $< $(BUILD)/libmech.a $(LDLIBS)
@@ -233,7 +328,7 @@ $(BUILD)/bench-accuracy: bench/bench_accuracy.c bench/bench_util.h tests/unit/cl
 
 # dense LU for comparison: LAPACK (liblapack-dev, a dependency of libsuitesparse-dev)
 $(BUILD)/bench-scale: bench/bench_scale.c bench/bench_util.h $(BUILD)/libmech.a $(HEADERS)
-	$(CC) $(CFLAGS) -Isrc -o $@ $< $(BUILD)/libmech.a $(LDLIBS) -llapack -lblas
+	$(CC) $(CFLAGS) -o $@ $< $(BUILD)/libmech.a $(LDLIBS) -llapack -lblas
 
 # Regenerate tests/golden/NAME.csv from mechanisms/NAME.yaml. Review the diff
 # (git diff --stat tests/golden; mech compare) before committing new goldens.

@@ -5,7 +5,7 @@
 #include <stdlib.h>
 #include <time.h>
 
-#include "system.h"
+#include "equations.h"
 
 static double now(void)
 {

@@ -183,7 +183,7 @@ static long hand_sweep(const hand_mech *h, const double *qs, int nq, double qd, 
             lu_solve(n, J, piv, F);
             for (int i = 0; i < n; i++)
                 dmax = fmax(dmax, fabs(F[i]));
-            /* converged as in src/solve.c: x is kept (not x - dx), so that the
+            /* converged as in src/solve/solve.c: x is kept (not x - dx), so that the
                factors used for the rates belong to the position returned */
             if (fn <= tol * h->lref && (dmax <= tol || dmax >= 0.9 * prev))
                 break; /* (or no longer shrinking: the rounding floor) */

@@ -40,7 +40,7 @@
 #include "bench_util.h"
 #include "mech.h"
 #include "solve.h"
-#include "system.h"
+#include "equations.h"
 
 /* LAPACK (Fortran calling convention) */
 void dgetrf_(const int *m, const int *n, double *a, const int *lda, int *ipiv, int *info);
@@ -330,7 +330,7 @@ static void measure(int N, result *r)
     sys_eval_position(s, x, m->driver.values[0], f, J);
     klu_common c;
     klu_defaults(&c);
-    c.scale = 0, c.tol = 0.1; /* as src/solve.c */
+    c.scale = 0, c.tol = 0.1; /* as src/solve/solve.c */
     klu_symbolic *sym = klu_analyze(n, s->Jp, s->Ji, &c);
     double tf = bench_now();
     klu_numeric *num = sym ? klu_factor(s->Jp, s->Ji, J, sym, &c) : NULL;
@@ -398,6 +398,13 @@ static result run_child(int N)
     pid_t pid = fork();
     if (pid == 0) {
         close(fd[0]);
+        /* the alarm must end the child even if SIGALRM came ignored or
+         * blocked from the parent (both survive fork and exec) */
+        sigset_t alrm;
+        sigemptyset(&alrm);
+        sigaddset(&alrm, SIGALRM);
+        signal(SIGALRM, SIG_DFL);
+        sigprocmask(SIG_UNBLOCK, &alrm, NULL);
         alarm(TIMEOUT);
         measure(N, &r);
         if (write(fd[1], &r, sizeof r) != (ssize_t)sizeof r)

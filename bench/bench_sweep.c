@@ -16,7 +16,7 @@
 #include <time.h>
 
 #include "mech.h"
-#include "sweep_variants.h"
+#include "study.h"
 
 enum { NVAR = 200, ROUNDS = 3, WAYS = 4 };
 
@@ -70,6 +70,7 @@ int main(int argc, char **argv)
             return 1;
         }
     }
+    sweep_shared *sh = sweep_shared_new(file, 0);  /* the sweep's parsed file and one analysis */
     double t[WAYS] = {1e300, 1e300, 1e300, 1e300};
     int failed = 0;
     for (int round = 0; round < WAYS * ROUNDS; round++) {  /* interleaved; best of ROUNDS */
@@ -84,7 +85,7 @@ int main(int argc, char **argv)
             mech_table tab = {0};
             int rc = way == 0 ? mech_analysis_solve(a[i], NULL, 0, &tab, NULL, &d)
                      : way == 1 ? old_way(file, &ov, &tab, &d)
-                                : sweep_variant_solve(file, &ov, 1, 0, &tab, NULL, &d);
+                                : sweep_variant_solve(sh, &ov, 1, &tab, NULL, &d);
             failed += rc != MECH_OK;
             mech_table_free(&tab);
         }
@@ -101,7 +102,8 @@ int main(int argc, char **argv)
         printf("%-34s %10.1f %14.1f %11.1f%%\n", what[way], t[way] * 1e6, 1 / t[way],
                100 * (t[way] - t[0]) / t[0]);
     long shared, alone;
-    sweep_variant_counts(&shared, &alone);
+    sweep_variant_counts(sh, &shared, &alone);
+    sweep_shared_free(&sh);
     printf("(sweep_variant_solve: %ld variant runs through the one analysis, %ld analysed alone)\n",
            shared, alone);
     if (failed)

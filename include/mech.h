@@ -9,14 +9,20 @@
  *                 one per thread, inside mech_analysis_solve).
  *
  * Ownership: every mech_*_new / mech_load_* result is released by the matching
- * mech_*_free, which accepts NULL. */
+ * mech_*_free, which accepts NULL.
+ *
+ * Pointers: which arguments may be NULL, function by function, is the list
+ * "NULL arguments" at the end of this header; a required one given as NULL
+ * is MECH_EINPUT (with the message in the mech_diag, when there is one),
+ * never a crash. Versions, sizes and the ABI: "Versions" at the end. */
 #ifndef MECH_H
 #define MECH_H
 
 #include <stddef.h>
 #include <stdio.h>
 
-#define MECH_VERSION "0.1.0"
+/* The version of this header; the library's is mech_version(). */
+#define MECH_VERSION "0.2.0"
 
 /* Status codes returned by library calls: 0 success, < 0 failure. */
 enum {
@@ -32,6 +38,40 @@ enum {
 
 typedef enum { MECH_SEV_ERROR, MECH_SEV_WARNING, MECH_SEV_NOTE } mech_severity;
 
+/* What kind of problem a diagnostic reports, and what made a solve fail
+ * (mech_diag_entry.kind, mech_solve_stats.failure): the failure as data, so
+ * that no program has to read the messages' words (docs/api.md, "Failure
+ * kinds"). New kinds are appended; the values never change. */
+typedef enum {
+    MECH_FAIL_NONE = 0,      /* no failure: notes, and warnings that report none */
+    MECH_FAIL_INPUT,         /* the file or the mechanism is invalid: syntax, names, units,
+                                topology, mobility, a structurally singular system */
+    MECH_FAIL_IO,            /* a file cannot be read or written */
+    MECH_FAIL_NOMEM,         /* out of memory */
+    MECH_FAIL_NO_ASSEMBLY,   /* cannot assemble: the loops do not close (links that cannot
+                                reach each other, a position past an assembly limit) */
+    MECH_FAIL_DEAD_POINT,    /* a singular position the driver cannot pass: dead point,
+                                toggle, limit position */
+    MECH_FAIL_CHANGE_POINT,  /* a singular position where two assembly branches cross */
+    MECH_FAIL_BRANCH,        /* not on the declared assembly branch (at the first position,
+                                or leaving it) */
+    MECH_FAIL_JUMP,          /* the solution jumps even with a tiny step */
+    MECH_FAIL_REDUNDANT,     /* redundant constraints: equations implied by the others (a
+                                warning), reactions that are then not unique (an error) */
+    MECH_FAIL_NOT_CONVERGED, /* an iteration does not converge: joint friction's fixed point
+                                (the mechanism may be self-locking there) */
+    MECH_FAIL_NON_FINITE,    /* a result is not a finite number (the data overflow) */
+    /* a suspect assembly (warnings; errors under `--strict`, docs/solver.md section 9):
+       the sweep solved, but not the mechanism the file seems to mean */
+    MECH_FAIL_FAR_FROM_GUESS, /* the first position far from an `initial:` guess (or a
+                                stated pose) */
+    MECH_FAIL_ON_GROUND_POINT, /* a moving point on a ground point over the whole sweep */
+    MECH_FAIL_STILL_SLIDER,  /* a slider whose travel is zero over the whole sweep */
+    MECH_FAIL_FOLDED_LOOP,   /* two pinned links of a loop folded onto each other over
+                                the whole sweep */
+    MECH_FAIL_STILL_OUTPUTS  /* the driver's motion moves none of the outputs */
+} mech_fail_kind;
+
 /* A place in an input file; line and col are 1-based, 0 means "unknown". */
 typedef struct mech_mark {
     int line;
@@ -43,6 +83,7 @@ typedef struct mech_diag_entry {
     char *file;          /* file name as given, owned */
     mech_mark mark;
     char *message;       /* one sentence, no trailing newline, owned */
+    mech_fail_kind kind; /* what it reports (MECH_FAIL_NONE for most notes and warnings) */
 } mech_diag_entry;
 
 typedef struct mech_diag {
@@ -58,6 +99,18 @@ void mech_diag_init(mech_diag *d);
 void mech_diag_free(mech_diag *d);
 /* Print "file:line:col: error: message" lines, one per entry. */
 void mech_diag_print(const mech_diag *d, FILE *out);
+/* The failure d's errors report: MECH_FAIL_NONE when it holds no error, else
+ * the gravest of their kinds (NOMEM first, whatever followed it; then those
+ * that stop a sweep: NOT_CONVERGED, NON_FINITE; then the singular ones:
+ * DEAD_POINT, CHANGE_POINT, REDUNDANT; else the first error's), the same
+ * rule as mech_solve_stats.failure. */
+mech_fail_kind mech_diag_failure(const mech_diag *d);
+/* A fixed word for each kind: "none", "input", "io", "no-memory",
+ * "no-assembly", "dead-point", "change-point", "branch", "jump", "redundant",
+ * "not-converged", "non-finite", "far-from-guess", "on-ground-point",
+ * "still-slider", "folded-loop", "still-outputs"; "unknown" for a value out
+ * of range. */
+const char *mech_fail_name(mech_fail_kind k);
 
 /* ------------------------------------------------------------------ */
 /* The model: everything in SI units (m, rad, kg, s, N).               */
@@ -67,7 +120,8 @@ typedef struct mech_point {
     int id;         /* index into mech_model.point_names (shared names = same pin) */
     double x, y;    /* in the link's own frame, m */
     mech_mark mark;
-    double dxy[2];  /* d(x, y)/dp for the parameter p a sensitivity load seeds, else 0 */
+    double dxy[2];  /* unused, 0 (kept for the layout): d(x, y)/d(parameter) comes from the
+                       model's parameter expressions (mech_model.pexpr) */
 } mech_point;
 
 typedef struct mech_link {
@@ -121,13 +175,13 @@ typedef struct mech_driver {
 /* One driver (docs/format.md section 7.3): a link angle (MECH_DRIVE_ANGLE,
  * link index) or a slider displacement (MECH_DRIVE_SLIDER, joint index)
  * held to a law of the sweep variable q, compiled symbolically
- * (src/drivers.h). `driver:` is the driver whose law is q itself; each
+ * (src/load/load.h). `driver:` is the driver whose law is q itself; each
  * entry of `drivers:` is a law of the time. */
 typedef struct mech_motion {
     mech_drive_kind kind; /* MECH_DRIVE_ANGLE: link index; MECH_DRIVE_SLIDER: joint index */
     int index;
     char *text;           /* owned: the law as written; NULL for `driver:` (the law q) */
-    struct mech_law *law; /* its expression tree (src/drivers.h): owned, but for the law q
+    struct mech_law *law; /* its expression tree (src/load/load.h): owned, but for the law q
                              of `driver:`, one tree shared by all models */
     mech_mark mark;
 } mech_motion;
@@ -277,7 +331,7 @@ typedef struct mech_model {
                              keep their places) */
     int nsprings;
     struct state_loads *state_loads; /* owned: the loads that depend on the motion
-                                        (src/state_loads.h), NULL when there are none */
+                                        (src/load/load.h), NULL when there are none */
     mech_gear *gears;     /* [ngears] gear pairs and racks (docs/format.md) */
     int ngears;
     mech_motion *motions; /* [nmotions] a view of `drivers` for the callers of 0.1: the
@@ -287,6 +341,13 @@ typedef struct mech_model {
     mech_motion *drivers; /* [ndrivers] every driver, whichever form the file used:
                              `driver:` is one (the law q), `drivers:` one per law */
     int ndrivers;
+    struct param_exprs *pexpr; /* owned: what the parameters move, as expressions over
+                                  them (src/load/load.h); NULL without parameters */
+    int has_start;        /* the drawn form (docs/format.md 5.4): the guesses hold at the */
+    double start_q;       /* driver value start_q (the drawing's), and row 0 is reached
+                             from there by continuation */
+    struct file_units *units; /* owned: the file's `units:` as written, for results in
+                                 them (src/base/base.h); NULL when it gives none */
 } mech_model;
 
 /* Read and validate a mechanism file. On success *out is the model and the
@@ -344,9 +405,9 @@ typedef struct mech_system mech_system;
 int mech_system_new(const mech_model *m, mech_system **out, mech_diag *d);
 /* The same equations for printing (mech equations): lengths and angles
  * that depend on the file's parameters appear as the parameters (`r`) or
- * as named lengths |AB| and angles <AB; the file is read again once per
- * parameter to see what depends on what (numbers are printed when it
- * cannot be, or with more than 200 parameters). Not for solving. */
+ * as named lengths |AB| and angles <AB; what depends on what comes from the
+ * model's parameter expressions (no file read: a model from memory too;
+ * numbers are printed with more than 200 parameters). Not for solving. */
 int mech_system_new_named(const mech_model *m, mech_system **out, mech_diag *d);
 void mech_system_free(mech_system **s);
 int mech_system_size(const mech_system *s);   /* number of unknowns */
@@ -358,7 +419,7 @@ void mech_system_print(const mech_system *s, mech_format fmt, FILE *out);
 
 /* ------------------------------------------------------------------ */
 /* Solving: positions, velocities, accelerations over the driver sweep */
-/* (src/solve.c; the numerical method is in docs/solver.md).           */
+/* (src/solve/solve.c; the numerical method is in docs/solver.md).           */
 
 /* What to compute (bits). Accelerations need velocities, velocities need
  * positions; asking for more implies the lower levels. */
@@ -370,6 +431,8 @@ enum {
 };
 
 typedef struct mech_solve_options {
+    size_t size;       /* sizeof the struct the caller was compiled with, set by
+                          mech_solve_options_init: the library reads no field past it */
     double tol;        /* Newton tolerance relative to the largest length (default 1e-12) */
     int max_iter;      /* Newton iterations per step before giving up (default 50) */
     double min_rcond;  /* a converged position with a smaller reciprocal condition
@@ -410,7 +473,17 @@ enum {
     MECH_FRICTION_BOTH     /* both, the frictionless columns suffixed ".nofriction" */
 };
 
-void mech_solve_options_default(mech_solve_options *o);
+/* The defaults in *o, a struct of `size` bytes (sizeof *o, as the caller was
+ * compiled): MECH_OK, or MECH_EINPUT when the library does not know that
+ * size (a header newer than the library; then o->size is 0 and every call
+ * given o refuses it). Call it before setting any field. */
+int mech_solve_options_init(mech_solve_options *o, size_t size);
+/* mech_solve_options_init(o, sizeof *o): inline, so that the size is the
+ * caller's. */
+static inline void mech_solve_options_default(mech_solve_options *o)
+{
+    (void)mech_solve_options_init(o, sizeof *o);
+}
 
 /* A table of results: named columns with units, one row per driver step. */
 typedef struct mech_column {
@@ -477,6 +550,11 @@ typedef struct mech_solve_stats {
     int max_friction_iterations; /* forces: worst step of the friction fixed point */
     double setup_seconds;    /* wall time to build the system, choose blocks, analyse */
     double seconds;          /* wall time of the sweep itself (all rows) */
+    mech_fail_kind failure;  /* why requested rows are missing or the solve failed: the
+                                gravest kind found (mech_diag_failure's rule);
+                                MECH_FAIL_NONE when every row was solved */
+    double failure_q;        /* driver position where that failure was found (rad, m or s);
+                                NaN when none, or not at a position (the analysis) */
 } mech_solve_stats;
 
 /* Solve the driver sweep of a checked model. On success *out holds one row
@@ -497,16 +575,50 @@ typedef struct mech_solve_stats {
 int mech_solve(const mech_model *m, const mech_solve_options *o, mech_table *out,
                mech_solve_stats *stats, mech_diag *d);
 
-/* Sensitivities (src/sensitivity.c, docs/sensitivity.md): to `table`, the
+/* ---- Poses: where the file puts the mechanism (src/solve/pose.c) ----------
+ * A pose places every link: its frame's origin (m) and angle (rad) in the
+ * ground's frame at the driver position q. `mech draw` draws the pose the
+ * file states beside the assembled one (docs/plots.md, "mech draw"). */
+typedef enum {
+    MECH_POSE_NONE = 0,  /* the file states no pose (the frames are the solver's
+                            default first iterate: every unknown 0) */
+    MECH_POSE_GUESSED,   /* from the `initial:` guesses */
+    MECH_POSE_DRAWN      /* from the file's drawing */
+} mech_pose_kind;
+
+typedef struct mech_pose {
+    mech_pose_kind kind;
+    double q;            /* the driver position, SI (rad, m or s) */
+    double *frame;       /* [3 nlinks] origin x, y and angle of each link; the ground's
+                            0, 0, 0; NaN for a link not connected to the ground */
+    int nlinks;
+} mech_pose;
+
+/* The pose the file states at driver position q, for a checked model: the
+ * solver's first Newton iterate at a sweep's first row (each unknown at
+ * its `initial:` guess, else 0; the drivers at q), the links placed along
+ * the spanning tree from the ground, so a loop the guesses do not close is
+ * drawn open. kind says whether the file stated it (MECH_POSE_GUESSED) or
+ * not. MECH_OK, or an error in d. Free with mech_pose_free. */
+int mech_pose_guess(const mech_model *m, double q, mech_pose *out, mech_diag *d);
+/* Where the pose puts point k of link `link`, m (NaN, NaN when the pose
+ * is empty or not of m, or m has no such point). */
+void mech_pose_point(const mech_model *m, const mech_pose *p, int link, int k, double xy[2]);
+void mech_pose_free(mech_pose *p);
+
+/* Sensitivities (src/study/sensitivity.c, docs/sensitivity.md): to `table`, the
  * result of mech_solve(m, o, ...), add for each parameter names[k] and each
  * kinematic column COL (points' x, y, vx, vy, ax, ay; links' angle, omega,
  * alpha; sliders' s, v, a) a column "d(COL)/d(NAME)" in COL's unit over
  * NAME's SI unit (per 1 of a bare number), from the implicit-function
  * theorem: J dx/dp = -df/dp at each row, and the derivatives of the
  * velocity and acceleration equations for the rates; exact to rounding.
- * m must come from a file (read again once per parameter, with the same
- * overrides ov[0..nov-1]); force columns get none. MECH_OK, or an error in
- * d (an unknown parameter, redundant constraints, a singular row). */
+ * The derivatives of the points by the parameters come from the model's
+ * parameter expressions (a model from a file or from memory alike; ov and
+ * nov, the replacements it was loaded with, are no longer needed: the model
+ * holds them); force columns get none. MECH_OK, or an error in d (an unknown
+ * parameter, a parameter that sets a slider's angle or a gear pair's
+ * numbers, redundant constraints, a singular row). */
 int mech_sensitivity(const mech_model *m, const mech_override *ov, int nov,
                      const mech_solve_options *o, const char *const *names, int nnames,
                      mech_table *table, mech_diag *d);
@@ -546,7 +658,7 @@ int mech_analysis_new(const mech_model *m, const mech_solve_options *o, mech_ana
 void mech_analysis_free(mech_analysis **a);
 /* Columns of the tables the analysis produces; mech_analysis_header gives
  * their names and units in a table with no rows (free it with
- * mech_table_free). MECH_OK or MECH_ENOMEM. */
+ * mech_table_free). MECH_OK, MECH_ENOMEM, or MECH_EINPUT for a NULL a or out. */
 int mech_analysis_columns(const mech_analysis *a);
 int mech_analysis_header(const mech_analysis *a, mech_table *out);
 /* Solve the driver positions q[0..nq-1] (in order: each row continues from
@@ -575,6 +687,139 @@ void mech_outputs_free(mech_outputs *o);
  * Returns MECH_OK or MECH_EIO (with a message in d). */
 int mech_table_write_csv(const mech_table *t, const char *path, mech_diag *d);
 
+/* ---- Sweeps: many variants of one mechanism file ----------------------
+ * `mech sweep` as a call (src/study/sweep_run.c, docs/batch.md, docs/api.md):
+ *
+ *   mech_sweep_new       an empty sweep;
+ *   mech_sweep_vary, mech_sweep_list, mech_sweep_metric
+ *                        the grid's parameters and the summaries of each
+ *                        variant's table, in the command line's words
+ *                        ("l=130mm:150mm:5", "r=30mm,40mm", "range:x_B.s");
+ *   mech_sweep_prepare   the file, the options (random samples instead of
+ *                        a grid, forces, the shard, threads), checked once:
+ *                        the first variant loads, each metric names columns
+ *                        its table has;
+ *   mech_sweep_run       every variant of the shard on worker threads, each
+ *                        reduced to one row handed to the caller, nothing
+ *                        of it kept afterwards (constant memory per variant);
+ *   mech_sweep_free.
+ *
+ * Messages about the sweep's own arguments (not its file) have the file
+ * MECH_SWEEP_ARGUMENTS; a variant that cannot be solved is a row with its
+ * status, not an error. */
+#define MECH_SWEEP_ARGUMENTS "mech sweep"
+
+typedef struct mech_sweep mech_sweep;
+
+typedef struct mech_sweep_options {
+    size_t size;               /* sizeof the struct the caller was compiled with, set by
+                                  mech_sweep_options_init (as mech_solve_options) */
+    int forces;                /* 1: the force analysis in every variant (driver.torque) */
+    long nrandom;              /* > 0: N variants with every parameter that has a
+                                  tolerance uniform within it (Monte Carlo), no grid */
+    unsigned long long seed;   /* of the samples (default 1): a variant's sample depends
+                                  on the seed and its index only */
+    long index_offset;         /* variant i of the grid is numbered index_offset + i */
+    int shard_k, shard_m;      /* only the variants i % shard_m == shard_k (default 0, 1) */
+    int nthreads;              /* worker threads; 0 (default): the CPUs this process
+                                  may run on (its affinity mask) */
+} mech_sweep_options;
+
+/* The defaults in *o, a struct of `size` bytes, as mech_solve_options_init:
+ * MECH_OK, or MECH_EINPUT when the library does not know that size (then
+ * o->size is 0 and mech_sweep_prepare refuses it). */
+int mech_sweep_options_init(mech_sweep_options *o, size_t size);
+/* mech_sweep_options_init(o, sizeof *o), the size the caller's. */
+static inline void mech_sweep_options_default(mech_sweep_options *o)
+{
+    (void)mech_sweep_options_init(o, sizeof *o);
+}
+
+/* What became of a variant (its table's rows are reduced to the metrics). */
+typedef enum {
+    MECH_VARIANT_OK,           /* "ok": every driver position solved */
+    MECH_VARIANT_NO_ASSEMBLY,  /* "no-assembly": some position not reached */
+    MECH_VARIANT_SINGULAR,     /* "singular": a singular position on the way */
+    MECH_VARIANT_SELF_LOCKING, /* "self-locking": joint friction locks it */
+    MECH_VARIANT_INVALID,      /* "invalid": the variant's model does not load or check */
+    MECH_VARIANT_ERROR,        /* "error": its file could not be read */
+    MECH_VARIANT_NON_FINITE    /* "non-finite": a column overflowed double precision */
+} mech_variant_status;
+
+/* "ok", "no-assembly", ... (the status column of mech sweep's CSV). */
+const char *mech_variant_status_name(mech_variant_status s);
+
+/* One variant, as mech_sweep_run hands it over (valid during the call). */
+typedef struct mech_variant {
+    long index;                 /* its number (index_offset included) */
+    long row;                   /* this shard's row, 0 .. mech_sweep_count - 1 */
+    mech_variant_status status;
+    int rows;                   /* driver positions solved */
+    const double *params;       /* [mech_sweep_nparams] its parameters, SI */
+    const double *metrics;      /* [mech_sweep_nmetrics]; NaN when not solved */
+    const char *messages;       /* "variant I: r=45 mm\n" and what its load and
+                                   solve said, one line each */
+    mech_fail_kind suspect;     /* solved, but its assembly is suspect: the first such
+                                   warning's kind (docs/solver.md section 9), else
+                                   MECH_FAIL_NONE (last: the fields before keep
+                                   their places) */
+} mech_variant;
+
+/* Where the rows go. row is called once per variant, one call at a time
+ * (under the sweep's lock), in the order the workers finish; done, when
+ * not NULL, is asked first from any worker: 1 leaves row `row` out (it is
+ * there already: mech sweep --resume). */
+typedef struct mech_sweep_sink {
+    void (*row)(void *ctx, const mech_variant *v);
+    int (*done)(void *ctx, long row);
+    void *ctx;
+} mech_sweep_sink;
+
+typedef struct mech_sweep_stats {
+    long solved;       /* variants with status ok */
+    long shared;       /* variants solved through the sweep's one analysis ... */
+    long alone;        /* ... and those analysed on their own (docs/batch.md) */
+} mech_sweep_stats;
+
+/* An empty sweep into *out: MECH_OK or MECH_ENOMEM. */
+int mech_sweep_new(mech_sweep **out);
+/* A parameter of the grid: "NAME=FROM:TO:COUNT" (COUNT values from FROM to
+ * TO, a unit after the numbers, the same on both: "l=130mm:150mm:5") or,
+ * for mech_sweep_list, "NAME=A,B,..." (each value a quantity: "r=30mm,
+ * 45 mm"). Every value of one parameter has the same dimension; at most 8
+ * parameters, a grid of at most 10^7 variants. MECH_OK or MECH_EINPUT. */
+int mech_sweep_vary(mech_sweep *s, const char *spec, mech_diag *d);
+int mech_sweep_list(mech_sweep *s, const char *spec, mech_diag *d);
+/* A summary of each variant's table (at most 32): "range:COL" (max - min),
+ * "max:COL", "min:COL", "maxabs:COL", "transmission:LINK1,LINK2" (the
+ * smallest angle between the links, 0..pi/2 rad), "flywheel:CS" (the
+ * flywheel inertia for the coefficient of speed fluctuation CS; forces).
+ * MECH_OK or MECH_EINPUT. */
+int mech_sweep_metric(mech_sweep *s, const char *spec, mech_diag *d);
+/* The file and options, checked: a grid or random samples (not both),
+ * the file loads with the first variant's parameters, the metrics' columns
+ * exist (a note when forces are asked of a file with no mass and no load).
+ * o may be NULL (the defaults). MECH_OK, or the first problem's status. */
+int mech_sweep_prepare(mech_sweep *s, const char *path, const mech_sweep_options *o,
+                       mech_diag *d);
+
+/* A prepared sweep's shape: its variants in all and in this shard; its
+ * parameters (the grid's, or those with a tolerance) and metrics, with
+ * their SI units ("m", "-" for a bare number). */
+long mech_sweep_total(const mech_sweep *s);
+long mech_sweep_count(const mech_sweep *s);
+int mech_sweep_nparams(const mech_sweep *s);
+const char *mech_sweep_param(const mech_sweep *s, int k, const char **unit);
+int mech_sweep_nmetrics(const mech_sweep *s);
+const char *mech_sweep_metric_label(const mech_sweep *s, int k, const char **unit);
+
+/* Solve every variant of the shard on worker threads, each row to sink.
+ * MECH_OK (whatever became of the variants: see their status), or
+ * MECH_EINPUT when not prepared. stats may be NULL. */
+int mech_sweep_run(mech_sweep *s, const mech_sweep_sink *sink, mech_sweep_stats *stats,
+                   mech_diag *d);
+void mech_sweep_free(mech_sweep **s);
+
 /* Exit codes of the `mech` program. */
 enum {
     MECH_EXIT_OK = 0,
@@ -582,5 +827,74 @@ enum {
     MECH_EXIT_INPUT = 2,  /* bad usage or bad input */
     MECH_EXIT_IO = 3      /* cannot read or write a file */
 };
+
+/* ------------------------------------------------------------------ */
+/* NULL arguments. Outputs a caller may not want, and inputs that have   */
+/* a default, may be NULL (in brackets: what NULL means); every other    */
+/* pointer is required: NULL there is MECH_EINPUT with "FUNCTION: error: */
+/* ARG is NULL ..." in d (a function returning an index gives -1, a      */
+/* count 0; a void one does nothing).                                     */
+/*                                                                        */
+/*   mech_diag_init(d), mech_diag_free(d)     d                           */
+/*   mech_diag_print(d, out)                  d (nothing), out (stderr)   */
+/*   mech_load_file(path, out, d)             out (the file is checked,   */
+/*   mech_load_file_with(path, ov, nov,           the model freed), d;    */
+/*                       out, d)                  ov when nov is 0        */
+/*   mech_load_string(text, len, name,        name ("<string>"), out, d   */
+/*                    out, d)                                             */
+/*   mech_model_free(m)                       m, *m                       */
+/*   mech_find_link, _joint, _point(m, name)  m, name (-1)                */
+/*   mech_check(m, s, d)                      s, d                        */
+/*   mech_system_new(m, out, d), _named       d                           */
+/*   mech_system_free(s)                      s, *s                       */
+/*   mech_system_size(s)                      s (0)                       */
+/*   mech_system_print(s, fmt, out)           s (nothing), out (stdout)   */
+/*   mech_solve_options_init(o, size)         none                        */
+/*   mech_solve(m, o, out, stats, d)          o (the defaults), out (the  */
+/*                                            rows are not kept), stats, d */
+/*   mech_pose_guess(m, q, out, d)            d                           */
+/*   mech_pose_point(m, p, link, k, xy)       m, p, xy (nothing); NaN for */
+/*                                            a link or point not in m    */
+/*   mech_pose_free(p)                        p                           */
+/*   mech_sensitivity(m, ov, nov, o, names,   ov when nov is 0, o, names  */
+/*                    nnames, table, d)       when nnames is 0, d         */
+/*   mech_tolerances(m, ov, nov, o, table, d) ov when nov is 0, o, d      */
+/*   mech_analysis_new(m, o, out, d)          o, d                        */
+/*   mech_analysis_free(a)                    a, *a                       */
+/*   mech_analysis_columns(a)                 a (0)                       */
+/*   mech_analysis_header(a, out)             none                        */
+/*   mech_analysis_solve(a, q, nq, out,       q (the analysis's own       */
+/*                       stats, d)            positions), out, stats, d   */
+/*   mech_table_free(t)                       t                           */
+/*   mech_table_column(t, name)               t, name (-1)                */
+/*   mech_table_get(t, row, col)              none (inline, unchecked)    */
+/*   mech_table_write_csv(t, path, d)         d                           */
+/*   mech_parse_value(text, is_angle, si,     si (the text is checked),   */
+/*                    err, errsize)           err (no message)            */
+/*   mech_outputs_parse(m, list, out, err,    out (the list is checked),  */
+/*                      errsize)              err                         */
+/*   mech_outputs_free(o)                     o                           */
+/*   mech_version()                           -                           */
+
+/* ------------------------------------------------------------------ */
+/* Versions (docs/api.md, "Versions and the ABI").                      */
+
+/* The library's version, its MECH_VERSION as built: a program may compare
+ * it with the MECH_VERSION of the header it was compiled with. */
+const char *mech_version(void);
+
+/* The ABI. libmech.so's symbols carry the version node MECH_<major>.<minor>
+ * of the release that brought them (MECH_0.2: libmech.map); the soname is
+ * libmech.so.0.<minor> before 1.0 (each 0.x may change the ABI) and
+ * libmech.so.<major> from 1.0. Within one soname:
+ *   - functions are only added (in a new node), never changed or removed;
+ *   - mech_solve_options grows at its end only: the library reads the
+ *     caller's o->size bytes and takes the defaults for the rest;
+ *   - mech_model is the library's: fields are only appended to it (read
+ *     through a pointer, an older program sees the part it knows); the
+ *     structs of its arrays (mech_link, mech_point, ...) and the caller's
+ *     structs the library writes (mech_diag, mech_summary, mech_table,
+ *     mech_column, mech_gap, mech_solve_stats, mech_outputs) do not change:
+ *     changing one of them takes a new soname. */
 
 #endif /* MECH_H */

@@ -20,6 +20,18 @@
 
 #define MAX_SET 64 /* as mech solve --set */
 
+/* What the extension was built for (python/setup.py and the Makefile say;
+ * docs/api.md, "Python"): the interpreter, its version, numpy's version. */
+#ifndef MECH_BUILT_PYTHON
+#define MECH_BUILT_PYTHON "an unknown interpreter"
+#endif
+#ifndef MECH_BUILT_PYTHON_VERSION
+#define MECH_BUILT_PYTHON_VERSION "?"
+#endif
+#ifndef MECH_BUILT_NUMPY
+#define MECH_BUILT_NUMPY "?"
+#endif
+
 static PyObject *MechError;
 
 /* ---- errors ---------------------------------------------------------- */
@@ -38,15 +50,17 @@ static PyObject *diag_line(const mech_diag_entry *e)
     return PyUnicode_FromFormat("%s: %s: %s", e->file, severity_name(e->severity), e->message);
 }
 
-/* [{'file', 'line', 'column', 'severity', 'message'}, ...] */
+/* [{'file', 'line', 'column', 'severity', 'message', 'kind'}, ...]; kind is
+ * mech_fail_name's word ('no-assembly', 'dead-point', ..., 'none'). */
 static PyObject *diag_list(const mech_diag *d)
 {
     PyObject *list = PyList_New(0);
     for (size_t i = 0; list && i < d->count; i++) {
         const mech_diag_entry *e = &d->entries[i];
-        PyObject *item = Py_BuildValue("{s:s,s:i,s:i,s:s,s:s}", "file", e->file, "line",
+        PyObject *item = Py_BuildValue("{s:s,s:i,s:i,s:s,s:s,s:s}", "file", e->file, "line",
                                        e->mark.line, "column", e->mark.col, "severity",
-                                       severity_name(e->severity), "message", e->message);
+                                       severity_name(e->severity), "message", e->message,
+                                       "kind", mech_fail_name(e->kind));
         if (!item || PyList_Append(list, item) < 0) {
             Py_XDECREF(item);
             Py_CLEAR(list);
@@ -88,12 +102,24 @@ out:
     return text;
 }
 
-/* Raise MechError(message) with .status, .diagnostics and, when partial is
- * not NULL, .partial (the pieces of the rows solved before a failure).
- * message NULL: the diagnostics' text. Returns NULL. */
+/* The failure a status and the diagnostics report: the errors' gravest
+ * kind (mech_diag_failure), else the kind the status stands for. */
+static mech_fail_kind failure_of(int status, const mech_diag *d)
+{
+    mech_fail_kind k = d ? mech_diag_failure(d) : MECH_FAIL_NONE;
+    if (k != MECH_FAIL_NONE || status == MECH_OK)
+        return k;
+    return status == MECH_ENOMEM ? MECH_FAIL_NOMEM : status == MECH_EIO ? MECH_FAIL_IO
+           : status == MECH_ESOLVE ? MECH_FAIL_NO_ASSEMBLY : MECH_FAIL_INPUT;
+}
+
+/* Raise MechError(message) with .status, .kind (mech_fail_name's word of
+ * failure_of), .diagnostics and, when partial is not NULL, .partial (the
+ * pieces of the rows solved before a failure). message NULL: the
+ * diagnostics' text. Returns NULL. */
 static PyObject *raise_mech(int status, const mech_diag *d, const char *message, PyObject *partial)
 {
-    PyObject *msg = NULL, *exc = NULL, *list = NULL, *st = NULL;
+    PyObject *msg = NULL, *exc = NULL, *list = NULL, *st = NULL, *kind = NULL;
     if (PyErr_Occurred())
         return NULL;
     msg = message ? PyUnicode_FromString(message) : diag_text(d);
@@ -108,10 +134,13 @@ static PyObject *raise_mech(int status, const mech_diag *d, const char *message,
     exc = PyObject_CallOneArg(MechError, msg);
     list = d ? diag_list(d) : PyList_New(0);
     st = PyLong_FromLong(status);
-    if (exc && list && st && PyObject_SetAttrString(exc, "status", st) == 0 &&
+    kind = PyUnicode_FromString(mech_fail_name(failure_of(status, d)));
+    if (exc && list && st && kind && PyObject_SetAttrString(exc, "status", st) == 0 &&
+        PyObject_SetAttrString(exc, "kind", kind) == 0 &&
         PyObject_SetAttrString(exc, "diagnostics", list) == 0 &&
         PyObject_SetAttrString(exc, "partial", partial ? partial : Py_None) == 0)
         PyErr_SetObject(MechError, exc);
+    Py_XDECREF(kind);
     Py_XDECREF(st);
     Py_XDECREF(list);
     Py_XDECREF(exc);
@@ -537,14 +566,16 @@ static int solve_options(const mech_model *m, const solve_request *r, mech_solve
 static PyObject *stats_dict(const mech_solve_stats *s)
 {
     return Py_BuildValue(
-        "{s:i,s:l,s:i,s:d,s:d,s:d,s:i,s:i,s:i,s:i,s:i,s:i,s:d,s:i,s:d,s:d}", "steps", s->steps,
+        "{s:i,s:l,s:i,s:d,s:d,s:d,s:i,s:i,s:i,s:i,s:i,s:i,s:d,s:i,s:d,s:d,s:s,s:d}",
+        "steps", s->steps,
         "iterations", s->iterations, "max_iterations", s->max_iterations, "worst_residual",
         s->worst_residual, "min_rcond", s->min_rcond, "worst_rcond_q", s->worst_rcond_q,
         "factorizations", s->factorizations, "refactorizations", s->refactorizations,
         "nunknowns", s->nunknowns, "nsolved", s->nsolved, "nblocks", s->nblocks,
         "nblocks_solved", s->nblocks_solved, "worst_power_residual", s->worst_power_residual,
         "max_friction_iterations", s->max_friction_iterations, "setup_seconds",
-        s->setup_seconds, "seconds", s->seconds);
+        s->setup_seconds, "seconds", s->seconds, "failure", mech_fail_name(s->failure),
+        "failure_q", s->failure_q);
 }
 
 /* (names, units, arrays, stats, messages): one contiguous float64 array of
@@ -569,6 +600,8 @@ static PyObject *table_tuple(const mech_table *t, const mech_solve_stats *s, con
         double *col = (double *)PyArray_DATA((PyArrayObject *)a);
         for (int r = 0; r < t->nrows; r++)
             col[r] = mech_table_get(t, r, c);
+        /* read-only, as documented: a Result is what the library computed */
+        PyArray_CLEARFLAGS((PyArrayObject *)a, NPY_ARRAY_WRITEABLE);
         PyList_SET_ITEM(names, c, n);
         PyList_SET_ITEM(units, c, u);
         PyList_SET_ITEM(arrays, c, a);
@@ -626,7 +659,192 @@ static PyObject *py_solve(PyObject *self, PyObject *args, PyObject *kw)
     return result;
 }
 
+/* ---- sweeps (mech_sweep) ------------------------------------------------ */
+
+/* The rows of a sweep as mech_sweep_run hands them over, written straight
+ * into arrays made before it runs, one slot per variant: no Python object
+ * is touched while the GIL is released, and a variant leaves nothing but its
+ * row (and, when it was not solved, its messages). */
+typedef struct sweep_rows {
+    int np, nm;
+    long long *index;
+    double *param[64], *metric[64];
+    signed char *status;
+    long long *rows;
+    char **messages;  /* [count] the messages of a variant not solved, else NULL */
+} sweep_rows;
+
+static void sweep_row(void *ctx, const mech_variant *v)
+{
+    sweep_rows *r = ctx;
+    long i = v->row;
+    r->index[i] = v->index;
+    for (int k = 0; k < r->np; k++)
+        r->param[k][i] = v->params[k];
+    r->status[i] = (signed char)v->status;
+    r->rows[i] = v->rows;
+    for (int k = 0; k < r->nm; k++)
+        r->metric[k][i] = v->metrics[k];
+    if (v->status != MECH_VARIANT_OK)
+        r->messages[i] = strdup(v->messages);  /* NULL when out of memory: left out */
+}
+
+/* A new 1-D array of n items of type and its data in *data, appended to
+ * the list; -1 when out of memory. */
+static int new_column(PyObject *list, npy_intp n, int type, void **data)
+{
+    PyObject *a = PyArray_ZEROS(1, &n, type, 0);
+    if (!a || PyList_Append(list, a) < 0) {
+        Py_XDECREF(a);
+        return -1;
+    }
+    Py_DECREF(a);
+    *data = PyArray_DATA((PyArrayObject *)a);
+    return 0;
+}
+
+/* The grid ([(is_list, spec), ...]) and the metrics ([spec, ...]) into s. */
+static int sweep_specs(mech_sweep *s, PyObject *grid, PyObject *metrics, mech_diag *d)
+{
+    PyObject *g = PySequence_Fast(grid, "grid: a list of (is_list, spec)");
+    PyObject *m = g ? PySequence_Fast(metrics, "metrics: a list of str") : NULL;
+    int rc = g && m ? MECH_OK : -100;
+    for (Py_ssize_t i = 0; rc == MECH_OK && i < PySequence_Fast_GET_SIZE(g); i++) {
+        int is_list;
+        const char *spec;
+        if (!PyArg_ParseTuple(PySequence_Fast_GET_ITEM(g, i), "ps", &is_list, &spec))
+            rc = -100;
+        else
+            rc = is_list ? mech_sweep_list(s, spec, d) : mech_sweep_vary(s, spec, d);
+    }
+    for (Py_ssize_t i = 0; rc == MECH_OK && i < PySequence_Fast_GET_SIZE(m); i++) {
+        const char *spec = PyUnicode_AsUTF8(PySequence_Fast_GET_ITEM(m, i));
+        rc = spec ? mech_sweep_metric(s, spec, d) : -100;
+    }
+    Py_XDECREF(g);
+    Py_XDECREF(m);
+    return rc;
+}
+
+/* (names, units, arrays, status, messages, stats, nparams) of a prepared
+ * sweep run: the columns variant, the parameters, rows, the metrics; the
+ * status codes apart (the status column comes after the parameters). */
+static PyObject *sweep_result(mech_sweep *s, mech_diag *d)
+{
+    npy_intp n = mech_sweep_count(s);
+    sweep_rows r = {mech_sweep_nparams(s), mech_sweep_nmetrics(s)};
+    PyObject *names = PyList_New(0), *units = PyList_New(0), *arrays = PyList_New(0);
+    PyObject *status = NULL, *messages = PyDict_New(), *result = NULL;
+    void *data;
+    r.messages = calloc((size_t)n + 1, sizeof *r.messages);
+    int bad = !names || !units || !arrays || !messages || !r.messages ||
+              r.np > 64 || r.nm > 64 || new_column(arrays, n, NPY_INT64, &data) < 0;
+    r.index = bad ? NULL : data;
+    for (int k = 0; !bad && k < r.np; k++)
+        bad = new_column(arrays, n, NPY_DOUBLE, (void **)&r.param[k]) < 0;
+    bad = bad || new_column(arrays, n, NPY_INT64, &data) < 0;
+    r.rows = bad ? NULL : data;
+    for (int k = 0; !bad && k < r.nm; k++)
+        bad = new_column(arrays, n, NPY_DOUBLE, (void **)&r.metric[k]) < 0;
+    if (!bad && (status = PyArray_ZEROS(1, &n, NPY_INT8, 0)))
+        r.status = PyArray_DATA((PyArrayObject *)status);
+    if (bad || !status)
+        goto out;
+    mech_sweep_sink sink = {sweep_row, NULL, &r};
+    mech_sweep_stats st = {0};
+    int rc;
+    Py_BEGIN_ALLOW_THREADS
+    rc = mech_sweep_run(s, &sink, &st, d);
+    Py_END_ALLOW_THREADS
+    if (rc != MECH_OK) {
+        raise_mech(rc, d, NULL, NULL);
+        goto out;
+    }
+    const char *unit;
+    for (int c = 0; c < 2 + r.np + r.nm; c++) {  /* the CSV's header, without status */
+        const char *name = c == 0 ? (unit = "-", "variant")
+                           : c <= r.np ? mech_sweep_param(s, c - 1, &unit)
+                           : c == r.np + 1 ? (unit = "-", "rows")
+                           : mech_sweep_metric_label(s, c - r.np - 2, &unit);
+        PyObject *pn = PyUnicode_FromString(name), *pu = PyUnicode_FromString(unit);
+        int fail = !pn || !pu || PyList_Append(names, pn) < 0 || PyList_Append(units, pu) < 0;
+        Py_XDECREF(pn);
+        Py_XDECREF(pu);
+        if (fail)
+            goto out;
+    }
+    for (npy_intp i = 0; i < n; i++) {
+        if (!r.messages[i])
+            continue;
+        PyObject *key = PyLong_FromLongLong(r.index[i]);
+        PyObject *text = PyUnicode_DecodeUTF8(r.messages[i], (Py_ssize_t)strlen(r.messages[i]),
+                                              "replace");
+        int fail = !key || !text || PyDict_SetItem(messages, key, text) < 0;
+        Py_XDECREF(key);
+        Py_XDECREF(text);
+        if (fail)
+            goto out;
+    }
+    result = Py_BuildValue("(OOOOO{s:l,s:l,s:l,s:l}i)", names, units, arrays, status, messages,
+                           "total", mech_sweep_total(s), "solved", st.solved, "shared",
+                           st.shared, "alone", st.alone, r.np);
+out:
+    for (npy_intp i = 0; r.messages && i < n; i++)
+        free(r.messages[i]);
+    free(r.messages);
+    Py_XDECREF(names);
+    Py_XDECREF(units);
+    Py_XDECREF(arrays);
+    Py_XDECREF(status);
+    Py_XDECREF(messages);
+    if (!result && !PyErr_Occurred())
+        PyErr_NoMemory();
+    return result;
+}
+
+/* _mech.sweep(path, grid, metrics, random=0, seed=1, forces=False, shard=(0, 1),
+ *             index_offset=0, jobs=0)
+ *   -> (names, units, arrays, status, messages, stats, nparams) */
+static PyObject *py_sweep(PyObject *self, PyObject *args, PyObject *kw)
+{
+    static char *kwlist[] = {"path", "grid", "metrics", "random", "seed", "forces", "shard",
+                             "index_offset", "jobs", NULL};
+    PyObject *path, *grid, *metrics, *bytes = NULL, *result = NULL;
+    mech_sweep_options o;
+    mech_sweep_options_default(&o);
+    (void)self;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "OOO|lKp(ii)li", kwlist, &path, &grid, &metrics,
+                                     &o.nrandom, &o.seed, &o.forces, &o.shard_k, &o.shard_m,
+                                     &o.index_offset, &o.nthreads) ||
+        !PyUnicode_FSConverter(path, &bytes))
+        return NULL;
+    mech_sweep *s = NULL;
+    mech_diag d;
+    mech_diag_init(&d);
+    int rc = mech_sweep_new(&s);
+    if (rc == MECH_OK)
+        rc = sweep_specs(s, grid, metrics, &d);
+    if (rc == MECH_OK) {
+        const char *file = PyBytes_AS_STRING(bytes);
+        Py_BEGIN_ALLOW_THREADS
+        rc = mech_sweep_prepare(s, file, &o, &d);
+        Py_END_ALLOW_THREADS
+    }
+    if (rc == MECH_OK)
+        result = sweep_result(s, &d);
+    else if (rc != -100)
+        raise_mech(rc, &d, NULL, NULL);
+    mech_diag_free(&d);
+    mech_sweep_free(&s);
+    Py_DECREF(bytes);
+    return result;
+}
+
 static PyMethodDef methods[] = {
+    {"sweep", (PyCFunction)(void (*)(void))py_sweep, METH_VARARGS | METH_KEYWORDS,
+     "sweep(path, grid, metrics, random=0, seed=1, forces=False, shard=(0, 1), "
+     "index_offset=0, jobs=0) -> (names, units, arrays, status, messages, stats, nparams): "
+     "mech_sweep, one row per variant"},
     {"load", (PyCFunction)(void (*)(void))py_load, METH_VARARGS | METH_KEYWORDS,
      "load(path, set=None, check=False) -> dict: the model (SI units); with check, "
      "also its structure (mech check)"},
@@ -640,11 +858,74 @@ static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "mech._mech",
                                     "libmech for Python (use the package mech)", -1, methods,
                                     NULL, NULL, NULL, NULL};
 
+/* FAIL_KINDS: the words of mech_fail_name, in the order of the enum. */
+static int add_fail_kinds(PyObject *mod)
+{
+    PyObject *names = PyList_New(0);
+    for (int k = 0; names && strcmp(mech_fail_name((mech_fail_kind)k), "unknown") != 0; k++) {
+        PyObject *n = PyUnicode_FromString(mech_fail_name((mech_fail_kind)k));
+        if (!n || PyList_Append(names, n) < 0)
+            Py_CLEAR(names);
+        Py_XDECREF(n);
+    }
+    PyObject *kinds = names ? PyList_AsTuple(names) : NULL;
+    Py_XDECREF(names);
+    int rc = kinds ? PyModule_AddObjectRef(mod, "FAIL_KINDS", kinds) : -1;
+    Py_XDECREF(kinds);
+    return rc;
+}
+
+/* numpy's C API did not load (another interpreter than the one built for,
+ * without numpy or with another numpy): an ImportError that says what the
+ * extension was built for, what runs it, and how to build it for that. */
+static void numpy_import_failed(void)
+{
+    PyObject *type, *value, *tb;
+    PyErr_Fetch(&type, &value, &tb);
+    PyObject *why = value ? PyObject_Str(value) : NULL;
+    PyObject *exe = PySys_GetObject("executable");  /* borrowed */
+    PyObject *np = PyImport_ImportModule("numpy");
+    PyObject *npv = np ? PyObject_GetAttrString(np, "__version__") : NULL;
+    PyErr_Clear();
+    char version[32];
+    snprintf(version, sizeof version, "%s", Py_GetVersion());
+    version[strcspn(version, " ")] = '\0';
+    PyObject *has = npv ? PyUnicode_FromFormat("numpy %S", npv) : PyUnicode_FromString("no numpy");
+    PyErr_Format(PyExc_ImportError,
+                 "mech's extension was built for %s (Python %s) with numpy %s; this is %S "
+                 "(Python %s) with %S, and numpy's C API did not load (%S). Build mech for "
+                 "this interpreter: make install PYTHON=%S, or %S -m pip install "
+                 "--no-build-isolation ./python (docs/api.md, Python)",
+                 MECH_BUILT_PYTHON, MECH_BUILT_PYTHON_VERSION, MECH_BUILT_NUMPY,
+                 exe ? exe : Py_None, version, has ? has : Py_None, why ? why : Py_None,
+                 exe ? exe : Py_None, exe ? exe : Py_None);
+    Py_XDECREF(has);
+    Py_XDECREF(npv);
+    Py_XDECREF(np);
+    Py_XDECREF(why);
+    Py_XDECREF(type);
+    Py_XDECREF(value);
+    Py_XDECREF(tb);
+}
+
+/* _mech.BUILT_FOR: {'python': path, 'python_version': ..., 'numpy': ...}. */
+static int add_built_for(PyObject *mod)
+{
+    PyObject *built = Py_BuildValue("{ssssss}", "python", MECH_BUILT_PYTHON, "python_version",
+                                    MECH_BUILT_PYTHON_VERSION, "numpy", MECH_BUILT_NUMPY);
+    int rc = built ? PyModule_AddObjectRef(mod, "BUILT_FOR", built) : -1;
+    Py_XDECREF(built);
+    return rc;
+}
+
 PyMODINIT_FUNC PyInit__mech(void);
 
 PyMODINIT_FUNC PyInit__mech(void)
 {
-    import_array();
+    if (_import_array() < 0) {  /* not import_array(): it prints, and says less */
+        numpy_import_failed();
+        return NULL;
+    }
     PyObject *mod = PyModule_Create(&module);
     if (!mod)
         return NULL;
@@ -652,15 +933,20 @@ PyMODINIT_FUNC PyInit__mech(void)
         "mech.MechError",
         "A mechanism file that does not load or check, or a solve that fails. str(e) holds "
         "the library's messages, one 'file:line:column: error: message' per line; e.status "
-        "is the libmech status (EINPUT, ENOMEM, EIO, ESOLVE), e.diagnostics the messages as "
-        "dicts, e.partial the rows solved before a failed solve (or None).",
+        "is the libmech status (EINPUT, ENOMEM, EIO, ESOLVE), e.kind what failed (one of "
+        "FAIL_KINDS: 'input', 'io', 'no-memory', 'no-assembly', 'dead-point', "
+        "'change-point', 'branch', 'jump', 'redundant', 'not-converged', 'non-finite', "
+        "'far-from-guess', 'on-ground-point', 'still-slider', 'folded-loop', 'still-outputs'), "
+        "e.diagnostics the messages as dicts (each with its 'kind'), e.partial the rows "
+        "solved before a failed solve (or None).",
         NULL, NULL);
     if (!MechError || PyModule_AddObjectRef(mod, "MechError", MechError) < 0 ||
         PyModule_AddStringConstant(mod, "VERSION", MECH_VERSION) < 0 ||
+        add_built_for(mod) < 0 ||
         PyModule_AddIntConstant(mod, "EINPUT", MECH_EINPUT) < 0 ||
         PyModule_AddIntConstant(mod, "ENOMEM", MECH_ENOMEM) < 0 ||
         PyModule_AddIntConstant(mod, "EIO", MECH_EIO) < 0 ||
-        PyModule_AddIntConstant(mod, "ESOLVE", MECH_ESOLVE) < 0) {
+        PyModule_AddIntConstant(mod, "ESOLVE", MECH_ESOLVE) < 0 || add_fail_kinds(mod) < 0) {
         Py_DECREF(mod);
         return NULL;
     }

@@ -2,7 +2,7 @@
 # tests/cli.sh: the `mech` command line: exit statuses and what it prints.
 # Run from the repository root:  MECH=build/mech sh tests/cli.sh
 # Prints one line per failure, then "cli: N passed, M failed"; exits 1 if
-# anything failed.
+# anything failed. MECH_QUICK=1: all but the plot of 10^6 steps.
 NAME=cli . tests/lib.sh
 
 # ---- usage ----------------------------------------------------------------
@@ -130,6 +130,15 @@ if run "mech check epicyclic" 0 "$MECH" check mechanisms/epicyclic.yaml; then
     has_line "$tmp/out" '^  mobility   1 = 3\*(4-1) - 2\*3 - 0 - 2 gears, drivers 1$' "mech check counts the gears"
 fi
 
+# every option of every command's --help (printed from its option table,
+# src/cli/cmd_opts.c) is documented in docs/ (the man page: tests/install.sh)
+for c in check equations solve compare batch sweep merge plot animate codegen report; do
+    "$MECH" "$c" --help | grep -o -- '--[a-z][a-z-]*' | sort -u | while read -r opt; do
+        grep -q -- "$opt" docs/*.md || echo "$c $opt"
+    done
+done >"$tmp/undocumented"
+if [ -s "$tmp/undocumented" ]; then fail "options not in docs/*.md: $(tr '\n' ' ' <"$tmp/undocumented")"; else pass; fi
+
 # ---- mech solve ---------------------------------------------------------
 
 # has_line FILE PATTERN LABEL: pass when FILE has a line matching PATTERN
@@ -215,6 +224,42 @@ fi
 
 run "mech solve bad option" 2 "$MECH" solve mechanisms/fourbar.yaml --frobnicate && pass
 run "mech solve --steps 0" 2 "$MECH" solve mechanisms/fourbar.yaml --steps 0 && pass
+# options are exact words, parsed by one table-driven parser (src/cli/cmd_opts.c):
+# a word that only starts like one, a number that strtod reads but a file
+# would refuse (--level positionsXYZ, --steps 0x10 were solved)
+if run "mech solve --level positionsXYZ" 2 "$MECH" solve mechanisms/fourbar.yaml --level positionsXYZ -o "$tmp/lv.csv"; then
+    has_line "$tmp/err" "^mech solve: --level is positions, velocities or accelerations, not 'positionsXYZ' (did you mean 'positions'?) (see 'mech solve --help')$" "--level positionsXYZ: the message"
+    [ ! -e "$tmp/lv.csv" ] && pass || fail "--level positionsXYZ: wrote the CSV"
+fi
+run "mech solve --level position" 2 "$MECH" solve mechanisms/fourbar.yaml --level position && pass
+if run "mech solve --steps 0x10" 2 "$MECH" solve mechanisms/fourbar.yaml --steps 0x10 -o "$tmp/st.csv"; then
+    has_line "$tmp/err" "^mech solve: --steps needs a whole number from 1 to 1000000 (as in a file), not '0x10': write it with digits only (see 'mech solve --help')$" "--steps 0x10: the message"
+    [ ! -e "$tmp/st.csv" ] && pass || fail "--steps 0x10: wrote the CSV"
+fi
+for bad in 1e3 16.0 " 16" +16; do
+    run "mech solve --steps '$bad'" 2 "$MECH" solve mechanisms/fourbar.yaml --steps "$bad" && pass
+done
+for args in "sweep mechanisms/slider-crank.yaml --vary r=30mm:40mm:2 -j 0x2" \
+            "sweep mechanisms/offset-slider-crank.yaml --random 1e2" \
+            "batch -j 2.0 mechanisms/fourbar.yaml" "plot mechanisms/fourbar.yaml --steps 0x10 --out $tmp/figs" \
+            "animate mechanisms/fourbar.yaml --frames 1e3" "report mechanisms/fourbar.yaml --steps 1e2" \
+            "solve mechanisms/fourbar.yaml --tol 0x1p-30" "compare --rtol inf a.csv b.csv" \
+            "codegen mechanisms/fourbar.yaml -o - --friction of" "equations --format LaTeX mechanisms/fourbar.yaml"; do
+    # shellcheck disable=SC2086
+    if run "mech $args" 2 "$MECH" $args; then
+        has_line "$tmp/err" "^mech ${args%% *}: .*, not '.*'.*(see 'mech ${args%% *} --help')$" "mech $args: the message"
+    fi
+done
+# --name=value, a flag with a value, a typo of an option
+if run "mech solve --steps=4" 0 "$MECH" solve mechanisms/fourbar.yaml --steps=4 --level=positions; then
+    [ "$(wc -l <"$tmp/out")" -eq 6 ] && pass || fail "--steps=4: $(wc -l <"$tmp/out") lines, expected 6"
+fi
+if run "mech solve --forces=yes" 2 "$MECH" solve mechanisms/fourbar.yaml --forces=yes; then
+    has_line "$tmp/err" "^mech solve: option '--forces=yes' takes no value" "--forces=yes"
+fi
+if run "mech solve --forcse" 2 "$MECH" solve mechanisms/fourbar.yaml --forcse; then
+    has_line "$tmp/err" "^mech solve: unknown option '--forcse' (did you mean '--forces'?)" "--forcse"
+fi
 run "mech solve --from without --to" 2 "$MECH" solve mechanisms/fourbar.yaml --from 10 && pass
 run "mech solve --from with a wrong unit" 2 "$MECH" solve mechanisms/fourbar.yaml --from 10kg --to 20 && pass
 # command-line ranges are checked like the file's: finite, and positions a
@@ -284,6 +329,25 @@ if run "mech solve dead centre" 1 "$MECH" solve tests/solve/dead-centre.yaml -o 
     [ "$(wc -l <"$tmp/dc.csv")" -eq 31 ] && pass || fail "dead centre: $(wc -l <"$tmp/dc.csv") lines written, expected 31"
 fi
 run "mech solve dead centre --within-assembly" 0 "$MECH" solve tests/solve/dead-centre.yaml --within-assembly -o "$tmp/dc2.csv" && pass
+
+# issue 32 point 10: a crank far too long (tests/solve/crank-too-long.yaml) is
+# "cannot assemble" at the first driver value, naming the loop and the links
+# that cannot reach, not a "singular position" (reciprocal condition 0.41,
+# far above the limit); as a sweep variant its status is no-assembly
+if run "mech solve, a crank far too long" 1 "$MECH" solve tests/solve/crank-too-long.yaml -o "$tmp/long.csv"; then
+    has_line "$tmp/err" 'error: cannot assemble at driver angle = 0 deg: loop 1 (B-C-O-A-B) does not close (residual 0.02 m at best, .* where coupler and rocker are at the limit of their reach)' "crank too long: cannot assemble, the loop and the links"
+    grep -q singular "$tmp/err" && fail "crank too long: called singular: $(head -n 1 "$tmp/err")" || pass
+    has_line "$tmp/err" '^mech solve: gap: rows 1 to 37 of 37 .* not solved: the mechanism does not assemble$' "crank too long: the gap's kind"
+fi
+if run "mech sweep, a crank far too long" 0 "$MECH" sweep tests/solve/crank-too-long.yaml --list r=20mm,200mm -o "$tmp/long-sweep.csv"; then
+    has_line "$tmp/long-sweep.csv" '^0,0.02,ok,37$' "sweep: the crank-rocker solves"
+    has_line "$tmp/long-sweep.csv" '^1,0.2,no-assembly,0$' "sweep: a crank far too long is no-assembly (not singular)"
+fi
+sed 's|^ground:|parameters: {r: 40 mm}\nground:|; s|A: \[40, 0\]|A: [r, 0]|' tests/solve/dead-centre.yaml >"$tmp/dc-r.yaml"
+if run "mech sweep, a dead centre" 0 "$MECH" sweep "$tmp/dc-r.yaml" --list r=40mm,30mm --unsolvable-ok -o "$tmp/dc-sweep.csv"; then
+    has_line "$tmp/dc-sweep.csv" '^0,0.04,singular,30$' "sweep: a dead point's status is singular (from its kind)"
+    has_line "$tmp/dc-sweep.csv" '^1,0.03,singular,20$' "sweep: the shorter crank's dead centre at 170 mm, a row"
+fi
 
 if run "mech solve --forces --friction both" 0 "$MECH" solve mechanisms/conveyor.yaml --friction both --stats -o "$tmp/cv.csv"; then
     has_line "$tmp/cv.csv" '^q \[rad\],.*,O\.Fx \[N\],O\.Fy \[N\],O\.F \[N\],.*driver\.torque \[N\*m\],power\.residual \[-\],friction\.power \[W\],friction\.iterations \[-\],.*driver\.torque\.nofriction \[N\*m\],power\.residual\.nofriction \[-\]$' "--friction both header"
@@ -433,7 +497,7 @@ if run "mech animate --outputs unknown" 2 "$MECH" animate mechanisms/fourbar.yam
     has_line "$tmp/err" "^mech animate: --outputs: 'Q' is not a point" "animate --outputs Q"
 fi
 # 10^6 steps: every figure of bounded size (the paths and the curves thinned)
-if run "mech plot --steps 1000000" 0 "$MECH" plot mechanisms/fourbar.yaml --steps 1000000 --outputs P,coupler --out "$tmp/fig6"; then
+if [ -z "$MECH_QUICK" ] && run "mech plot --steps 1000000" 0 "$MECH" plot mechanisms/fourbar.yaml --steps 1000000 --outputs P,coupler --out "$tmp/fig6"; then
     big=$(find "$tmp/fig6" -name '*.svg' -size +200k | head -n 1)
     [ -z "$big" ] && pass || fail "plot of 10^6 steps: $big is over 200 kB"
     [ -s "$tmp/fig6/fourbar-path-P.svg" ] && pass || fail "plot of 10^6 steps: no path figure"
@@ -597,5 +661,56 @@ if run "mech solve --sensitivity, a slider's angle" 2 "$MECH" solve "$tmp/angle.
     has_line "$tmp/err" "error: parameter 'alpha' sets the angle of slider 'x_B': sensitivities through a slider's angle are not computed" "sensitivity: slider angle refused"
 fi
 run "mech solve --sensitivity r, a slider's angle elsewhere" 0 "$MECH" solve "$tmp/angle.yaml" -q --steps 4 --sensitivity r && pass
+
+# ---- messages found on the way (issue 28 point 5) --------------------------
+cat >"$tmp/p5.yaml" <<'EOF2'
+name: four-bar with a coupler point from parameters
+units: {length: mm, angle: deg}
+parameters:
+  c: 30 mm
+  a: 20 mm
+  b: 25 mm
+ground: {O: [0, 0], C: [70, 0]}
+links:
+  crank:   {points: {O: [0, 0], A: [20, 0]}}
+  coupler: {points: {A: [0, 0], B: [60, 0], P: [c * c / a, 10]}}
+  rocker:  {points: {C: [0, 0], B: [50, 0]}}
+driver: {link: crank, angle: {from: 0, to: 360, steps: 4}}
+initial: {coupler: 44.6, rocker: 146}
+outputs: {points: [A, B, P]}
+EOF2
+# a bare --vary value for a parameter with a unit: the option and the value named
+if run "sweep: bare --vary values" 2 "$MECH" sweep "$tmp/p5.yaml" --vary c=0:1000:3; then
+    has_line "$tmp/err" "^mech sweep: --vary c=0:1000:3: the value '0' has no unit, but parameter 'c' has one in the file (c = 0.03 m, line 4)" "sweep: bare value named"
+fi
+run "sweep: --vary with units" 0 "$MECH" sweep "$tmp/p5.yaml" --vary c=20mm:40mm:3 && pass
+# an unquoted min(a, b) in [x, y]: the hint to quote it
+sed 's/P: \[c \* c \/ a, 10\]/P: [min(a, b), 10]/' "$tmp/p5.yaml" >"$tmp/p5-min.yaml"
+if run "check: min(a, b) unquoted" 2 "$MECH" check -q "$tmp/p5-min.yaml"; then
+    has_line "$tmp/err" "p5-min.yaml:10:48: error: point 'P' of link 'coupler' must be a list of two values \[x, y\], not of 3: the commas of an expression split it; quote it: 'min(a, b)'$" "min(a, b): quote it"
+fi
+sed "s/P: \[c \* c \/ a, 10\]/P: ['c * atan2(a, b) \/ atan2(a, b)', 10]/" "$tmp/p5.yaml" >"$tmp/p5-quoted.yaml"
+run "check: an expression with a comma, quoted" 0 "$MECH" check -q "$tmp/p5-quoted.yaml" && pass
+sed 's/P: \[c \* c \/ a, 10\]/P: [1, 2, 3]/' "$tmp/p5.yaml" >"$tmp/p5-three.yaml"
+if run "check: three numbers" 2 "$MECH" check -q "$tmp/p5-three.yaml"; then
+    has_line "$tmp/err" "must be a list of two values \[x, y\], not of 3$" "three numbers: no hint"
+fi
+# a point of one link named in outputs is a coupler point, not a typo
+sed -e 's/P: \[c \* c \/ a, 10\]/c: [30, 10]/' -e 's/points: \[A, B, P\]/points: [A, B, c]/' "$tmp/p5.yaml" >"$tmp/p5-out.yaml"
+run "check: an output point on one link" 0 "$MECH" check -q "$tmp/p5-out.yaml" && pass
+grep -q "joins nothing" "$tmp/err" && fail "an output point warned as joining nothing: $(cat "$tmp/err")" || pass
+sed 's/points: \[A, B, c\]/points: [A, B]/' "$tmp/p5-out.yaml" >"$tmp/p5-lone.yaml"
+if run "check: a lone point near C" 0 "$MECH" check -q "$tmp/p5-lone.yaml"; then
+    has_line "$tmp/err" "point 'c' of link 'coupler' is on no other link and in no joint, so it joins nothing (did you mean 'C'" "lone point: still warned"
+fi
+# a dimension in the units the format knows: N*m*rad, not kg*m^2*rad/s^2
+sed -e 's/^  b: 25 mm/  b: 25 mm\n  w: 2 N*m * 1 rad/' -e 's/P: \[c \* c \/ a, 10\]/P: [w, 10]/' "$tmp/p5.yaml" >"$tmp/p5-dim.yaml"
+if run "check: a torque times an angle for a length" 2 "$MECH" check -q "$tmp/p5-dim.yaml"; then
+    has_line "$tmp/err" "expected a length, got a quantity in N\*m\*rad$" "dimension in N*m*rad"
+fi
+# --stats under a time sweep names t
+if run "solve --stats, a time sweep" 0 "$MECH" solve mechanisms/five-bar.yaml --stats -o /dev/null; then
+    has_line "$tmp/err" "smallest rcond .* at t = .* s$" "--stats: at t"
+fi
 
 summary

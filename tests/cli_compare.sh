@@ -163,6 +163,27 @@ if "$MECH" solve --help >/dev/null 2>&1 && [ -f mechanisms/fourbar.yaml ]; then
     else
         fail "mech solve mechanisms/fourbar.yaml: $(head -n 1 "$tmp/err")"
     fi
+    # a golden kept in the file's units (mm, deg): the SI golden with each
+    # column scaled by its unit, by awk; `--units file` writes the same
+    awk -F, -v OFS=, 'NR == 1 { for (i = 1; i <= NF; i++) { f[i] = 1; u = $i
+                                   if (u ~ /\[m(\/|\])/) { f[i] = 1000; sub(/\[m/, "[mm", $i) }
+                                   if (u ~ /\[rad/) { f[i] = 180 / 3.14159265358979324; sub(/\[rad/, "[deg", $i) } }
+                        print; next }
+                      { for (i = 1; i <= NF; i++) $i = sprintf("%.17g", $i * f[i]); print }' \
+        tests/golden/fourbar.csv >"$tmp/golden-mm.csv"
+    has_line "$tmp/golden-mm.csv" "^q \[deg\],A.x \[mm\],A.y \[mm\],A.vx \[mm/s\],A.vy \[mm/s\],A.ax \[mm/s^2\]" "golden in mm: header"
+    if run "solve --units file" 0 "$MECH" solve mechanisms/fourbar.yaml --units file -o "$tmp/mm.csv"; then
+        run "--units file against a golden in mm and deg" 0 "$MECH" compare "$tmp/mm.csv" "$tmp/golden-mm.csv" && pass
+        run "SI against a golden in mm and deg" 1 "$MECH" compare "$tmp/a.csv" "$tmp/golden-mm.csv" && pass
+    fi
+    # --stats and the --tolerances summary in the file's units
+    if run "solve --units file --stats --tolerances" 0 "$MECH" solve tests/sweep/tol-slider-crank.yaml \
+        --units file --stats --tolerances -o "$tmp/tol.csv"; then
+        has_line "$tmp/err" "from r +-0.05 mm l +-0.1 mm" "--tolerances: the parameters' tolerances in mm"
+        has_line "$tmp/err" "worst residual .* mm$" "--stats: the residual in mm"
+        has_line "$tmp/err" "^  B.x .*\[mm\] (worst at q = 240)" "--tolerances: worst(B.x) in mm, q in deg"
+        has_line "$tmp/tol.csv" "worst(B.x) \[mm\]" "--tolerances: the column in mm"
+    fi
 fi
 
 summary

@@ -9,10 +9,25 @@
 # nothing. Then the status codes (no assembly, singular, branch), the
 # default names, and bad input: errors with exit status 2 or 3, the input
 # never overwritten.
+# MECH_QUICK=1 (make check): the same kinds of checks on a few cases each
+# (two mechanisms, two force systems, one --jit file, one prefix of each
+# kind), the generated code compiled at -O0 (four times faster; the same
+# IEEE arithmetic, so the same numbers).
 # Run from the repository root:  MECH=build/mech sh tests/codegen.sh
 NAME=codegen . tests/lib.sh
 CC=${CC:-cc}
 CFLAGS_GEN="-std=c11 -Wall -Wextra -Werror -pedantic -O2"
+files="mechanisms/*.yaml tests/hard/high-speed.yaml tests/hard/micrometre-fourbar.yaml
+    tests/hard/mixed-scale.yaml tests/hard/dead-centre-slider.yaml tests/solve/dead-centre.yaml"
+min_rcond="conveyor:0.03 conveyor:0.05 stirling:0.04 stirling:0.05"
+# (with the runtime's rt_ names that end in no public suffix)
+prefixes="cg block linear newton rt_step rt_column cg_newton"
+force_prefixes="force friction kinetostatics smooth fv rt_power rt_load"
+if [ -n "$MECH_QUICK" ]; then
+    CFLAGS_GEN="-std=c11 -Wall -Wextra -Werror -pedantic -O0"
+    files="mechanisms/fourbar.yaml mechanisms/stirling.yaml" min_rcond=stirling:0.04
+    prefixes=block force_prefixes=friction
+fi
 # under a sanitizer build, the generated code runs under one too
 [ -n "$MECH_SANITIZE" ] && CFLAGS_GEN="-std=c11 -Wall -Wextra -Werror -pedantic -O1 \
     -fsanitize=address,undefined -fno-sanitize-recover=all"
@@ -51,8 +66,7 @@ refused() {
     esac
 }
 
-for file in mechanisms/*.yaml tests/hard/high-speed.yaml tests/hard/micrometre-fourbar.yaml \
-        tests/hard/mixed-scale.yaml tests/hard/dead-centre-slider.yaml tests/solve/dead-centre.yaml; do
+for file in $files; do
     base=$(basename "$file" .yaml)
     dir=$tmp/$base
     why=$(refused "$base")
@@ -119,8 +133,7 @@ fi
 # (tests/codegen_rcond.c); the conveyor (one 4 x 4 block) and the Stirling
 # engine (six blocks) must keep the bound at most rows, the four-bar (one
 # 2 x 2 block: the exact value is cheaper) never
-for file in mechanisms/*.yaml tests/hard/high-speed.yaml tests/hard/micrometre-fourbar.yaml \
-        tests/hard/mixed-scale.yaml tests/hard/dead-centre-slider.yaml tests/solve/dead-centre.yaml; do
+for file in $files; do
     base=$(basename "$file" .yaml)
     dir=$tmp/$base
     if ! $CC $CFLAGS_GEN -I"$dir" -o "$dir/rcond" "$dir/gen.c" tests/codegen_rcond.c -lm \
@@ -147,7 +160,7 @@ done
 # says) to values the sweeps cross, the conveyor and the Stirling engine are
 # singular exactly where the interpreter's rcond is below it: the status
 # from a bound is the status from the exact value
-for run in conveyor:0.03 conveyor:0.05 stirling:0.04 stirling:0.05; do
+for run in $min_rcond; do
     base=${run%:*} min=${run#*:}
     dir=$tmp/$base
     sed "s/^#define MIN_RCOND .*/#define MIN_RCOND $min/" "$dir/gen.c" >"$dir/genm.c"
@@ -171,6 +184,7 @@ sed 's/  angle: {from: 0 deg, to: 360 deg, steps: 360}/  angle: {from: 150 deg, 
 grep -q "from: 150 deg" "$tmp/conveyor-part.yaml" && pass || fail "conveyor-part: the range was not set"
 for file in mechanisms/conveyor.yaml "$tmp/conveyor-part.yaml" mechanisms/watt-six-bar.yaml \
         tests/hard/mixed-scale.yaml tests/truths/incline-block.yaml; do
+    [ -n "$MECH_QUICK" ] && [ "$file" != "$tmp/conveyor-part.yaml" ] && continue
     "$MECH" solve "$file" -q --stats -o /dev/null 2>"$tmp/st-interp"
     TMPDIR=$tmp/jt "$MECH" solve "$file" -q --stats --jit -o /dev/null 2>"$tmp/st-jit"
     want=$(grep "smallest rcond" "$tmp/st-interp")
@@ -207,23 +221,23 @@ forces() {
 # every shipped file with masses: the conveyor (pin friction on, off, and
 # both sets), the four-bar (a crank with a mass), the slider-crank with
 # springs and a damper; the Stirling engine has no masses (every reaction 0)
-forces conveyor mechanisms/conveyor.yaml
-forces conveyor-off mechanisms/conveyor.yaml --friction off
+full forces conveyor mechanisms/conveyor.yaml
+full forces conveyor-off mechanisms/conveyor.yaml --friction off
 forces conveyor-both mechanisms/conveyor.yaml --friction both
-forces fourbar mechanisms/fourbar.yaml
-forces springs mechanisms/spring-slider-crank.yaml --friction both
-forces stirling mechanisms/stirling.yaml
+full forces fourbar mechanisms/fourbar.yaml
+full forces springs mechanisms/spring-slider-crank.yaml --friction both
+full forces stirling mechanisms/stirling.yaml
 # slider friction (locked and free sliders, a moving guide, a slider driver),
 # pin friction on both links of each pin, the frictionless set beside them
 for f in incline-block oscillating-cylinder-friction slider-crank-guide-friction \
         slider-crank-pin-friction oscillating-cylinder-guide; do
-    forces "$f" "tests/truths/$f.yaml" --friction both
+    full forces "$f" "tests/truths/$f.yaml" --friction both
 done
 # several drivers (laws of time): the five-bar's two cranks (a torque
 # column each, the power of both in the balance); a slider pushed by a law
 # with slider and pin friction (its force column along the guide, the
 # friction's relative speed that of the driven unknown)
-FTOL=0 forces five-bar mechanisms/five-bar.yaml
+FTOL=0 full forces five-bar mechanisms/five-bar.yaml
 cat >"$tmp/pushed.yaml" <<'YAML'
 name: pushed slider-crank with masses and friction
 units: {length: mm, angle: deg}
@@ -241,11 +255,11 @@ sweep: {time: {from: 0 s, to: 1 s, steps: 40}}
 drivers: [{slider: s_B, displacement: "70 mm + 5 mm * sin(2 * pi * t / 1 s)"}]
 outputs: {points: [A], links: [rod], forces: true}
 YAML
-FTOL=0 forces pushed "$tmp/pushed.yaml" --friction both
+FTOL=0 full forces pushed "$tmp/pushed.yaml" --friction both
 # loads that depend on the motion (docs/format.md 10.2): forces at a point,
 # torques and forces along a line, reading every kind of input (points,
 # links, sliders, the driver; positions, rates, accelerations) through
-# every operation of the register program (src/state_loads.h), with pin
+# every operation of the register program (src/load/load.h), with pin
 # and slider friction; the shaper and stirling-gas above have them too
 cat >"$tmp/state-loads.yaml" <<'YAML'
 name: slider-crank with every kind of load that depends on the motion
@@ -279,15 +293,15 @@ outputs:
   forces: true
 YAML
 FTOL=0 forces state-loads "$tmp/state-loads.yaml" --friction both
-FTOL=0 forces state-loads-on "$tmp/state-loads.yaml"
+FTOL=0 full forces state-loads-on "$tmp/state-loads.yaml"
 # gear pairs and racks (docs/forces.md section 9): the tooth force's
 # column, its separating part solved after it (frictionless, and in each
 # friction iteration), the NAME.W column: the epicyclic train (a moving
 # carrier, an internal ring on the ground) and the geared five-bar, a rack
 # on an inclined guide with pin and slider friction (driven by the pinion,
 # and by the rack), a ring gear named first driving a pinion inside it
-FTOL=0 forces epicyclic mechanisms/epicyclic.yaml --friction both
-FTOL=0 forces geared-five-bar mechanisms/geared-five-bar.yaml
+FTOL=0 full forces epicyclic mechanisms/epicyclic.yaml --friction both
+FTOL=0 full forces geared-five-bar mechanisms/geared-five-bar.yaml
 cat >"$tmp/rack.yaml" <<'YAML'
 name: rack and pinion with masses, a load and friction
 units: {length: mm, angle: deg}
@@ -326,8 +340,8 @@ loads:
 outputs: {points: [R], links: [ring, pinion], forces: true}
 YAML
 for f in rack rack-driven ring; do
-    FTOL=0 forces "$f" "$tmp/$f.yaml" --friction both
-    FTOL=0 forces "$f-off" "$tmp/$f.yaml" --friction off
+    FTOL=0 full forces "$f" "$tmp/$f.yaml" --friction both
+    FTOL=0 full forces "$f-off" "$tmp/$f.yaml" --friction off
 done
 # a hand calculation: the block of tests/truths/incline-block.yaml (m = 2 kg,
 # guide at b = 30 deg, mu = 0.25) pushed at constant speed up the incline
@@ -355,7 +369,7 @@ run "bad --friction" 2 "$MECH" codegen mechanisms/conveyor.yaml -o "$tmp/x.c" --
     has_line "$tmp/err" "on, off or both" "bad --friction"
 # --no-forces: the conveyor's kinematics alone
 "$MECH" codegen mechanisms/conveyor.yaml --no-forces -o "$tmp/nf.c" --prefix nf 2>/dev/null &&
-    ! grep -q 'NF_NF\|kinetostatics' "$tmp/nf.c" && pass || fail "--no-forces: forces generated"
+    ! grep -q 'NF_NF\|static void force_matrix\|rt_fcol_entries' "$tmp/nf.c" && pass || fail "--no-forces: forces generated"
 rm -f "$tmp/x.c"
 
 # ---- mech solve --jit ----
@@ -382,6 +396,7 @@ printf '#!/bin/sh\necho run >>"%s/cc.log"\nexec %s "$@"\n' "$tmp" "$CC" >"$tmp/c
 chmod +x "$tmp/cc-log"
 for file in mechanisms/*.yaml "$tmp/pushed.yaml" "$tmp/state-loads.yaml" "$tmp/rack.yaml" \
         "$tmp/rack-driven.yaml" "$tmp/ring.yaml"; do
+    [ -n "$MECH_QUICK" ] && [ "$file" != mechanisms/fourbar.yaml ] && continue
     base=$(basename "$file" .yaml)
     for opts in "" --forces; do
         rm -f "$tmp/cc.log"
@@ -391,7 +406,7 @@ for file in mechanisms/*.yaml "$tmp/pushed.yaml" "$tmp/state-loads.yaml" "$tmp/r
             continue
         fi
         "$MECH" solve "$file" -q $opts -o "$tmp/interp.csv" 2>/dev/null
-        if TMPDIR=$tmp/jt CC=$tmp/cc-log "$MECH" solve "$file" -q --jit $opts -o "$tmp/jit.csv" \
+        if MECH_JIT_CACHE=off TMPDIR=$tmp/jt CC=$tmp/cc-log "$MECH" solve "$file" -q --jit $opts -o "$tmp/jit.csv" \
                 2>"$tmp/jit.err" && cmp -s "$tmp/interp.csv" "$tmp/jit.csv" && [ -s "$tmp/cc.log" ] &&
                 ! grep -q 'note: --jit' "$tmp/jit.err"; then
             pass
@@ -448,14 +463,14 @@ fi
 
 # prefixes that meet the source's own names (CG_OK, the static block_solve
 # of an earlier version) compile
-for p in cg block linear newton; do
+for p in $prefixes; do
     "$MECH" codegen mechanisms/stirling.yaml -o "$tmp/$p.c" --prefix $p 2>"$tmp/err" &&
         $CC $CFLAGS_GEN -c -o "$tmp/$p.o" "$tmp/$p.c" 2>"$tmp/cc" && pass ||
         fail "--prefix $p: $(cat "$tmp/err" "$tmp/cc" | head -n 2)"
 done
 
 # with forces: prefixes that meet the force code's own names
-for p in force friction kinetostatics smooth fv; do
+for p in $force_prefixes; do
     "$MECH" codegen mechanisms/conveyor.yaml --friction both -o "$tmp/$p.c" --prefix $p 2>"$tmp/err" &&
         $CC $CFLAGS_GEN -c -o "$tmp/$p.o" "$tmp/$p.c" 2>"$tmp/cc" && pass ||
         fail "--prefix $p with forces: $(cat "$tmp/err" "$tmp/cc" | head -n 2)"
@@ -484,6 +499,11 @@ run "no output" 2 "$MECH" codegen mechanisms/fourbar.yaml && pass
 run "no file" 2 "$MECH" codegen -o "$tmp/x.c" && pass
 run "bad prefix" 2 "$MECH" codegen mechanisms/fourbar.yaml -o "$tmp/x.c" --prefix 9lives &&
     has_line "$tmp/err" "not a C identifier" "bad prefix"
+# a prefix that makes a public name the runtime uses (rt_blocks_solve; RT_COL_...)
+run "prefix meets the runtime" 2 "$MECH" codegen mechanisms/fourbar.yaml -o "$tmp/x.c" \
+    --prefix rt_blocks && has_line "$tmp/err" "public name 'rt_blocks_solve'" "prefix rt_blocks"
+run "prefix meets the runtime, forces" 2 "$MECH" codegen mechanisms/conveyor.yaml -o "$tmp/x.c" \
+    --prefix RT && has_line "$tmp/err" "public name 'RT_COL_" "prefix RT"
 run "unknown option" 2 "$MECH" codegen mechanisms/fourbar.yaml -o "$tmp/x.c" --fast && pass
 run "redundant constraints" 2 "$MECH" codegen tests/hard/redundant-parallelogram.yaml -o "$tmp/x.c" &&
     has_line "$tmp/err" "redundant constraints" "redundant constraints"

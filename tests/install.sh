@@ -13,6 +13,12 @@ CC=${CC:-cc}
 MAKE=${MAKE:-make}
 P="$tmp/prefix"
 export PKG_CONFIG_PATH="$P/lib/pkgconfig"
+# the version and soname (docs/api.md, "Versions and the ABI")
+version=$(sed -n 's/^#define MECH_VERSION "\([0-9][0-9.]*\)"$/\1/p' include/mech.h)
+major=${version%%.*}
+minor=${version#*.}
+minor=${minor%%.*}
+[ "$major" = 0 ] && soname=libmech.so.0.$minor || soname=libmech.so.$major
 
 # 1. the installed tree
 if $MAKE --no-print-directory install PREFIX="$P" BUILD="$BUILD" ${OPT:+OPT="$OPT"} SAN="$SAN" \
@@ -21,21 +27,21 @@ if $MAKE --no-print-directory install PREFIX="$P" BUILD="$BUILD" ${OPT:+OPT="$OP
     summary
     exit
 fi
-for f in bin/mech include/mech.h lib/libmech.a lib/libmech.so.0.1.0 lib/pkgconfig/mech.pc \
+for f in bin/mech include/mech.h lib/libmech.a lib/libmech.so.$version lib/pkgconfig/mech.pc \
     share/man/man1/mech.1 lib/python3/dist-packages/mech/__init__.py; do
     if [ -f "$P/$f" ]; then pass; else fail "not installed: $f"; fi
 done
-if [ "$(readlink "$P/lib/libmech.so")" = libmech.so.0 ] &&
-    [ "$(readlink "$P/lib/libmech.so.0")" = libmech.so.0.1.0 ]; then pass; else
-    fail "links: libmech.so -> $(readlink "$P/lib/libmech.so"), libmech.so.0 -> $(readlink "$P/lib/libmech.so.0")"
+if [ -n "$version" ] && [ "$(readlink "$P/lib/libmech.so")" = "$soname" ] &&
+    [ "$(readlink "$P/lib/$soname")" = "libmech.so.$version" ]; then pass; else
+    fail "links: libmech.so -> $(readlink "$P/lib/libmech.so"), $soname -> $(readlink "$P/lib/$soname")"
 fi
 if command -v readelf >/dev/null 2>&1; then
-    if readelf -d "$P/lib/libmech.so.0.1.0" | grep -q 'SONAME.*\[libmech\.so\.0\]'; then pass; else
-        fail "soname: $(readelf -d "$P/lib/libmech.so.0.1.0" | grep SONAME)"
+    if readelf -d "$P/lib/libmech.so.$version" | grep -q "SONAME.*\[$soname\]"; then pass; else
+        fail "soname: $(readelf -d "$P/lib/libmech.so.$version" | grep SONAME)"
     fi
-    # only the API of mech.h is exported
-    if readelf --dyn-syms -W "$P/lib/libmech.so.0.1.0" | awk '$7 != "UND" && $5 == "GLOBAL" {print $8}' |
-        grep -v '^mech_' | grep . >"$tmp/exported"; then
+    # only the API of mech.h is exported (and its version node's name)
+    if readelf --dyn-syms -W "$P/lib/libmech.so.$version" | awk '$7 != "UND" && $5 == "GLOBAL" {print $8}' |
+        grep -v -e '^mech_' -e '^MECH_[0-9.]*$' | grep . >"$tmp/exported"; then
         fail "exported beyond mech_*: $(head -n 5 "$tmp/exported" | tr '\n' ' ')"
     else pass; fi
 fi
@@ -87,8 +93,8 @@ check_numbers() {
 if [ -x "$tmp/example" ]; then
     # the shared library is the one installed, found by LD_LIBRARY_PATH
     if command -v ldd >/dev/null 2>&1; then
-        if LD_LIBRARY_PATH="$P/lib" ldd "$tmp/example" | grep -q "libmech.so.0 => $P/lib/libmech.so.0"; then
-            pass; else fail "example not linked with $P/lib/libmech.so.0: $(LD_LIBRARY_PATH="$P/lib" ldd "$tmp/example" | grep mech)"; fi
+        if LD_LIBRARY_PATH="$P/lib" ldd "$tmp/example" | grep -q "$soname => $P/lib/$soname"; then
+            pass; else fail "example not linked with $P/lib/$soname: $(LD_LIBRARY_PATH="$P/lib" ldd "$tmp/example" | grep mech)"; fi
     fi
     check_numbers "shared" "$tmp/example" mechanisms/fourbar.yaml B.x B.vx B.ay coupler.omega rocker.alpha
     check_numbers "shared" "$tmp/example" mechanisms/stirling.yaml D.x L.vy J.ay link4.angle

@@ -31,14 +31,17 @@ shard_pid() {
 }
 
 # The first shard K of M whose out/sweep.K.csv.partial (or the file $3
-# names, %s for K) holds rows: waits up to $2 seconds; prints K, or nothing.
+# names, %s for K) is there with its head (manifest and header: the shard
+# runs; a sweep's rows come in blocks up to a second apart, so a short shard
+# may show none before its end): waits up to $2 seconds; prints K, or
+# nothing.
 running_shard() {
     m=$1 limit=$2 waited=0 pattern=${3:-sweep.%s.csv.partial}
     while [ "$waited" -lt $((limit * 20)) ]; do
         for k in $(seq 0 $((m - 1))); do
             # shellcheck disable=SC2059
             f=$work/out/$(printf "$pattern" "$k")
-            if [ -f "$f" ] && [ "$(wc -l <"$f")" -ge 4 ]; then
+            if [ -f "$f" ] && [ "$(wc -l <"$f")" -ge 2 ]; then
                 echo "$k"
                 return 0
             fi

@@ -6,7 +6,8 @@
 # loads nothing from elsewhere, holds every figure of `mech plot` (by
 # title), the text of `mech equations`, the lines of `mech check`, the
 # warnings of `mech solve`, and behind its slider the rows of `mech solve`'s
-# CSV bit for bit.
+# CSV bit for bit. MECH_QUICK=1: the pages of five cases (of thirteen): the
+# four-bar, forces, a warning, a partial sweep, --set.
 # Run from the repository root:  MECH=build/mech sh tests/report.sh
 NAME=report
 . tests/lib.sh
@@ -178,22 +179,22 @@ page_of() {
 }
 
 page_of fourbar $four
-page_of stirling mechanisms/stirling.yaml
-page_of springs mechanisms/spring-slider-crank.yaml
+full page_of stirling mechanisms/stirling.yaml
+full page_of springs mechanisms/spring-slider-crank.yaml
 # laws of time with two drivers, gears, loads that depend on the motion: the
 # page's structure lines are mech check's (model_describe)
-page_of five-bar mechanisms/five-bar.yaml
-page_of epicyclic mechanisms/epicyclic.yaml
-page_of shaper mechanisms/shaper.yaml --steps 90
+full page_of five-bar mechanisms/five-bar.yaml
+full page_of epicyclic mechanisms/epicyclic.yaml
+full page_of shaper mechanisms/shaper.yaml --steps 90
 page_of conveyor-forces mechanisms/conveyor.yaml --forces --steps 90
-PLOT_ALL=0 page_of slider-range mechanisms/offset-slider-crank.yaml --from 10 --to 100 --steps 9
-page_of outputs mechanisms/watt-six-bar.yaml --outputs B,bellcrank
+PLOT_ALL=0 full page_of slider-range mechanisms/offset-slider-crank.yaml --from 10 --to 100 --steps 9
+full page_of outputs mechanisms/watt-six-bar.yaml --outputs B,bellcrank
 page_of warnings tests/hard/redundant-parallelogram.yaml
 grep -q "warning" "$tmp/warnings/solve.err" && pass || fail "redundant-parallelogram has no warning to show"
 # partial sweeps: the page of the rows solved, the gaps listed, exit 1
 WANT=1 page_of partial tests/hard/non-grashof-crank.yaml
 has_line "$tmp/err" "220 of the sweep's 361 positions were solved; the page shows them" "partial"
-WANT=1 page_of two-intervals tests/hard/non-grashof-two-intervals.yaml
+WANT=1 full page_of two-intervals tests/hard/non-grashof-two-intervals.yaml
 # the animation traces paths (dashed, data-trace) only when no gap would be bridged
 traces() { grep -c 'stroke-dasharray="[^"]*" data-trace=' "$1"; }
 [ "$(traces "$tmp/fourbar/page.html")" -gt 0 ] && pass || fail "the four-bar's page traces no path"

@@ -1,6 +1,7 @@
 #!/bin/sh
-# tests/valgrind.sh: `mech solve` (with forces) on every mechanism and the
-# failure cases under valgrind: no invalid reads or writes, no leaks.
+# tests/valgrind.sh: `mech solve` (with forces) on every mechanism, the
+# failure cases and the other commands (mech watch served, edited and
+# stopped by SIGINT) under valgrind: no invalid reads or writes, no leaks.
 # Run from the repository root:  MECH=build/mech sh tests/valgrind.sh
 MECH=${MECH:-build/mech}
 command -v valgrind >/dev/null || { echo "valgrind: not installed (apt-get install valgrind)" >&2; exit 2; }
@@ -44,5 +45,55 @@ check "mech plot" plot mechanisms/fourbar.yaml --out "$tmp/plots"
 check "mech animate" animate mechanisms/fourbar.yaml -o "$tmp/a.svg"
 check "mech report --forces" report mechanisms/fourbar.yaml --forces -o "$tmp/r.html"
 check "mech report, a partial sweep" report tests/hard/non-grashof-crank.yaml -o "$tmp/p.html"
+check "mech draw (a guessed pose)" draw mechanisms/fourbar.yaml --frame 30 -o "$tmp/d.svg"
+check "mech check --draw" check mechanisms/offset-slider-crank.yaml --draw "$tmp/d.svg"
+check "mech draw, no assembly" draw tests/hard/non-grashof-crank.yaml --at 180 -o "$tmp/d.svg"
+
+# mech watch: served, saved (good, broken, good again), requests refused,
+# a long poll and an idle connection open at SIGINT; nothing may leak
+cp mechanisms/fourbar.yaml "$tmp/w.yaml"
+valgrind -q --leak-check=full --show-leak-kinds=definite,indirect \
+    --errors-for-leak-kinds=definite,indirect --error-exitcode=99 \
+    "$MECH" watch "$tmp/w.yaml" >"$tmp/url" 2>"$tmp/werr" &
+wpid=$!
+python3 - "$tmp/url" "$tmp/w.yaml" <<'EOF2'
+import json, os, shutil, socket, sys, time, urllib.request
+for _ in range(600):  # the address, under valgrind: up to 60 s
+    url = open(sys.argv[1]).read().strip()
+    if url:
+        break
+    time.sleep(0.1)
+port = int(url.rsplit(":", 1)[1].strip("/"))
+def state(since=None):
+    q = "" if since is None else f"?since={since}"
+    return json.load(urllib.request.urlopen(url + "state" + q, timeout=120))
+urllib.request.urlopen(url, timeout=120).read()
+v = state()["version"]
+for data in (b"GET / HTTP/1.1\r\nHost: evil.example\r\n\r\n", b"POST / HTTP/1.1\r\n\r\n",
+             b"GET /x HTTP/1.1\r\nHost: localhost\r\n\r\n" + b"X: y\r\n" * 2000):
+    with socket.create_connection(("127.0.0.1", port), timeout=60) as s:
+        s.sendall(data)
+        s.recv(100)
+text = open(sys.argv[2]).read()
+for new in (text.replace("A: [20, 0]", "A: [25, 0]"), text.replace("A: [20, 0]", "A: [25, 0"), text):
+    with open(sys.argv[2] + ".tmp", "w") as f:
+        f.write(new)
+    os.replace(sys.argv[2] + ".tmp", sys.argv[2])
+    v = state(since=v)["version"]
+idle = socket.create_connection(("127.0.0.1", port), timeout=60)
+poll = socket.create_connection(("127.0.0.1", port), timeout=60)
+poll.sendall(f"GET /state?since={v} HTTP/1.1\r\nHost: localhost\r\n\r\n".encode())
+time.sleep(1)
+print(v)
+EOF2
+kill -INT $wpid
+wait $wpid
+if [ $? -eq 0 ] && grep -q "^mech watch: stopped" "$tmp/werr"; then
+    passed=$((passed + 1))
+else
+    failed=$((failed + 1))
+    echo "FAIL: mech watch"
+    sed 's/^/    /' "$tmp/werr" | head -n 30
+fi
 echo "valgrind: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -42,7 +42,7 @@ int main(int argc, char **argv)
      * threads may share it), then solve the file's driver range. One call,
      * mech_solve(model, &options, &table, &stats, &diag), does both. */
     mech_solve_options options;
-    mech_solve_options_default(&options);
+    mech_solve_options_init(&options, sizeof options);  /* the defaults, with its size */
     mech_analysis *analysis = NULL;
     mech_table table = {0};
     mech_solve_stats stats;

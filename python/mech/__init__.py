@@ -9,21 +9,44 @@
 
     mech.load(path)   # the model as a dict (SI units)
     mech.check(path)  # the same plus 'structure' (mobility, loops, ...), as `mech check`
-    mech.sweep(path, {'r': ['30 mm', '40 mm']})   # one solve per variant
+    s = mech.sweep(path, {'r': ['30 mm', '40 mm']}, metrics=['range:B.x'])
+    s['range:B.x']    # one value per variant, as `mech sweep`'s CSV column
 
 Every function takes set={'name': '45 mm'} to replace the file's parameters.
 Errors in the file, its structure or the solve raise MechError, whose message
-is the library's, one 'file:line:column: error: message' per line.
+is the library's, one 'file:line:column: error: message' per line, and whose
+.kind says what failed as data ('no-assembly', 'dead-point', 'input', ...: one
+of FAIL_KINDS), so that no program has to read the message's words.
 See docs/api.md.
 """
-import itertools
-from concurrent.futures import ThreadPoolExecutor
+import numbers
 
-from ._mech import MechError, VERSION, EINPUT, ENOMEM, EIO, ESOLVE
+try:
+    from ._mech import MechError, VERSION, EINPUT, ENOMEM, EIO, ESOLVE, FAIL_KINDS
+except ModuleNotFoundError as e:
+    if e.name != __name__ + '._mech':
+        raise
+
+    def _another_python():
+        """The extension is here, but for another Python's ABI: say which."""
+        import glob
+        import os
+        import platform
+        import sys
+        import sysconfig
+        here = os.path.dirname(os.path.abspath(__file__))
+        found = sorted(os.path.basename(p) for p in glob.glob(os.path.join(here, '_mech*')))
+        return ImportError(
+            "mech's extension in %s is %s, which is for another Python than this one, %s "
+            "(Python %s, which loads _mech%s): build mech for this interpreter: make install "
+            "PYTHON=%s, or %s -m pip install --no-build-isolation ./python (docs/api.md, Python)"
+            % (here, ', '.join(found) or 'missing', sys.executable, platform.python_version(),
+               sysconfig.get_config_var('EXT_SUFFIX'), sys.executable, sys.executable))
+    raise _another_python() from None
 from . import _mech
 
-__all__ = ['MechError', 'Result', 'load', 'check', 'solve', 'sweep', 'VERSION',
-           'EINPUT', 'ENOMEM', 'EIO', 'ESOLVE']
+__all__ = ['MechError', 'Result', 'SweepResult', 'load', 'check', 'solve', 'sweep', 'VERSION',
+           'EINPUT', 'ENOMEM', 'EIO', 'ESOLVE', 'FAIL_KINDS', 'VARIANT_STATUS']
 __version__ = VERSION
 
 
@@ -34,7 +57,8 @@ class Result:
     r.columns   the column names in the CSV's order (the first is 'q', the driver)
     r.units     {name: unit}, e.g. 'm', 'rad/s', 'N', '-'
     r.stats     how the solve went (mech_solve_stats: steps, iterations,
-                worst_residual, min_rcond, seconds, ...)
+                worst_residual, min_rcond, seconds, ..., failure: 'none' or the
+                kind of failure, failure_q: where, in SI)
     r.messages  the library's warnings and notes (dicts like MechError.diagnostics)
     r.nrows     the number of rows (driver positions)
     """
@@ -136,36 +160,110 @@ def solve(path, set=None, from_=None, to=None, steps=None, outputs=None, forces=
     return Result(names, units, arrays, stats, messages)
 
 
-def sweep(path, vary, jobs=None, **options):
-    """Solve every combination of parameter values: vary={'r': ['30 mm',
-    '40 mm'], 'l': [100, 120]} (texts as in the file; a number is a bare
-    number of the file, which takes the file's unit where it is used).
-    options are solve()'s (set= gives fixed overrides). Returns one dict per
-    variant, in the order of the grid (the last name varies fastest):
-    {'set': {...}, 'ok': bool, 'result': Result or None, 'error': MechError
-    or None}. A variant that cannot be solved is reported, not raised; an
-    invalid file or option raises as solve() does (for the first variant).
-    jobs: worker threads (default: as many as variants, at most 8); the
-    library releases the GIL while it solves."""
-    names = list(vary)
-    fixed = dict(options.pop('set', None) or {})
-    grid = [dict(zip(names, values)) for values in itertools.product(*(vary[n] for n in names))]
+# mech_variant_status, in its order: the status column of `mech sweep`
+VARIANT_STATUS = ('ok', 'no-assembly', 'singular', 'self-locking', 'invalid', 'error', 'non-finite')
 
-    def one(values):
-        overrides = dict(fixed)
-        overrides.update(values)
-        try:
-            return {'set': values, 'ok': True, 'result': solve(path, set=overrides, **options),
-                    'error': None}
-        except MechError as e:
-            if e.status != ESOLVE:
-                raise
-            return {'set': values, 'ok': False, 'result': None, 'error': e}
 
-    if not grid:
-        return []
-    workers = jobs if jobs else min(len(grid), 8)
-    if workers <= 1:
-        return [one(v) for v in grid]
-    with ThreadPoolExecutor(max_workers=workers) as pool:
-        return list(pool.map(one, grid))
+class SweepResult(Result):
+    """A sweep's rows, one per variant, as `mech sweep`'s CSV: columns
+    'variant' (int64, its index), one per parameter (float64, SI), 'status'
+    (str: 'ok', 'no-assembly', 'singular', 'self-locking', 'invalid',
+    'error', 'non-finite'), 'rows' (int64, driver positions solved) and one per metric
+    (float64, NaN where the variant was not solved).
+
+    s.messages  {variant index: text} what the load and solve of each variant
+                not solved said (`mech sweep` prints the same on stderr)
+    s.stats     {'total': variants of the whole grid, 'solved': variants ok,
+                'shared': solved through the sweep's one analysis, 'alone':
+                analysed on their own}
+    s.nrows     the variants of this shard
+    """
+
+    def __init__(self, names, units, arrays, status, messages, stats, nparams):
+        import numpy
+        names, units, arrays = list(names), list(units), list(arrays)
+        at = 1 + nparams  # after the variant and its parameters, as in the CSV
+        codes = numpy.asarray(status)
+        words = numpy.array(VARIANT_STATUS)[codes] if codes.size else numpy.array([], dtype='<U12')
+        names.insert(at, 'status')
+        units.insert(at, '-')
+        arrays.insert(at, words)
+        for a in arrays:
+            a.setflags(write=False)
+        Result.__init__(self, names, units, arrays, stats)
+        self.messages = dict(messages)
+
+    def __repr__(self):
+        return '<mech.SweepResult: %d variants, %d columns: %s>' % (
+            self.nrows, len(self.columns),
+            ', '.join(self.columns[:6]) + (', ...' if len(self.columns) > 6 else ''))
+
+
+def _grid_spec(name, values):
+    """(is_list, spec) of one parameter of vary=: a list of values is
+    `--list NAME=A,B,...`, a str 'FROM:TO:COUNT' is `--vary NAME=FROM:TO:COUNT`."""
+    if not isinstance(name, str):
+        raise TypeError('vary: parameter names must be str, not %r' % (name,))
+    if isinstance(values, str):
+        return (False, '%s=%s' % (name, values))
+    texts = []
+    for v in values:
+        if isinstance(v, str):
+            t = v
+        elif isinstance(v, numbers.Real) and not isinstance(v, bool):
+            t = repr(float(v)) if isinstance(v, float) else repr(int(v))
+        else:
+            raise TypeError("vary['%s']: a value must be a str like '45 mm' or a number, "
+                            'not %r' % (name, v))
+        if ',' in t:
+            raise ValueError("vary['%s']: the value %r holds a comma" % (name, t))
+        texts.append(t)
+    return (True, '%s=%s' % (name, ','.join(texts)))
+
+
+def sweep(path, vary=None, metrics=(), random=None, seed=1, forces=False, jobs=None,
+          shard=None, index_offset=0):
+    """Solve variants of one mechanism file, as `mech sweep`, each reduced to
+    one row (mech_sweep in libmech: the grid, the samples, the metrics and
+    the variants on worker threads are the command's own; constant memory
+    per variant). Returns a SweepResult, whose columns equal `mech sweep`'s
+    CSV columns bit for bit.
+
+    vary        {'r': ['30 mm', '40 mm'], 'l': '130mm:150mm:5'}: a list of
+                values (texts as in the file; a number is a bare number of
+                the file) as --list, or 'FROM:TO:COUNT' as --vary; every
+                combination, the last name varying fastest
+    metrics     ['range:B.x', 'maxabs:driver.torque', 'transmission:coupler,rocker',
+                'flywheel:0.02', 'max:COL', 'min:COL'] as --metric
+    random      N: N variants with every parameter that has a tolerance
+                uniform within it (not with vary), seed as --seed
+    forces      True: the force analysis in every variant (driver.torque)
+    jobs        worker threads (default: the CPUs this process may run on)
+    shard       (k, m): only the variants i % m == k, as --shard K/M
+    index_offset  number the variants from it, as --index-offset
+
+    A variant that cannot be solved is a row with its status; an invalid
+    file, parameter or metric raises MechError (EINPUT), a bad argument
+    ValueError or TypeError. The GIL is released while the variants are
+    solved."""
+    grid = [_grid_spec(n, v) for n, v in (vary or {}).items()]
+    if isinstance(metrics, str):
+        metrics = [metrics]
+    metrics = list(metrics)
+    if not all(isinstance(m, str) for m in metrics):
+        raise TypeError('metrics: a list of str like "range:B.x"')
+    if random is not None and (not isinstance(random, numbers.Integral) or random < 1):
+        raise ValueError('random: a number of variants from 1 to 10**7, not %r' % (random,))
+    if not isinstance(seed, numbers.Integral) or not 0 <= seed < 2 ** 64:
+        raise ValueError('seed: a whole number from 0 to 2**64-1, not %r' % (seed,))
+    k, m = shard if shard is not None else (0, 1)
+    if not all(isinstance(x, numbers.Integral) for x in (k, m)) or not 0 <= k < m <= 10 ** 6:
+        raise ValueError('shard: (k, m) with 0 <= k < m <= 10**6, not %r' % (shard,))
+    if not isinstance(index_offset, numbers.Integral) or not 0 <= index_offset <= 10 ** 12:
+        raise ValueError('index_offset: a whole number from 0 to 10**12, not %r'
+                         % (index_offset,))
+    if jobs is not None and (not isinstance(jobs, numbers.Integral) or not 1 <= jobs <= 1024):
+        raise ValueError('jobs: a number of workers from 1 to 1024, not %r' % (jobs,))
+    return SweepResult(*_mech.sweep(
+        path, grid, metrics, random=int(random or 0), seed=int(seed), forces=bool(forces),
+        shard=(int(k), int(m)), index_offset=int(index_offset), jobs=int(jobs or 0)))

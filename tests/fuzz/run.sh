@@ -21,12 +21,16 @@ bin=$out/fuzz_load
 
 command -v "$cc" >/dev/null || { echo "run.sh: $cc not found (Debian: apt-get install clang)" >&2; exit 2; }
 mkdir -p "$out/corpus" "$out/artifacts"
-lib_src=$(ls src/*.c | grep -v -e '^src/main\.c$' -e '^src/cmd_')
+lib_src=$(ls src/*/*.c | grep -v '^src/cli/')
+# the runtime's text for mech codegen, as the Makefile makes it
+awk -f tools/c_lines.awk $(sed -n 's/^RT_SRC *= *$(addprefix src\/runtime\/,\(.*\))$/\1/p' Makefile |
+    tr ' ' '\n' | sed 's|^|src/runtime/|') >"$out/rt_text.c"
+src_inc=$(for d in src/*/; do printf ' -I%s' "${d%/}"; done)
 # -fno-sanitize-recover: an UBSan report stops the run and counts as a crash.
 $cc -g -O1 -std=c11 -D_POSIX_C_SOURCE=200809L -pthread \
     -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all \
-    -Iinclude -Isrc -I/usr/include/suitesparse \
-    $lib_src tests/fuzz/fuzz_load.c -o "$bin" \
+    -Iinclude $src_inc -I/usr/include/suitesparse \
+    $lib_src "$out/rt_text.c" tests/fuzz/fuzz_load.c -o "$bin" \
     -lyaml -lklu -lbtf -lamd -lcolamd -lsuitesparseconfig -lm -pthread
 
 # -rss_limit_mb: a file must not make the loader use gigabytes; -timeout: nor
@@ -45,9 +49,9 @@ if [ "$mode" = replay ]; then
     exit 0
 fi
 
-# Seed corpus: the examples, the malformed corpus, the solver cases and
-# every input that once crashed.
-for f in mechanisms/*.yaml tests/bad/*.yaml tests/solve/*.yaml $regressions; do
+# Seed corpus: the examples, the malformed corpus, the solver cases, the
+# drawn-form files and every input that once crashed.
+for f in mechanisms/*.yaml tests/bad/*.yaml tests/solve/*.yaml tests/drawn/*.yaml $regressions; do
     [ -f "$f" ] && cp "$f" "$out/corpus/seed-$(basename "$f")"
 done
 # -fork=N runs N fuzzing processes; the first crash still stops the run.

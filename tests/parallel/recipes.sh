@@ -7,6 +7,8 @@
 # and the merge then equals the unsharded run; the batch recipe's merged
 # table equals one batch's, and a batch shard killed while it runs is named
 # by merge and repaired by the batch repair recipe. Skipped (exit 0, said) without `parallel`.
+# MECH_QUICK=1: the sweep recipes over 20 x 20 variants (the documented grid
+# is 100 x 20) and the killed batch over 40 conveyor copies (not 400).
 # Run from the repository root:  MECH=build/mech sh tests/parallel/recipes.sh
 NAME=parallel . tests/lib.sh
 . tests/recipe.sh
@@ -15,14 +17,20 @@ if ! command -v parallel >/dev/null 2>&1; then
     echo "parallel: GNU Parallel is not installed (Debian package parallel); skipped"
     exit 0
 fi
+n1=100 copies=400
+[ -n "$MECH_QUICK" ] && n1=20 copies=40
+# sized NAME: the recipe NAME with the sweep's l1 over n1 values
+sized() {
+    recipe "$1" | sed "s/--vary l1=50mm:64mm:100 /--vary l1=50mm:64mm:$n1 /"
+}
 scratch
 cd "$work" || exit 2
-build/mech sweep mechanisms/conveyor.yaml --vary l1=50mm:64mm:100 --vary l2=420mm:440mm:20 \
+build/mech sweep mechanisms/conveyor.yaml --vary l1=50mm:64mm:$n1 --vary l2=420mm:440mm:20 \
     --metric range:E.x -q -o "$tmp/ref.csv" || fail "the unsharded sweep"
 
 # the sweep recipe with one shard killed while it runs
-recipe parallel-sweep >"$tmp/sweep.sh"
-[ -s "$tmp/sweep.sh" ] && pass || fail "no recipe parallel-sweep in docs/batch.md"
+sized parallel-sweep >"$tmp/sweep.sh"
+grep -q -- "--vary l1=50mm:64mm:$n1 " "$tmp/sweep.sh" && pass || fail "no recipe parallel-sweep over l1=50mm:64mm:100 in docs/batch.md"
 sh "$tmp/sweep.sh" >"$tmp/out" 2>"$tmp/err" &
 pid=$!
 k=$(running_shard 8 60)
@@ -38,7 +46,7 @@ else
     fail "no shard was seen running to kill it"
 fi
 
-recipe parallel-sweep-repair >"$tmp/repair.sh"
+sized parallel-sweep-repair >"$tmp/repair.sh"
 if run "the repair recipe" 0 sh "$tmp/repair.sh"; then
     cmp -s out/sweep.csv "$tmp/ref.csv" && pass || fail "the repaired merge differs from the unsharded run"
     [ ! -e "out/sweep.$k.csv.partial" ] && pass || fail "the repaired shard's partial file stays"
@@ -65,7 +73,7 @@ rm -rf out
 rm mechanisms  # the link to the repository's directory, not the files
 mkdir mechanisms
 cp "$repo"/mechanisms/*.yaml mechanisms/
-for i in $(seq 100 499); do cp "$repo/mechanisms/conveyor.yaml" "mechanisms/c$i.yaml"; done
+for i in $(seq 100 $((99 + copies))); do cp "$repo/mechanisms/conveyor.yaml" "mechanisms/c$i.yaml"; done
 sh "$tmp/batch.sh" >"$tmp/out" 2>"$tmp/err" &
 pid=$!
 k=$(running_shard 4 60 'summary.%s.txt.partial')
@@ -90,7 +98,7 @@ if run "the batch repair recipe" 0 sh "$tmp/brepair.sh"; then
         fail "the repaired batch merge differs from one batch's table"
     [ "$(ls out/csv | grep -c '\.csv$')" -eq "$(wc -l <out/files.txt)" ] && pass ||
         fail "the batch repair: $(ls out/csv | grep -c '\.csv$') CSVs for $(wc -l <out/files.txt) files"
-    # known problem (src/output.c, reported): SIGTERM can leave a NAME.csv.tmpXXXXXX
+    # known problem (src/output/output.c, reported): SIGTERM can leave a NAME.csv.tmpXXXXXX
     left=$(ls out/csv | grep -v '\.csv$' | tr '\n' ' ')
     [ -n "$left" ] && echo "parallel: note: the killed shard left temporary files: $left"
 fi

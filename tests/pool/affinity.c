@@ -1,5 +1,5 @@
 /* tests/pool/affinity.c: the default number of workers of mech batch and
- * mech sweep (cmd_default_jobs, src/cmd_common.c) is the number of CPUs in
+ * mech sweep (parallel_default_jobs, src/base/parallel.c) is the number of CPUs in
  * the process's affinity mask, as taskset and Slurm set it: checked by
  * restricting this process to one CPU, then to two when the machine has
  * them. Run: build/affinity (exit 0 and "affinity: ok"). */
@@ -7,14 +7,14 @@
 #include <sched.h>
 #include <stdio.h>
 
-#include "commands.h"
+#include "base.h"
 
 static int failures;
 
 static void expect(const char *what, int got, int want)
 {
     if (got != want) {
-        printf("affinity: %s: cmd_default_jobs() = %d, expected %d\n", what, got, want);
+        printf("affinity: %s: parallel_default_jobs() = %d, expected %d\n", what, got, want);
         failures++;
     }
 }
@@ -24,7 +24,7 @@ int main(void)
     cpu_set_t all, one;
     if (sched_getaffinity(0, sizeof all, &all) != 0)
         return printf("affinity: sched_getaffinity failed\n"), 1;
-    expect("the mask we started with", cmd_default_jobs(), CPU_COUNT(&all));
+    expect("the mask we started with", parallel_default_jobs(), CPU_COUNT(&all));
     int first = -1, second = -1;
     for (int c = 0; c < CPU_SETSIZE && second < 0; c++)
         if (CPU_ISSET(c, &all)) {
@@ -37,12 +37,12 @@ int main(void)
     CPU_SET(first, &one);
     if (sched_setaffinity(0, sizeof one, &one) != 0)
         return printf("affinity: sched_setaffinity failed\n"), 1;
-    expect("one CPU (taskset -c N)", cmd_default_jobs(), 1);
+    expect("one CPU (taskset -c N)", parallel_default_jobs(), 1);
     if (second >= 0) {
         CPU_SET(second, &one);
         if (sched_setaffinity(0, sizeof one, &one) != 0)
             return printf("affinity: sched_setaffinity failed\n"), 1;
-        expect("two CPUs", cmd_default_jobs(), 2);
+        expect("two CPUs", parallel_default_jobs(), 2);
     }
     if (!failures)
         printf("affinity: ok\n");

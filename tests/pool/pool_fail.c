@@ -1,4 +1,4 @@
-/* tests/pool/pool_fail.c: cmd_run_parallel (src/cmd_common.c) when a
+/* tests/pool/pool_fail.c: parallel_run (src/base/parallel.c) when a
  * pthread_create in the middle fails: it must join exactly the threads it
  * created, each once, and still run every job once.
  *
@@ -12,7 +12,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "commands.h"
+#include "base.h"
 
 enum { MAXT = 64 };
 
@@ -52,7 +52,7 @@ int pthread_join(pthread_t t, void **ret)
 
 static int runs[100];
 
-static void job(void *ctx, int i)
+static void job(void *ctx, long i)
 {
     (void)ctx;
     runs[i]++;
@@ -61,7 +61,7 @@ static void job(void *ctx, int i)
 int main(void)
 {
     int problems = 0;
-    cmd_run_parallel(100, 4, job, NULL);
+    parallel_run(100, 4, job, NULL);
     if (nmade != 3) {
         printf("pool-fail: %d threads made of 4 asked (one failing), expected 3\n", nmade);
         problems++;

@@ -11,8 +11,8 @@ BUILD=${BUILD:-build}
 PYTHON=${PYTHON:-python3}
 MAKE=${MAKE:-make}
 P="$tmp/prefix"
-if ! $MAKE --no-print-directory install PREFIX="$P" BUILD="$BUILD" ${OPT:+OPT="$OPT"} SAN="$SAN" \
-    >"$tmp/install.log" 2>&1; then
+if ! $MAKE --no-print-directory install PREFIX="$P" BUILD="$BUILD" PYTHON="$PYTHON" \
+    ${OPT:+OPT="$OPT"} SAN="$SAN" >"$tmp/install.log" 2>&1; then
     fail "make install PREFIX=$P: $(tail -n 5 "$tmp/install.log")"
     summary
     exit
@@ -22,6 +22,7 @@ if ! "$PYTHON" -c 'import numpy, pytest' 2>"$tmp/err"; then
     summary
     exit
 fi
+pydir=$("$PYTHON" python/buildinfo.py pydir)  # where make install put it for $PYTHON
 preload=""
 if [ -n "$SAN" ]; then
     for lib in $SAN_PRELOAD; do
@@ -36,7 +37,7 @@ fi
 # pytest's exit status: 0 all passed, 1 some failed, 5 no test collected
 # (also a failure here), others: usage or internal errors.
 LD_PRELOAD="$preload" ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=0} PYTHONDONTWRITEBYTECODE=1 \
-    MECH="$P/bin/mech" MECH_PREFIX="$P" PYTHONPATH="$P/lib/python3/dist-packages" \
+    MECH="$P/bin/mech" MECH_PREFIX="$P" MECH_PYDIR="$pydir" PYTHONPATH="$P/$pydir" \
     "$PYTHON" -m pytest -q -p no:cacheprovider tests/python >"$tmp/pytest.out" 2>&1
 status=$?
 tail -n 1 "$tmp/pytest.out" | sed 's/^/python: pytest: /'

@@ -56,10 +56,17 @@ def assert_same_as_cli(r, path, *args):
 
 def test_imported_from_the_install_prefix():
     prefix = os.environ.get('MECH_PREFIX')
+    pydir = os.environ.get('MECH_PYDIR', 'lib/python3/dist-packages')
     if prefix:
         assert os.path.realpath(mech.__file__).startswith(
-            os.path.realpath(os.path.join(prefix, 'lib/python3/dist-packages/mech')))
+            os.path.realpath(os.path.join(prefix, pydir, 'mech')))
     assert re.fullmatch(r'\d+\.\d+\.\d+', mech.__version__)
+    # built for this interpreter and its numpy
+    import platform
+    import sys
+    assert mech._mech.BUILT_FOR == {'python': sys.executable,
+                                    'python_version': platform.python_version(),
+                                    'numpy': np.__version__}
 
 
 @pytest.mark.parametrize('path', MECHANISMS)
@@ -180,6 +187,43 @@ def test_solve_failure_keeps_the_rows_solved():
     assert isinstance(partial, mech.Result) and 0 < partial.nrows < 361
 
 
+def test_error_kinds():
+    """MechError.kind says what failed as data, from the library's failure
+    kinds (mech_fail_kind), not from the message's words."""
+    assert mech.FAIL_KINDS[:5] == ('none', 'input', 'io', 'no-memory', 'no-assembly')
+    cases = [('tests/solve/non-grashof.yaml', 'no-assembly'),
+             ('tests/solve/dead-centre.yaml', 'dead-point'),
+             ('tests/hard/change-point.yaml', 'change-point'),
+             # issue 32 point 10: a crank far too long cannot assemble; it is
+             # not a singular position
+             ('tests/solve/crank-too-long.yaml', 'no-assembly')]
+    for path, kind in cases:
+        with pytest.raises(mech.MechError) as e:
+            mech.solve(path)
+        assert e.value.status == mech.ESOLVE and e.value.kind == kind, (path, e.value.kind)
+        errors = [d for d in e.value.diagnostics if d['severity'] == 'error']
+        assert errors[0]['kind'] == kind
+        assert e.value.partial.stats['failure'] == kind
+    with pytest.raises(mech.MechError) as e:
+        mech.solve('tests/solve/crank-too-long.yaml')
+    assert 'coupler and rocker' in str(e.value) and 'singular' not in str(e.value)
+    assert e.value.partial.stats['failure_q'] == 0.0
+    with pytest.raises(mech.MechError) as e:
+        mech.load('tests/no-such-file.yaml')
+    assert e.value.kind == 'io'
+    with pytest.raises(mech.MechError) as e:
+        mech.load('tests/bad/09-unknown-link-key-typo.yaml')
+    assert e.value.kind == 'input' and e.value.diagnostics[0]['kind'] == 'input'
+    with pytest.raises(mech.MechError) as e:
+        mech.solve('mechanisms/fourbar.yaml', outputs=['Bee'])
+    assert e.value.kind == 'input'
+    r = mech.solve('mechanisms/fourbar.yaml')
+    assert r.stats['failure'] == 'none' and np.isnan(r.stats['failure_q'])
+    # a sweep's status column comes from the kinds (mech.VARIANT_STATUS)
+    s = mech.sweep('tests/solve/crank-too-long.yaml', {'r': ['20 mm', '200 mm']}, jobs=1)
+    assert list(s['status']) == ['ok', 'no-assembly']
+
+
 def test_bad_options():
     path = 'mechanisms/fourbar.yaml'
     with pytest.raises(ValueError):
@@ -211,24 +255,27 @@ def test_result_mapping():
     assert 'rows' in repr(r)
 
 
-def test_sweep_equals_solve_with_set():
-    path = 'mechanisms/slider-crank.yaml'
-    variants = mech.sweep(path, {'r': ['30 mm', '40 mm', '50 mm']}, outputs='B', jobs=3)
-    assert [v['set'] for v in variants] == [{'r': '30 mm'}, {'r': '40 mm'}, {'r': '50 mm'}]
-    for v in variants:
-        assert v['ok'] and v['error'] is None
-        one = mech.solve(path, set=v['set'], outputs='B')
-        assert_bits_equal(v['result']['B.x'], one['B.x'], str(v['set']))
-    stroke = [np.ptp(v['result']['B.x']) for v in variants]
-    assert stroke == pytest.approx([0.06, 0.08, 0.10])
-
-
-def test_sweep_reports_variants_that_cannot_be_solved():
-    # a crank longer than the connecting rod (140 mm) cannot turn
-    variants = mech.sweep('mechanisms/slider-crank.yaml', {'r': ['40 mm', '150 mm']}, jobs=1)
-    assert [v['ok'] for v in variants] == [True, False]
-    assert variants[1]['result'] is None
-    assert variants[1]['error'].status == mech.ESOLVE
+def test_result_arrays_are_read_only():
+    r = mech.solve('mechanisms/fourbar.yaml', outputs='B')
+    assert r.nrows == 361 and all(not r[name].flags.writeable for name in r)
+    before = r['B.x'].copy()
+    with pytest.raises(ValueError, match='read-only'):
+        r['B.x'][0] = 1.0
+    with pytest.raises(ValueError, match='read-only'):
+        r['B.x'] += 1.0
+    assert_bits_equal(r['B.x'], before, 'B.x after the refused writes')
+    # the rows of a failed solve, and a sweep's results, too
+    with pytest.raises(mech.MechError) as e:
+        mech.solve('tests/solve/non-grashof.yaml')
+    assert not e.value.partial['q'].flags.writeable
+    s = mech.sweep('mechanisms/slider-crank.yaml', {'r': ['40 mm']}, metrics=['range:B.x'], jobs=1)
+    assert all(not s[name].flags.writeable for name in s)
+    # to_array and copies are the caller's
+    a = r.to_array()
+    a[0, 0] = 1.0
+    c = np.array(r['B.x'])
+    c[0] = 1.0
+    assert a.flags.writeable and c.flags.writeable
 
 
 def test_threads_give_the_same_numbers():

@@ -79,12 +79,13 @@ done
     { fail "the node is not idle: $(sinfo 2>&1; tail -n 5 "$sl/log/slurmctld.log")"; exit 1; }
 
 # Cancel task $3 of the array job named $2 once its partial output $1
-# holds rows (waits up to 60 s; gives up when the task finished first, its
-# output without .partial existing). Sets cancelled to 1 when it did.
+# is there with its head (the task runs; a sweep's rows come in blocks up to
+# a second apart) (waits up to 60 s; gives up when the task finished first,
+# its output without .partial existing). Sets cancelled to 1 when it did.
 cancel_when_running() {
     cancelled=
     for i in $(seq 1200); do
-        if [ -f "$1" ] && [ "$(wc -l <"$1")" -ge 4 ]; then
+        if [ -f "$1" ] && [ "$(wc -l <"$1")" -ge 2 ]; then
             job=$(squeue -h -n "$2" -o %F | head -n 1)
             scancel "${job}_$3" && cancelled=1
             return

@@ -34,6 +34,48 @@ static inline mech_model *test_load(const char *text, const char *path)
 static inline mech_model *load_text(const char *text) { return test_load(text, NULL); }
 static inline mech_model *load_path(const char *path) { return test_load(NULL, path); }
 
+/* mech_load_file_with of `path` with parameter `name` replaced by value in
+ * `unit` (as `mech solve --set`; name NULL: as in the file), not checked;
+ * fails the test with the diagnostics when it does not load. */
+static inline mech_model *load_with_value(const char *path, const char *name, double value,
+                                          const char *unit)
+{
+    char text[64];
+    snprintf(text, sizeof text, "%.17g %s", value, unit);
+    mech_override ov = {name, text};
+    mech_model *m = NULL;
+    mech_diag d;
+    mech_diag_init(&d);
+    int rc = mech_load_file_with(path, &ov, name ? 1 : 0, &m, &d);
+    if (rc != MECH_OK)
+        mech_diag_print(&d, stderr);
+    mech_diag_free(&d);
+    cr_assert_eq(rc, MECH_OK, "%s does not load with %s = %s", path, name ? name : "-", text);
+    return m;
+}
+
+/* The equations of m as `mech equations` prints them in `fmt` (named: with
+ * the parameters' names, mech_system_new_named), in a string to free. */
+static inline char *system_text(const mech_model *m, mech_format fmt, int named)
+{
+    mech_diag d;
+    mech_diag_init(&d);
+    mech_system *s = NULL;
+    int rc = named ? mech_system_new_named(m, &s, &d) : mech_system_new(m, &s, &d);
+    if (rc != MECH_OK)
+        mech_diag_print(&d, stderr);
+    mech_diag_free(&d);
+    cr_assert_eq(rc, MECH_OK, "%s: no system", m->file);
+    char *buf = NULL;
+    size_t len = 0;
+    FILE *mem = open_memstream(&buf, &len);
+    cr_assert_not_null(mem);
+    mech_system_print(s, fmt, mem);
+    fclose(mem);
+    mech_system_free(&s);
+    return buf;
+}
+
 /* A measured figure, printed with the tag when MECH_HARD_VERBOSE is set
  * (the tests assert bounds; this shows how far inside them they are). */
 static inline void note_tagged(const char *tag, const char *fmt, va_list ap)

@@ -161,8 +161,8 @@ Test(analysis, outputs_are_options_not_model_changes)
  * with forces spent 80 % of their time there). 200 000 joints, half of
  * them sharing a name with another: quadratic would be 4e10 comparisons,
  * minutes; linear is milliseconds. The timeout is the check. */
-#include "columns.h"
-#include "drivers.h"
+#include "study.h"
+#include "load.h"
 
 Test(analysis, joint_labels_are_linear, .timeout = 20)
 {

@@ -1,7 +1,7 @@
 /* tests/unit/test_chain_compact.c: a long chain of four-bars solved through
  * mech_solve, whose analysis frees what only its set-up needed
- * (src/plan_compact.c) and whose link frames get cos and sin only for the
- * links placed (src/kinematics.c): angles, points and rates of links far
+ * (src/solve/plan_compact.c) and whose link frames get cos and sin only for the
+ * links placed (src/solve/kinematics.c): angles, points and rates of links far
  * along the chain against the closed form of one four-bar (every odd loop
  * turns its rocker as loop 1, every even loop undoes it), rates against
  * central differences of that closed form. The chain is bench/bench_scale.c's. */

@@ -17,8 +17,8 @@
 #include <math.h>
 
 #include "helpers.h"
-#include "drivers.h"
-#include "system.h"
+#include "load.h"
+#include "equations.h"
 
 #define PI 3.14159265358979323846
 #define DEG (PI / 180.0)

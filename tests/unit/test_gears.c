@@ -1,5 +1,5 @@
-/* tests/unit/test_gears.c: gear pairs and racks (src/gears.c,
- * src/load_gears.c) against independent truths: an external pair's exact
+/* tests/unit/test_gears.c: gear pairs and racks (src/equations/gears.c,
+ * src/load/load_gears.c) against independent truths: an external pair's exact
  * ratio -r_a/r_b and an internal pair's +r_a/r_b for angles, speeds and
  * accelerations (with the 'offset' phase); the planetary train of
  * mechanisms/epicyclic.yaml and a sun-fixed variant against Willis' formula
@@ -16,7 +16,7 @@
 #include <unistd.h>
 
 #include "helpers.h"
-#include "internal.h"  /* xalloc_fail_countdown */
+#include "base.h"
 
 static const double PI = 3.14159265358979323846;
 #define DEG (PI / 180.0)

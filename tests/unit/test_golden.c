@@ -49,11 +49,11 @@
 #include <sys/stat.h>
 
 #include "closed_forms.h"
-#include "compare.h"
+#include "output.h"
 #include "mech.h"
 
-/* src/drivers.c: a law of time and its first two derivatives, evaluated on
- * the law's tree by forward differentiation (src/drivers.h; declared here
+/* src/load/drivers.c: a law of time and its first two derivatives, evaluated on
+ * the law's tree by forward differentiation (src/load/load.h; declared here
  * because drivers.h brings in the library's internal.h) */
 double law_eval(const struct mech_law *l, double t, double *dt, double *dtt);
 
@@ -357,7 +357,7 @@ static golden *load_all(int *n)
     return g;
 }
 
-static void free_all(golden *g, int n)
+static void free_goldens(golden *g, int n)
 {
     for (int i = 0; i < n; i++)
         free_golden(&g[i]);
@@ -555,7 +555,7 @@ Test(golden, columns_and_driver_range)
         }
         worst_report(g, &w);
     }
-    free_all(gs, n);
+    free_goldens(gs, n);
 }
 
 /* ---- rigid links, loop closure, sliders ---------------------------------- */
@@ -992,7 +992,7 @@ Test(golden, rigid_links_and_loop_closure)
         worst_report(g, &wc.acc);
         motions_free(g, &mo);
     }
-    free_all(gs, n);
+    free_goldens(gs, n);
 }
 
 /* ---- finite differences ------------------------------------------------- */
@@ -1114,7 +1114,7 @@ Test(golden, rates_match_differences)
         worst_report(g, &wv);
         worst_report(g, &wa);
     }
-    free_all(gs, n);
+    free_goldens(gs, n);
 }
 
 /* ---- periodicity -------------------------------------------------------- */
@@ -1151,7 +1151,7 @@ Test(golden, full_revolution_returns_to_start)
         }
         worst_report(g, &w);
     }
-    free_all(gs, n);
+    free_goldens(gs, n);
 }
 
 /* ---- closed forms ------------------------------------------------------- */
@@ -1261,7 +1261,7 @@ Test(golden, fourbar_matches_closed_form)
         check_closed_form(&gs[i], FOURBAR_COLS, NFOURBAR, fourbar_ref, &geom, 10, 0, 0, 360, 360,
                           TOL_CLOSED);
     }
-    free_all(gs, n);
+    free_goldens(gs, n);
 }
 
 /* mechanisms/double-crank.yaml, from its text: O = (0, 0), C = (20, 0) mm;
@@ -1289,7 +1289,7 @@ Test(golden, double_crank_matches_closed_form)
         check_closed_form(&gs[i], ptr, NFOURBAR, fourbar_ref, &geom, 10, 0, 0, 360, 360,
                           TOL_CLOSED);
     }
-    free_all(gs, n);
+    free_goldens(gs, n);
 }
 
 /* mechanisms/slider-crank.yaml, from its text: in line (e = 0), r = 40 mm,
@@ -1305,7 +1305,7 @@ Test(golden, slider_crank_matches_closed_form)
         check_closed_form(&gs[i], SLIDER_COLS, NSLIDER, slider_ref, &geom, 100 * PI, 0, 0, 360,
                           72, TOL_CLOSED);
     }
-    free_all(gs, n);
+    free_goldens(gs, n);
 }
 
 /* mechanisms/offset-slider-crank.yaml, from its text: the line of stroke
@@ -1322,7 +1322,7 @@ Test(golden, offset_slider_crank_matches_closed_form)
         check_closed_form(&gs[i], SLIDER_COLS, NSLIDER, slider_ref, &geom, 100 * PI, 0, 0, 360,
                           360, TOL_CLOSED);
     }
-    free_all(gs, n);
+    free_goldens(gs, n);
 }
 
 /* The force analysis's own proof (docs/forces.md): driver power, load and
@@ -1342,7 +1342,7 @@ Test(golden, forces_power_balance)
                           g->t.names[j], val(g, i, (int)j), i + 1);
         }
     }
-    free_all(gs, n);
+    free_goldens(gs, n);
 }
 
 /* mechanisms/five-bar.yaml, from its text: O = (0, 0), E = (50, 0) mm;
@@ -1398,5 +1398,5 @@ Test(golden, five_bar_matches_closed_form)
         }
         worst_report(g, &w);
     }
-    free_all(gs, n);
+    free_goldens(gs, n);
 }

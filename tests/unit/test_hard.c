@@ -1273,13 +1273,15 @@ Test(hard, chain_solves_and_work_scales)
  * Passing since the solver's set-up became linear (commit bf66b6b); before
  * it, N = 10 000 took ~15 s (load+check ~11 s, set-up 3.8 s: a ratio of
  * ~100). Two quadratic parts remain and keep the ratio at ~15-25 (see
- * tests/hard/README.md): largest_length in src/solve.c compares every pair
- * of ground points (10 001 here: 38% of the run), and intern in src/load.c
+ * tests/hard/README.md): largest_length in src/solve/solve.c compares every pair
+ * of ground points (10 001 here: 38% of the run), and intern in src/load/load.c
  * looks point names up linearly (15%). */
 Test(hard, chain_10000_solves_in_linear_time)
 {
     int big = sanitized() ? 3000 : 10000, small = big / 10;
-    chain_run a = run_chain_best(small, 10, 0.1), b = run_chain(big, 10, 0.1);
+    /* each the better of two runs: a machine busy with other work slows
+       one run of either (a CI run beside other builds measured 37) */
+    chain_run a = run_chain_best(small, 10, 0.1), b = run_chain_best(big, 10, 0.1);
     cr_assert_eq(a.rc, MECH_OK, "N = %d: %s", small, a.msg);
     cr_assert_eq(b.rc, MECH_OK, "N = %d: %s", big, b.msg);
     note("chain: CPU time of the whole run N = %d %.3g s, N = %d %.3g s, ratio %.3g (load+check "

@@ -1,4 +1,4 @@
-/* tests/unit/test_linsys.c: the linear solves (src/blocklu.c, src/linsys.c)
+/* tests/unit/test_linsys.c: the linear solves (src/solve/blocklu.c, src/solve/linsys.c)
  * against independent dense computations: random sparse matrices with a
  * hidden block triangular form (rows and columns shuffled), solved by the
  * dense-block LU and by KLU, checked against the residual of a dense
@@ -11,9 +11,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "blocklu.h"
+#include "solve.h"
 #include "helpers.h"
-#include "linsys.h"
 #include "mech.h"
 
 enum { MAXN = 64 };

@@ -1,5 +1,5 @@
-/* tests/unit/test_model.c: loading mechanism files (src/load.c) and the
- * structural check (src/model.c): every shipped mechanism, Gruebler-Kutzbach
+/* tests/unit/test_model.c: loading mechanism files (src/load/load.c) and the
+ * structural check (src/equations/check.c): every shipped mechanism, Gruebler-Kutzbach
  * counts of textbook mechanisms, SI conversion of the geometry, defaults.
  *
  * Tests run from the repository root (make test does), so mechanisms/ is
@@ -16,7 +16,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "internal.h"
+#include "base.h"
 
 #define PI_ 3.14159265358979323846
 #define EXACT 4.0
@@ -454,7 +454,7 @@ Test(mobility, triangle_is_rigid)
 }
 
 /* The over-constrained error is followed by a note naming the rigid
- * triangle (src/model.c report_rigid). */
+ * triangle (src/equations/check.c report_rigid). */
 Test(mobility, triangle_is_named_as_rigid)
 {
     mech_model *m = load_ok("triangle", TRIANGLE);

@@ -9,7 +9,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "plot.h"
+#include "output.h"
 
 Test(plot, nice_steps_are_1_2_5_times_a_power_of_ten)
 {

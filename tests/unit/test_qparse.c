@@ -1,5 +1,5 @@
 /* tests/unit/test_qparse.c: the one parser of quantity expressions
- * (src/qparse.c) on its own, through a backend that writes down every hook
+ * (src/load/qparse.c) on its own, through a backend that writes down every hook
  * it is called with (the operations in reverse Polish notation), and its
  * three real backends against each other.
  *
@@ -18,8 +18,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "drivers.h"
-#include "qparse.h"
+#include "load.h"
 
 /* ---- a backend that records ------------------------------------------ */
 
@@ -38,10 +37,10 @@ static void put(qparse *p, const char *fmt, ...)
     va_end(ap);
 }
 
-static qv r_constant(qparse *p, double v, double dv)
+static qv r_constant(qparse *p, double v)
 {
     put(p, " %g", v);
-    return (qv){v, dv, 0, {{0, 0, 0, 0}}, 0};
+    return (qv){v, 0, {{0, 0, 0, 0}}, 0};
 }
 
 static int r_unit(qparse *p, const char *u, double *scale, dim *d, const char **end)
@@ -55,7 +54,7 @@ static int r_word(qparse *p, const char *at, size_t n, qv *out)
     if (!(n == 1 && *at == 't'))
         return 0;
     put(p, " T");
-    *out = (qv){0, 0, 0, {{0, 0, 1, 0}}, 0};
+    *out = (qv){0, 0, {{0, 0, 1, 0}}, 0};
     return 1;
 }
 
@@ -63,7 +62,7 @@ static qv r_call(qparse *p, const char *name, size_t n, const char *at, qv a, qv
 {
     (void)at, (void)a, (void)b;
     put(p, " %.*s/%d", (int)n, name, two ? 2 : 1);
-    return (qv){0, 0, 0, {{0, 0, 0, 0}}, 1};
+    return (qv){0, 0, {{0, 0, 0, 0}}, 1};
 }
 
 static qv r_neg(qparse *p, qv a)

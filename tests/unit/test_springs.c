@@ -11,7 +11,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "flywheel.h"
+#include "study.h"
 #include "helpers.h"
 
 static const double PI = 3.14159265358979323846;

@@ -17,7 +17,7 @@
 #include <string.h>
 
 #include "helpers.h"
-#include "sweep_variants.h"
+#include "study.h"
 
 static void note_hard(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
 static void note_hard(const char *fmt, ...)
@@ -93,8 +93,8 @@ static double table_difference(const mech_table *got, const mech_table *want)
 
 /* Each variant (texts[k][i] for parameter names[k], nvar variants) solved
  * both ways; returns the largest relative difference over all variants. */
-static double compare_variants(const char *file, const char *const *names, int nnames,
-                               const char *const *texts, int nvar, int forces)
+static double compare_variants(sweep_shared *sh, const char *file, const char *const *names,
+                               int nnames, const char *const *texts, int nvar, int with_forces)
 {
     double worst = 0.0;
     for (int v = 0; v < nvar; v++) {
@@ -104,7 +104,7 @@ static double compare_variants(const char *file, const char *const *names, int n
         mech_diag d;
         mech_diag_init(&d);
         mech_table shared = {0}, alone = {0};
-        int rc1 = sweep_variant_solve(file, ov, nnames, forces, &shared, NULL, &d);
+        int rc1 = sweep_variant_solve(sh, ov, nnames, &shared, NULL, &d);
         mech_model *m = NULL;
         mech_summary s;
         int rc2 = mech_load_file_with(file, ov, nnames, &m, &d);
@@ -113,7 +113,7 @@ static double compare_variants(const char *file, const char *const *names, int n
         if (rc2 == MECH_OK) {
             mech_solve_options o;
             mech_solve_options_default(&o);
-            o.forces = forces;
+            o.forces = with_forces;
             rc2 = mech_solve(m, &o, &alone, NULL, &d);
         }
         if (rc1 != rc2)
@@ -145,9 +145,11 @@ Test(sweep_shared, conveyor_every_variant_as_solved_alone)
         for (int k = 0; k < 3; k++)
             texts[v * 3 + k] = buf[v][k];
     }
-    double e = compare_variants("mechanisms/conveyor.yaml", names, 3, texts, NV, 1);
+    sweep_shared *sh = sweep_shared_new("mechanisms/conveyor.yaml", 1);
+    double e = compare_variants(sh, "mechanisms/conveyor.yaml", names, 3, texts, NV, 1);
     long shared, alone;
-    sweep_variant_counts(&shared, &alone);
+    sweep_variant_counts(sh, &shared, &alone);
+    sweep_shared_free(&sh);
     cr_assert_eq(shared, NV, "%ld of %d variants through the shared analysis (%ld alone)",
                  shared, NV, alone);
     note_hard("conveyor: %d variants, largest relative difference %.3g", NV, e);
@@ -158,9 +160,11 @@ Test(sweep_shared, offset_slider_crank_every_variant)
     static const char *const names[] = {"r", "l", "e"};
     static const char *const texts[] = {"40 mm", "120 mm", "30 mm", "35 mm", "110 mm", "0 mm",
                                         "45 mm", "150 mm", "-20 mm", "30.5 mm", "99 mm", "12 mm"};
-    double e = compare_variants("mechanisms/offset-slider-crank.yaml", names, 3, texts, 4, 0);
+    sweep_shared *sh = sweep_shared_new("mechanisms/offset-slider-crank.yaml", 0);
+    double e = compare_variants(sh, "mechanisms/offset-slider-crank.yaml", names, 3, texts, 4, 0);
     long shared, alone;
-    sweep_variant_counts(&shared, &alone);
+    sweep_variant_counts(sh, &shared, &alone);
+    sweep_shared_free(&sh);
     /* e = 0 makes the ground vector O -> G of length 0 (its terms vanish from
        the numeric system), e = -20 mm turns its angle from +90 to -90 deg (a
        folded number: its derivative by e is 0): both are analysed alone */
@@ -186,9 +190,11 @@ Test(sweep_shared, fourbar_every_variant_with_forces)
         for (int k = 0; k < 6; k++)
             texts[v * 6 + k] = buf[v][k];
     }
-    double e = compare_variants(file, names, 6, texts, NV, 1);
+    sweep_shared *sh = sweep_shared_new(file, 1);
+    double e = compare_variants(sh, file, names, 6, texts, NV, 1);
     long shared, alone;
-    sweep_variant_counts(&shared, &alone);
+    sweep_variant_counts(sh, &shared, &alone);
+    sweep_shared_free(&sh);
     remove(file);
     cr_assert_eq(shared, NV, "%ld through the shared analysis, %ld alone", shared, alone);
     note_hard("four-bar: largest relative difference %.3g", e);
@@ -202,9 +208,11 @@ Test(sweep_shared, structure_changes_are_reanalysed)
     const char *file = write_temp(FOURBAR);
     static const char *const names[] = {"m2", "a"};
     static const char *const texts[] = {"0 kg", "20 mm", "0.2 kg", "20 mm", "0.2 kg", "45 mm"};
-    compare_variants(file, names, 2, texts, 3, 1);
+    sweep_shared *sh = sweep_shared_new(file, 1);
+    compare_variants(sh, file, names, 2, texts, 3, 1);
     long shared, alone;
-    sweep_variant_counts(&shared, &alone);
+    sweep_variant_counts(sh, &shared, &alone);
+    sweep_shared_free(&sh);
     remove(file);
     cr_assert_eq(shared, 1, "%ld through the shared analysis, %ld alone", shared, alone);
     cr_assert_eq(alone, 2, "%ld through the shared analysis, %ld alone", shared, alone);
@@ -232,9 +240,11 @@ Test(sweep_shared, law_parameter_is_reanalysed)
     const char *file = write_temp(text);
     static const char *const names[] = {"w"};
     static const char *const texts[] = {"10 rad/s", "20 rad/s"};
-    compare_variants(file, names, 1, texts, 2, 0);
+    sweep_shared *sh = sweep_shared_new(file, 0);
+    compare_variants(sh, file, names, 1, texts, 2, 0);
     long shared, alone;
-    sweep_variant_counts(&shared, &alone);
+    sweep_variant_counts(sh, &shared, &alone);
+    sweep_shared_free(&sh);
     remove(file);
     cr_assert(shared == 1 && alone == 1, "%ld through the shared analysis, %ld alone", shared,
               alone);
@@ -242,12 +252,13 @@ Test(sweep_shared, law_parameter_is_reanalysed)
 
 /* Every parameter of every mechanism in mechanisms/, at 0.97, 1.01 and 1.03
  * times its value, with forces: the same status and every column to 1e-12.
- * One child process per parameter (a process keeps one sweep's analysis);
+ * One child process per parameter (one sweep each);
  * its exit status is the number of variants solved through the shared
  * analysis, or 100 for a difference. */
 static int parameter_child(const char *file, const mech_param *p)
 {
     static const double factor[] = {0.97, 1.01, 1.03};
+    sweep_shared *sh = sweep_shared_new(file, 1);
     for (int k = 0; k < 3; k++) {
         char text[64];
         snprintf(text, sizeof text, "%.17g %s", p->value * factor[k], p->unit);
@@ -255,7 +266,7 @@ static int parameter_child(const char *file, const mech_param *p)
         mech_diag d;
         mech_diag_init(&d);
         mech_table shared = {0}, alone = {0};
-        int rc1 = sweep_variant_solve(file, &ov, 1, 1, &shared, NULL, &d);
+        int rc1 = sweep_variant_solve(sh, &ov, 1, &shared, NULL, &d);
         mech_model *m = NULL;
         mech_summary s;
         int rc2 = mech_load_file_with(file, &ov, 1, &m, &d);
@@ -281,7 +292,8 @@ static int parameter_child(const char *file, const mech_param *p)
             return 100;
     }
     long shared, alone;
-    sweep_variant_counts(&shared, &alone);
+    sweep_variant_counts(sh, &shared, &alone);
+    sweep_shared_free(&sh);
     return (int)shared;
 }
 
@@ -321,4 +333,148 @@ Test(sweep_shared, every_parameter_of_every_mechanism)
                   through, variants);
     note_hard("%d variants of every parameter of every mechanism, %d through the shared "
               "analysis", variants, through);
+}
+
+/* ---- what the shared analysis folds, and the numbers it takes ------------ */
+
+/* A geared five-bar (docs/format.md section 6.4) with a spring, friction in
+ * the pin B, forces, and parameters in the gear pair's phase (ph), the
+ * coupler's and the rod's length and the coupler's mass (l), and the
+ * driver's speed (w). */
+static const char GEARED[] =
+    "name: geared five-bar with a spring and friction\n"
+    "units: {length: mm, angle: deg}\n"
+    "parameters: {l: 60 mm, ph: 90, w: 20 rad/s}\n"
+    "ground: {O: [0, 0], C: [60, 0], S: [30, -40]}\n"
+    "links:\n"
+    "  crank1: {points: {O: [0, 0], A: [15, 0]}, mass: 0.1 kg, center: [0, 0],"
+    " inertia: 2e-5 kg*m^2}\n"
+    "  crank2: {points: {C: [0, 0], D: [15, 0]}, mass: 0.3 kg, center: [0, 0],"
+    " inertia: 2.4e-4 kg*m^2}\n"
+    "  coupler: {points: {A: [0, 0], B: [l, 0], P: {length: 30, angle: -30}},"
+    " mass: 0.05 kg * l / 60 mm, center: [l/2, 0], inertia: 1.5e-5 kg*m^2}\n"
+    "  rod: {points: {D: [0, 0], B: [l, 0]}, mass: 0.05 kg, center: [l/2, 0],"
+    " inertia: 1.5e-5 kg*m^2}\n"
+    "joints:\n"
+    "  - {revolute: B, friction: 0.1, pin_radius: 5 mm}\n"
+    "driver: {link: crank1, angle: {from: 0, to: 720, steps: 72}, speed: w}\n"
+    "initial: {crank2: 90, coupler: 70, rod: 110}\n"
+    "branch:\n  - {points: [A, B, D], turn: cw}\n"
+    "gears:\n"
+    "  - {name: g12, gear: crank1, with: crank2, teeth: [20, 40], module: 2 mm,"
+    " offset: [0, ph]}\n"
+    "springs:\n"
+    "  - {name: s, between: [P, S], links: [coupler, ground], stiffness: 200 N/m,"
+    " free_length: 40 mm}\n"
+    "outputs: {points: [A, B, D, P], links: [crank1, crank2, coupler, rod], forces: true}\n";
+
+/* A law of time with a parameter (drivers.c folds it into the driver rows). */
+static const char LAWS[] =
+    "name: five-bar driven by laws of time\n"
+    "units: {length: mm, angle: deg}\n"
+    "parameters: {amp: 20 deg}\n"
+    "ground: {O: [0, 0], E: [50, 0]}\n"
+    "links:\n"
+    "  crank1: {points: {O: [0, 0], A: [25, 0]}}\n"
+    "  arm1: {points: {A: [0, 0], P: [60, 0]}}\n"
+    "  arm2: {points: {B: [0, 0], P: [60, 0]}}\n"
+    "  crank2: {points: {E: [0, 0], B: [25, 0]}}\n"
+    "initial: {arm1: 60 deg, arm2: 120 deg}\n"
+    "branch:\n  - {points: [A, P, B], turn: cw}\n"
+    "sweep: {time: {from: 0 s, to: 1 s, steps: 50}}\n"
+    "drivers:\n"
+    "  - {link: crank1, angle: \"90 deg + 360 deg/s * t\"}\n"
+    "  - {link: crank2, angle: \"60 deg + amp * sin(2 * pi * t / 1 s)\"}\n"
+    "outputs: {points: [P], links: [arm1, arm2]}\n";
+
+/* A gear pair's phase and a law of time are folded into the system's rows:
+ * a variant that changes one is analysed on its own (through the shared
+ * analysis it kept the base's numbers and gave the base's table). The first
+ * value is the file's own. */
+static void reanalysed(const char *text, const char *name, const char *const *values, int with_forces)
+{
+    const char *file = write_temp(text);
+    sweep_shared *sh = sweep_shared_new(file, with_forces);
+    compare_variants(sh, file, (const char *const[]){name}, 1, values, 3, with_forces);
+    long shared, alone;
+    sweep_variant_counts(sh, &shared, &alone);
+    sweep_shared_free(&sh);
+    cr_assert_eq(alone, 2, "%ld through the shared analysis, %ld alone", shared, alone);
+    remove(file);
+}
+
+Test(sweep_shared, gear_phases_are_not_folded_from_the_base)
+{
+    reanalysed(GEARED, "ph", (const char *const[]){"90", "95", "100"}, 1);
+}
+
+Test(sweep_shared, laws_of_time_are_not_folded_from_the_base)
+{
+    reanalysed(LAWS, "amp", (const char *const[]){"20 deg", "10 deg", "30 deg"}, 0);
+}
+
+static mech_model *load_with(const char *file, const mech_override *ov, int nov)
+{
+    mech_model *m = NULL;
+    mech_summary s;
+    mech_diag d;
+    mech_diag_init(&d);
+    int rc = mech_load_file_with(file, ov, nov, &m, &d);
+    if (rc == MECH_OK)
+        rc = mech_check(m, &s, &d);
+    if (rc != MECH_OK)
+        mech_diag_print(&d, stderr);
+    cr_assert_eq(rc, MECH_OK);
+    mech_diag_free(&d);
+    return m;
+}
+
+/* Structure apart from numbers: a variant solved through a view of the base
+ * A's analysis (the base's structure, every number the plans take from a
+ * model computed from the variant B by solver_plan_numbers and
+ * forces_plan_numbers) gives, bit for bit, the table of B's own analysis
+ * with the same leaves (its numbers computed by the same functions at its
+ * set-up). A and B differ in a length (lengths and angles that are leaves,
+ * the length scale, the link frames' attachment points), a mass (the force
+ * plan's model) and the driver's speed (the friction's speed scale): a
+ * number a plan took at set-up and the view did not take again would keep
+ * A's value and change the table. */
+Test(sweep_shared, a_variant_takes_every_number_from_its_model)
+{
+    const char *file = write_temp(GEARED);
+    static const char *const names[] = {"l", "w"};
+    mech_override ov[2] = {{"l", "63 mm"}, {"w", "27 rad/s"}};
+    mech_model *a = load_with(file, NULL, 0), *b = load_with(file, ov, 2);
+    mech_model *bv = load_with(file, ov, 2);
+    variant_base *va = NULL, *vb = NULL;
+    mech_diag d;
+    mech_diag_init(&d);
+    cr_assert_eq(vbase_new(a, names, 2, 1, &va, &d), MECH_OK);
+    cr_assert_eq(vbase_new(b, names, 2, 1, &vb, &d), MECH_OK);
+    mech_table through = {0}, own = {0};
+    cr_assert_eq(vbase_solve(va, bv, &through, &d), MECH_OK, "B through A's analysis");
+    cr_assert_eq(mech_analysis_solve(vbase_analysis(vb), NULL, 0, &own, NULL, &d), MECH_OK);
+    cr_assert_eq(through.nrows, 73);
+    cr_assert_eq(through.nrows, own.nrows);
+    cr_assert_eq(through.ncolumns, own.ncolumns);
+    int friction = mech_table_column(&own, "friction.power");
+    cr_assert_geq(friction, 0, "a friction column");
+    for (int r = 0; r < own.nrows; r++)
+        for (int c = 0; c < own.ncolumns; c++) {
+            double x = mech_table_get(&through, r, c), y = mech_table_get(&own, r, c);
+            cr_assert(memcmp(&x, &y, sizeof x) == 0, "row %d, %s: %.17g through A's analysis, "
+                      "%.17g in B's own", r, own.columns[c].name, x, y);
+        }
+    /* and B's numbers are not A's: the same row of A differs */
+    mech_table ta = {0};
+    cr_assert_eq(mech_analysis_solve(vbase_analysis(va), NULL, 0, &ta, NULL, &d), MECH_OK);
+    cr_assert_neq(mech_table_get(&ta, 10, friction), mech_table_get(&own, 10, friction));
+    mech_table_free(&ta);
+    mech_table_free(&through);
+    mech_table_free(&own);
+    vbase_free(&va);
+    vbase_free(&vb);
+    mech_model_free(&bv);
+    mech_diag_free(&d);
+    remove(file);
 }

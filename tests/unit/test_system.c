@@ -13,7 +13,7 @@
 #include <string.h>
 
 #include "helpers.h"
-#include "system.h"
+#include "equations.h"
 
 /* ---- helpers ----------------------------------------------------------- */
 

@@ -4,7 +4,7 @@
  * the loads, never the library's own formula applied to its own output. The
  * mechanisms are the files of tests/truths/ (README.md there).
  *
- * - the kinematics of a link placed through a slider (src/kinematics.c,
+ * - the kinematics of a link placed through a slider (src/solve/kinematics.c,
  *   slide_offset and place_link): an oscillating cylinder written both ways
  *   round (rod sliding in the cylinder; cylinder sliding on the rod), so that
  *   the spanning tree places a link through the slider once from the guide
@@ -18,7 +18,7 @@
  * - pin friction: a slider-crank with friction in its three pins, the moments
  *   mu r |F| against the relative rotation of each pin (driver torque,
  *   reactions, the piston guide's couple, the dissipated power);
- * - the branch-jump guard (src/sweep.c, try_position): a four-bar, and two
+ * - the branch-jump guard (src/study/sweep.c, try_position): a four-bar, and two
  *   identical four-bars on one crank, output every half turn, which without
  *   the guard land on the other assembly (the twin silently: det J keeps its
  *   sign).
@@ -94,7 +94,7 @@ static void compare_rows(const mech_table *t, const char *const *names, int n, c
  *   P = A + R p, P' = A' + phi' k x R p, P'' = A'' + phi'' k x R p - phi'^2 R p.
  * The library instead builds the rod's frame through the slider:
  * C + s u and its rates with the sliding, Coriolis and centripetal terms
- * (src/kinematics.c, slide_offset), so P tests those. */
+ * (src/solve/kinematics.c, slide_offset), so P tests those. */
 typedef struct cylinder {
     double r, cx, cy;   /* crank, ground pivot C */
     double px, py;      /* P on the rod, rod frame (origin A) */

@@ -1,8 +1,8 @@
 /* tests/unit/test_units.c: units, dimensions and quantity expressions
- * (src/units.c).
+ * (src/load/units.c).
  *
  * Expected SI values are written out independently of the unit table in
- * src/units.c (from the definitions: 1 in = 25.4 mm exactly, 1 rev = 2 pi rad,
+ * src/load/units.c (from the definitions: 1 in = 25.4 mm exactly, 1 rev = 2 pi rad,
  * 1 rpm = 2 pi / 60 rad/s, ...), never copied from it.
  *
  * Tolerances, relative to the expected value:
@@ -20,7 +20,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "internal.h"
+#include "base.h"
 
 #define PI_ 3.14159265358979323846
 #define EXACT 4.0
@@ -106,7 +106,7 @@ typedef struct unit_case {
     double si;  /* SI value, written from the unit's definition */
 } unit_case;
 
-/* Every unit of src/units.c, one at a time (keep in step with its table). */
+/* Every unit of src/load/units.c, one at a time (keep in step with its table). */
 static const unit_case every_unit[] = {
     {"1 m", Q_LENGTH, 1.0},
     {"1 cm", Q_LENGTH, 0.01},
@@ -446,7 +446,7 @@ Test(expressions, pi_is_pi_radians)
  * expected ("expected a length, got a pure number"); the same for a bare
  * parameter, "r * cos(beta)" with r: 40. The natural reading (and the rule
  * "a bare number takes the default unit of whatever quantity it turns out to
- * be") says 50 mm. Disabled: a loader bug in src/units.c (parse_term sets
+ * be") says 50 mm. Disabled: a loader bug in src/load/units.c (parse_term sets
  * bare = a.bare && b.bare; a bare factor times a dimensionless non-bare one
  * should stay bare). Write "100 mm * cos(60)" meanwhile. */
 Test(expressions, bare_number_times_cosine_is_a_length)

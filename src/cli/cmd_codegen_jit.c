@@ -1,0 +1,644 @@
+/* src/cli/cmd_codegen_jit.c: `mech solve --jit` (docs/codegen.md, section "mech
+ * solve --jit"): the code `mech codegen` writes for the file, compiled by
+ * the system's C compiler ($CC, else cc) into a shared object in a private
+ * temporary directory, loaded with dlopen and used for the sweep. The
+ * generated code computes the interpreter's values bit for bit, so the
+ * table is the interpreter's as long as every row takes the one Newton
+ * solve from the predictor that the interpreter's continuation takes; a row
+ * where the interpreter would do more (step halving: the predictor moves
+ * too far, Newton lands far from the prediction or det J changes sign; a
+ * failure: no assembly, a singular position, a branch condition, the
+ * forces), an option the generated code does not follow, or no compiler,
+ * and the interpreter solves the sweep instead, with a note on stderr. A
+ * row with a value that is not finite stops the sweep with the
+ * interpreter's error (its check, sweep.c), as the interpreter does. */
+#include <dlfcn.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <signal.h>
+#include <spawn.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "codegen.h"
+#include "cli.h"
+
+extern char **environ;  /* the compiler's environment: ours (POSIX) */
+
+/* What the shared object adds to the generated source (prefix jit): the
+ * state's size and one row with the continuation's acceptance tests
+ * (src/solve/continuation.c cont_advance and cont_try). */
+static const char *const wrapper[] = {
+    "#include \"gen.c\"",
+    "",
+    "size_t jit_state_size(void);",
+    "int jit_nout(void);",
+    "const char *const *jit_names(void);",
+    "int jit_row(void *vs, double q, double qd, double qdd, int first, double *out, double *info);",
+    "",
+    "size_t jit_state_size(void) { return sizeof(jit_state); }",
+    "int jit_nout(void) { return JIT_NOUT; }",
+    "const char *const *jit_names(void) { return jit_column_names; }",
+    "",
+    "/* Row q: 0 solved (out, info set), a status of jit_solve, or -1 where the",
+    " * interpreter's continuation would not accept its first step. */",
+    "int jit_row(void *vs, double q, double qd, double qdd, int first, double *out, double *info)",
+    "{",
+    "    jit_state *s = vs;",
+    "    int st;",
+    "    if (first) {",
+    "        jit_init(s);",
+    "        st = jit_solve(s, q, qd, qdd);",
+    "    } else {",
+    "        double xpred[NX + 1], move;",
+    "        int det = s->det_sign;",
+    "        jit_predict(s, q);",
+    "        for (int i = 0; i < NX; i++) {",
+    "            xpred[i] = s->x[i];",
+    "            s->dx[i] = s->x[i] - s->xc[i];",
+    "        }",
+    "        move = rt_step_size(s->dx, unit, NX);",
+    "        if (move > 0.25)",
+    "            return -1;",
+    "        st = jit_solve(s, q, qd, qdd);",
+    "        if (st == 0) {",
+    "            for (int i = 0; i < NX; i++)",
+    "                s->dx[i] = s->x[i] - xpred[i];",
+    "            if (rt_step_size(s->dx, unit, NX) > 0.5 * move + 0.05 || s->det_sign != det)",
+    "                return -1;",
+    "        }",
+    "    }",
+    "    if (st != 0)",
+    "        return st;",
+    "    for (int c = 0; c < JIT_NOUT; c++)",
+    "        out[c] = s->out[c];",
+    "    info[0] = s->iterations;",
+    "    info[1] = s->residual;",
+    "    /* info[2] in: the smallest rcond so far; s->rcond is a lower bound of the",
+    "       interpreter's value, exact when it is not (docs/codegen.md): only one",
+    "       below the smallest so far can change it */",
+    "    info[2] = s->rcond < info[2] ? jit_rcond(s) : s->rcond;",
+    "    info[3] = info[4] = 0.0;",
+    "#ifdef NF",
+    "    info[3] = fmax(fabs(s->power_residual), fabs(s->power_residual0));",
+    "    info[4] = s->friction_iterations;",
+    "#endif",
+    "    return 0;",
+    "}",
+    NULL};
+
+/* How the last sweep ran (cmd_jit_how). */
+static char how[700];
+
+const char *cmd_jit_how(void)
+{
+    return how;
+}
+
+typedef struct jit {
+    void *so;
+    size_t (*state_size)(void);
+    int (*nout)(void);
+    const char *const *(*names)(void);
+    int (*row)(void *, double, double, double, int, double *, double *);
+} jit;
+
+/* Why the options keep the sweep with the interpreter, or NULL. */
+static const char *unsupported(const mech_solve_options *o)
+{
+    mech_solve_options d;
+    mech_solve_options_default(&d);
+    return o->outputs ? "--outputs"
+           : o->diagnostics ? "--diagnostics"
+           : o->limit_rows ? "--range assembly"
+           : o->tol != d.tol ? "--tol"
+           : o->max_iter != d.max_iter ? "--max-iter"
+           : o->min_rcond != d.min_rcond ? "--min-rcond"
+           : o->want != d.want ? "--level"
+           : o->linear_solver != d.linear_solver ? "--linear-solver"
+                                                : NULL;
+}
+
+static int write_text(const char *path, const codegen *g)
+{
+    FILE *f = fopen(path, "w");
+    if (!f)
+        return -1;
+    int rc = g ? codegen_emit_source(f, g) : 0;
+    for (int i = 0; !g && wrapper[i]; i++)
+        fprintf(f, "%s\n", wrapper[i]);
+    rc |= ferror(f) ? -1 : 0;
+    return fclose(f) != 0 || rc != 0 ? -1 : 0;
+}
+
+/* ---- the private directory and the compiler, undone on a signal ---------
+ * From mkdtemp to the directory's removal, SIGTERM, SIGINT and SIGHUP stop
+ * the compiler's process group (SIGTERM, SIGKILL after a second), remove
+ * the directory, then take the action they had before (src/output/output.c's
+ * handler, which removes the outputs being written, or the default): mech
+ * dies of the signal and leaves neither files nor a compiler behind. The
+ * compiler runs in a process group of its own, so that it is stopped as a
+ * whole (its driver and the cc1, as, ld it starts). One build at a time:
+ * mech solve is one thread. */
+enum { F_GEN, F_JIT, F_SO, F_ERR, JIT_FILES };
+static const char *const jit_file_names[JIT_FILES] = {"gen.c", "jit.c", "jit.so", "cc.err"};
+static const int guarded_signals[] = {SIGTERM, SIGINT, SIGHUP};
+
+static struct {
+    volatile sig_atomic_t live;      /* the directory exists: remove it */
+    volatile sig_atomic_t compiler;  /* the compiler's pid, its process group too; 0: none */
+    char dir[512];
+    char files[JIT_FILES][600];      /* the directory's files, built before they exist */
+    struct sigaction old[COUNT_OF(guarded_signals)];
+    int installed[COUNT_OF(guarded_signals)];
+} guard;
+
+static void guarded_set(sigset_t *set)
+{
+    sigemptyset(set);
+    for (size_t i = 0; i < COUNT_OF(guarded_signals); i++)
+        sigaddset(set, guarded_signals[i]);
+}
+
+/* Async-signal-safe: SIGTERM to the compiler's group, a second for its
+ * first process to end, then SIGKILL to what is left of the group. */
+static void stop_compiler(pid_t pid)
+{
+    struct timespec tick = {0, 10000000};
+    int reaped = 0;
+    kill(-pid, SIGTERM);
+    for (int i = 0; i < 100 && !reaped; i++) {
+        pid_t w = waitpid(pid, NULL, WNOHANG);
+        reaped = w == pid || (w < 0 && errno != EINTR);
+        if (!reaped)
+            nanosleep(&tick, NULL);
+    }
+    kill(-pid, SIGKILL);
+    while (!reaped && waitpid(pid, NULL, 0) < 0 && errno == EINTR)
+        ;
+}
+
+/* Async-signal-safe: the directory's files and the directory. */
+static void remove_guarded_dir(void)
+{
+    if (!guard.live)
+        return;
+    for (int i = 0; i < JIT_FILES; i++)
+        unlink(guard.files[i]);
+    rmdir(guard.dir);
+    guard.live = 0;
+}
+
+static void restore_actions(void)
+{
+    for (size_t i = 0; i < COUNT_OF(guarded_signals); i++)
+        if (guard.installed[i])
+            sigaction(guarded_signals[i], &guard.old[i], NULL);
+}
+
+static void on_guarded_signal(int sig)
+{
+    int e = errno;
+    if (guard.compiler > 0)
+        stop_compiler((pid_t)guard.compiler);
+    remove_guarded_dir();
+    restore_actions();
+    errno = e;
+    raise(sig);  /* blocked until the handler returns, then the former action's */
+}
+
+static void guard_begin(void)
+{
+    for (size_t i = 0; i < COUNT_OF(guarded_signals); i++) {
+        struct sigaction sa;
+        guard.installed[i] = 0;
+        if (sigaction(guarded_signals[i], NULL, &guard.old[i]) != 0 ||
+                guard.old[i].sa_handler == SIG_IGN)
+            continue;  /* nohup: an ignored signal stays ignored */
+        memset(&sa, 0, sizeof sa);
+        sa.sa_handler = on_guarded_signal;
+        guarded_set(&sa.sa_mask);
+        guard.installed[i] = sigaction(guarded_signals[i], &sa, NULL) == 0;
+    }
+}
+
+/* The directory removed (the loaded object stays mapped), the former
+ * actions back; a signal meanwhile waits for them. */
+static void guard_end(void)
+{
+    sigset_t set, old;
+    guarded_set(&set);
+    sigprocmask(SIG_BLOCK, &set, &old);
+    remove_guarded_dir();
+    restore_actions();
+    sigprocmask(SIG_SETMASK, &old, NULL);
+}
+
+/* mkdtemp in tmp, its file names set for the handler in the same step. */
+static int guard_mkdtemp(const char *tmp)
+{
+    sigset_t set, old;
+    guarded_set(&set);
+    sigprocmask(SIG_BLOCK, &set, &old);
+    snprintf(guard.dir, sizeof guard.dir, "%s/mech-jit.XXXXXX", tmp);
+    int ok = mkdtemp(guard.dir) != NULL;
+    for (int i = 0; ok && i < JIT_FILES; i++)
+        snprintf(guard.files[i], sizeof guard.files[i], "%s/%s", guard.dir, jit_file_names[i]);
+    guard.live = ok;
+    sigprocmask(SIG_SETMASK, &old, NULL);
+    return ok ? 0 : -1;
+}
+
+/* The first line of the compiler's messages, into buf. */
+static void first_line(const char *path, char *buf, size_t size)
+{
+    FILE *f = fopen(path, "r");
+    buf[0] = '\0';
+    if (f && fgets(buf, (int)size, f))
+        buf[strcspn(buf, "\n")] = '\0';
+    if (f)
+        fclose(f);
+}
+
+/* The compiler's command line: $CC split on blanks (the compiler and its
+ * own flags, no shell: no quoting, no expansion), then ours. */
+enum { CC_MAX_WORDS = 32 };
+typedef struct cc_command {
+    char words[1024];  /* $CC with NULs for its blanks */
+    char *argv[CC_MAX_WORDS + 9];
+} cc_command;
+
+static int cc_command_init(cc_command *c, const char *cc)
+{
+    static const char *const ours[] = {"-std=c11", "-O2", "-fPIC", "-shared", "-o"};
+    if (strlen(cc) >= sizeof c->words)
+        return -1;
+    strcpy(c->words, cc);
+    int n = 0;
+    char *save = NULL;
+    for (char *w = strtok_r(c->words, " \t\n", &save); w; w = strtok_r(NULL, " \t\n", &save)) {
+        if (n == CC_MAX_WORDS)
+            return -1;
+        c->argv[n++] = w;
+    }
+    if (n == 0)
+        c->argv[n++] = (char *)"cc";
+    for (size_t i = 0; i < COUNT_OF(ours); i++)
+        c->argv[n++] = (char *)ours[i];
+    c->argv[n++] = guard.files[F_SO];
+    c->argv[n++] = guard.files[F_JIT];
+    c->argv[n++] = (char *)"-lm";
+    c->argv[n] = NULL;
+    return 0;
+}
+
+/* Start the compiler in its own process group, its output in cc.err: its
+ * pid, or -1 with errno. The signals are blocked from the spawn until the
+ * handler knows the pid. */
+static pid_t spawn_compiler(cc_command *c)
+{
+    posix_spawn_file_actions_t fa;
+    posix_spawnattr_t at;
+    sigset_t set, old;
+    pid_t pid = -1;
+    posix_spawn_file_actions_init(&fa);
+    posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
+    posix_spawn_file_actions_addopen(&fa, 1, guard.files[F_ERR], O_WRONLY | O_CREAT | O_TRUNC,
+                                     0600);
+    posix_spawn_file_actions_adddup2(&fa, 1, 2);
+    posix_spawnattr_init(&at);
+    guarded_set(&set);
+    sigprocmask(SIG_BLOCK, &set, &old);
+    posix_spawnattr_setsigmask(&at, &old);
+    posix_spawnattr_setpgroup(&at, 0);
+    posix_spawnattr_setflags(&at, POSIX_SPAWN_SETPGROUP | POSIX_SPAWN_SETSIGMASK);
+    int e = posix_spawnp(&pid, c->argv[0], &fa, &at, c->argv, environ);
+    if (e == 0)
+        guard.compiler = pid;
+    sigprocmask(SIG_SETMASK, &old, NULL);
+    posix_spawnattr_destroy(&at);
+    posix_spawn_file_actions_destroy(&fa);
+    errno = e;
+    return e == 0 ? pid : -1;
+}
+
+/* $CC, else cc. */
+static const char *compiler_words(void)
+{
+    const char *cc = getenv("CC");
+    return cc && *cc ? cc : "cc";
+}
+
+/* The compiler's file as "PATH bytes=N mtime=S.NS inode=I" (the program
+ * $CC names, found in $PATH as posix_spawnp finds it), so that another
+ * compiler, or the same one upgraded, makes another key. */
+static void compiler_identity(const char *word, char *buf, size_t size)
+{
+    char path[1024];
+    struct stat s;
+    const char *dirs = strchr(word, '/') ? "" : getenv("PATH");
+    snprintf(buf, size, "%s (not found)", word);
+    for (const char *d = dirs ? dirs : "/usr/bin:/bin"; d;) {
+        const char *end = strchr(d, ':');
+        int len = end ? (int)(end - d) : (int)strlen(d);
+        if (!strchr(word, '/'))
+            snprintf(path, sizeof path, "%.*s/%s", len, len ? d : ".", word);
+        else
+            snprintf(path, sizeof path, "%s", word);
+        if (stat(path, &s) == 0 && S_ISREG(s.st_mode) && access(path, X_OK) == 0) {
+            snprintf(buf, size, "%.1000s bytes=%lld mtime=%lld.%09ld inode=%llu",
+                     path, (long long)s.st_size,
+                     (long long)s.st_mtim.tv_sec, s.st_mtim.tv_nsec,
+                     (unsigned long long)s.st_ino);
+            return;
+        }
+        d = end && !strchr(word, '/') ? end + 1 : NULL;
+    }
+}
+
+/* What the compiled object depends on, as text (the cache's key): mech's
+ * version, the compiler (its file and its command line but the
+ * directory's paths), the generated source and the wrapper; NULL when it
+ * cannot be read. */
+static char *cache_key(const cc_command *c, size_t *n)
+{
+    char *text = NULL;
+    FILE *f = open_memstream(&text, n);
+    if (!f)
+        return NULL;
+    char id[1200];
+    compiler_identity(c->argv[0], id, sizeof id);
+    fprintf(f, "mech %s\ncompiler %s\ncommand", MECH_VERSION, id);
+    for (int i = 0; c->argv[i]; i++)
+        if (c->argv[i] != guard.files[F_SO] && c->argv[i] != guard.files[F_JIT])
+            fprintf(f, " %s", c->argv[i]);
+    fputs("\n", f);
+    FILE *g = fopen(guard.files[F_GEN], "r");
+    char buf[8192];
+    for (size_t r; g && (r = fread(buf, 1, sizeof buf, g)) > 0;)
+        fwrite(buf, 1, r, f);
+    int bad = !g || ferror(g);
+    if (g)
+        fclose(g);
+    for (int i = 0; wrapper[i]; i++)
+        fprintf(f, "%s\n", wrapper[i]);
+    bad |= ferror(f);
+    bad |= fclose(f) != 0;
+    if (bad) {
+        free(text);
+        return NULL;
+    }
+    return text;
+}
+
+/* Compile the directory's jit.c into jit.so with the command c: 0, or -1
+ * with why (after "no C compiler ran") in note. */
+static int compile(cc_command *cp, char *note, size_t size)
+{
+    const char *cc = compiler_words();
+    char buf[128];
+    pid_t pid = spawn_compiler(cp);
+    if (pid < 0)
+        return snprintf(note, size, "no C compiler ran ('%s': %s)", cp->argv[0],
+                        diag_strerror(errno, buf, sizeof buf)), -1;
+    int status = 0;
+    pid_t w;
+    while ((w = waitpid(pid, &status, 0)) < 0 && errno == EINTR)
+        ;
+    guard.compiler = 0;
+    if (w == pid && WIFEXITED(status) && WEXITSTATUS(status) == 0)
+        return 0;
+    char msg[300];
+    first_line(guard.files[F_ERR], msg, sizeof msg);
+    if (msg[0])
+        return snprintf(note, size, "no C compiler ran ('%s' failed: %s)", cc, msg), -1;
+    if (w == pid && WIFSIGNALED(status))
+        return snprintf(note, size, "no C compiler ran ('%s' was killed by signal %d)", cc,
+                        WTERMSIG(status)), -1;
+    return snprintf(note, size, "no C compiler ran ('%s' exited with status %d)", cc,
+                    w == pid && WIFEXITED(status) ? WEXITSTATUS(status) : -1), -1;
+}
+
+/* Generate, compile and load the solver of m in the private directory: 0,
+ * or -1 with why in note. */
+static int build_in_dir(jit *j, const mech_model *m, const mech_solve_options *o,
+                        mech_solve_stats *st, char *note, size_t size)
+{
+    codegen g;
+    mech_diag d;
+    mech_diag_init(&d);
+    codegen_options co = {"jit", NULL, o->all_blocks, o->forces, o->friction};
+    int rc = codegen_init(&g, m, &co, &d);
+    if (rc != MECH_OK) {
+        snprintf(note, size, "the code generator: %s",
+                 d.count > 0 ? d.entries[d.count - 1].message : "failed");
+        codegen_free(&g);
+        mech_diag_free(&d);
+        return -1;
+    }
+    mech_diag_free(&d);
+    st->nunknowns = g.sp.n;  /* the plan's sizes, as mech_solve reports them */
+    st->nsolved = g.sp.ns;
+    st->nblocks = g.sp.nblocks;
+    st->nblocks_solved = g.sp.nblocks_solved;
+    rc = write_text(guard.files[F_GEN], &g);
+    codegen_free(&g);
+    if (rc != 0 || write_text(guard.files[F_JIT], NULL) != 0)
+        return snprintf(note, size, "cannot write the generated code in %s", guard.dir), -1;
+    cc_command c;
+    if (cc_command_init(&c, compiler_words()) != 0)
+        return snprintf(note, size, "no C compiler ran ($CC has more than %d words or %zu "
+                        "characters)", CC_MAX_WORDS, sizeof c.words - 1), -1;
+    size_t klen = 0;
+    char *key = cache_key(&c, &klen);
+    char cached[600];
+    jit_cache cache;
+    jit_cache_open(&cache);
+    int hit = key && jit_cache_find(&cache, key, klen, cached, sizeof cached);
+    double t0 = clock_seconds();
+    rc = hit ? 0 : compile(&c, note, size);
+    if (rc == 0 && !hit) {
+        int stored = key && jit_cache_put(&cache, key, klen, guard.files[F_SO]) == 0;
+        snprintf(how, sizeof how, "compiled in %.2f s; %s%s", clock_seconds() - t0,
+                 stored ? "stored in the cache " : "not cached: ",
+                 stored ? cache.dir : cache.usable ? "cannot write the cache" : cache.why);
+    } else if (hit) {
+        snprintf(how, sizeof how, "from the cache, %s", cached);
+    }
+    jit_cache_close(&cache);
+    free(key);
+    if (rc != 0)
+        return -1;
+    j->so = dlopen(hit ? cached : guard.files[F_SO], RTLD_NOW | RTLD_LOCAL);
+    if (!j->so)
+        return snprintf(note, size, "dlopen: %s", dlerror()), -1;
+    /* POSIX: dlsym's object pointer holds a function's address */
+    void *f[4] = {dlsym(j->so, "jit_state_size"), dlsym(j->so, "jit_nout"),
+                  dlsym(j->so, "jit_names"), dlsym(j->so, "jit_row")};
+    memcpy(&j->state_size, &f[0], sizeof f[0]);
+    memcpy(&j->nout, &f[1], sizeof f[1]);
+    memcpy(&j->names, &f[2], sizeof f[2]);
+    memcpy(&j->row, &f[3], sizeof f[3]);
+    if (!j->state_size || !j->nout || !j->names || !j->row)
+        return snprintf(note, size, "the shared object lacks its functions"), -1;
+    return 0;
+}
+
+/* Build the solver of m in a private directory of $TMPDIR (else /tmp),
+ * removed before returning, also on a signal meanwhile: 0, or -1 with why
+ * in note. */
+static int jit_build(jit *j, const mech_model *m, const mech_solve_options *o,
+                     mech_solve_stats *st, char *note, size_t size)
+{
+    const char *tmp = getenv("TMPDIR");
+    if (!tmp || !*tmp || strlen(tmp) > 400)
+        tmp = "/tmp";
+    guard_begin();
+    int rc = guard_mkdtemp(tmp) == 0 ? build_in_dir(j, m, o, st, note, size)
+             : (snprintf(note, size, "cannot make a temporary directory in %s", tmp), -1);
+    guard_end();
+    return rc;
+}
+
+/* The interpreter's driver positions for o (sweep.c sweep_values). */
+static double *positions(const mech_model *m, const mech_solve_options *o, int *n)
+{
+    int steps = o->has_range ? (o->steps > 0 ? o->steps : 1) : m->driver.nvalues - 1;
+    double *v = xcalloc((size_t)steps + 2, sizeof *v);
+    for (int i = 0; v && i <= steps; i++)
+        v[i] = !o->has_range ? m->driver.values[i]
+               : i == steps  ? o->to
+                             : o->from + (o->to - o->from) * i / steps;
+    *n = steps + 1;
+    return v;
+}
+
+/* The sweep by the loaded code into t (its header already made): 0, or -1
+ * with why in note (t's rows are then to be discarded). A row with a value
+ * that is not finite ends the sweep before it, as in the interpreter:
+ * *bad is its index (else -1) and t holds the rows before it. */
+static int jit_sweep(const jit *j, const mech_model *m, const mech_analysis *a, const double *q,
+                     int nq, mech_table *t, mech_solve_stats *st, int *bad, char *note,
+                     size_t size)
+{
+    int nout = j->nout();
+    const char *const *names = j->names();
+    *bad = -1;
+    if (nout != t->ncolumns)
+        return snprintf(note, size, "the generated code has %d columns, mech solve %d", nout,
+                        t->ncolumns), -1;
+    for (int c = 0; c < nout; c++)
+        if (strcmp(names[c], t->columns[c].name) != 0)
+            return snprintf(note, size, "column %d is %s, mech solve's %s", c + 1, names[c],
+                            t->columns[c].name), -1;
+    void *s = calloc(1, j->state_size());
+    free(t->values);  /* the header's room for no rows */
+    t->values = xcalloc((size_t)nq * (size_t)nout + 1, sizeof *t->values);
+    if (!s || !t->values) {
+        free(s);
+        return snprintf(note, size, "out of memory"), -1;
+    }
+    double info[5];
+    for (int i = 0; i < nq; i++) {
+        double *out = t->values + (size_t)i * (size_t)nout;
+        info[2] = st->min_rcond;
+        int rc = j->row(s, q[i], m->driver.speed, m->driver.accel, i == 0, out, info);
+        if (rc != 0) {
+            free(s);
+            return snprintf(note, size, "the generated code %s at row %d", rc < 0
+                            ? "would take another step than the interpreter's continuation"
+                            : rc == 1 ? "found no assembly" : rc == 2 ? "found a singular position"
+                            : rc == 3 ? "found a branch condition false"
+                                      : "could not solve the forces", i + 1), -1;
+        }
+        if (analysis_check_finite(a, q[i], out, NULL) != MECH_OK) {
+            *bad = i;  /* sweep.c's fill_row: the row is not added, the sweep stops */
+            break;
+        }
+        st->iterations += (long)info[0];
+        st->max_iterations = (int)info[0] > st->max_iterations ? (int)info[0] : st->max_iterations;
+        st->worst_residual = fmax(st->worst_residual, info[1]);
+        if (info[2] < st->min_rcond) {
+            st->min_rcond = info[2];
+            st->worst_rcond_q = q[i];
+        }
+        st->worst_power_residual = fmax(st->worst_power_residual, info[3]);
+        if ((int)info[4] > st->max_friction_iterations)
+            st->max_friction_iterations = (int)info[4];
+        t->nrows = i + 1;
+    }
+    free(s);
+    return 0;
+}
+
+int cmd_jit_solve(const mech_model *m, const mech_solve_options *o, mech_table *t,
+                  mech_solve_stats *st, mech_diag *d)
+{
+    char note[700] = "";
+    const char *opt = unsupported(o);
+    how[0] = '\0';
+    if (opt) {
+        snprintf(how, sizeof how, "interpreted (--jit does not follow %s)", opt);
+        fprintf(stderr, "mech solve: note: --jit does not follow %s: the interpreter solves the "
+                "sweep\n", opt);
+        return mech_solve(m, o, t, st, d);
+    }
+    double t0 = clock_seconds();
+    mech_analysis *a = NULL;
+    mech_diag ad;  /* the analysis's notes: d's when the generated code solves */
+    mech_diag_init(&ad);
+    if (mech_analysis_new(m, o, &a, &ad) != MECH_OK) {
+        snprintf(how, sizeof how, "interpreted (the analysis failed)");
+        mech_diag_free(&ad);
+        return mech_solve(m, o, t, st, d);  /* it says what is wrong */
+    }
+    jit j;
+    memset(&j, 0, sizeof j);
+    int nq = 0, bad = -1;
+    double *q = positions(m, o, &nq);
+    memset(st, 0, sizeof *st);
+    st->min_rcond = INFINITY;  /* as the interpreter (sweep.c): row 0 sets it */
+    st->failure_q = NAN;       /* no failure (a failing sweep is the interpreter's) */
+    int ok = q && jit_build(&j, m, o, st, note, sizeof note) == 0;
+    double t1 = clock_seconds();
+    if (ok && mech_analysis_header(a, t) == MECH_OK) {
+        t->nrequested = nq;
+        ok = jit_sweep(&j, m, a, q, nq, t, st, &bad, note, sizeof note) == 0;
+    } else if (ok) {
+        ok = 0;
+        snprintf(note, sizeof note, "out of memory");
+    }
+    if (ok) {
+        st->steps = t->nrows;
+        st->seconds = clock_seconds() - t1;
+        st->setup_seconds = t1 - t0;
+    }
+    for (size_t i = 0; ok && i < ad.count; i++)  /* warnings and notes: it was built */
+        diag_copy(d, &ad.entries[i]);
+    mech_diag_free(&ad);
+    /* the interpreter's error for the row that is not finite, after its notes */
+    int status = ok && bad >= 0
+                 ? analysis_check_finite(a, q[bad], t->values + (size_t)bad * (size_t)t->ncolumns, d)
+                 : MECH_OK;
+    free(q);
+    if (j.so)
+        dlclose(j.so);
+    mech_analysis_free(&a);
+    if (ok) {
+        char built[sizeof how];
+        snprintf(built, sizeof built, "%s", how);
+        snprintf(how, sizeof how, "compiled (%.680s)", built);
+        return status;
+    }
+    snprintf(how, sizeof how, "interpreted (--jit: %s)", note);
+    mech_table_free(t);
+    memset(t, 0, sizeof *t);
+    fprintf(stderr, "mech solve: note: --jit: %s; the interpreter solves the sweep\n", note);
+    return mech_solve(m, o, t, st, d);
+}
