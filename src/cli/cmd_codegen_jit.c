@@ -636,7 +636,7 @@ int cmd_jit_solve(const mech_model *m, const mech_solve_options *o, mech_table *
         snprintf(how, sizeof how, "compiled (%.680s)", built);
         return status;
     }
-    snprintf(how, sizeof how, "interpreted (--jit: %s)", note);
+    snprintf(how, sizeof how, "interpreted (--jit: %.660s)", note);
     mech_table_free(t);
     memset(t, 0, sizeof *t);
     fprintf(stderr, "mech solve: note: --jit: %s; the interpreter solves the sweep\n", note);
