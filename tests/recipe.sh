@@ -30,20 +30,22 @@ shard_pid() {
     return 1
 }
 
-# The first shard K of M whose out/sweep.K.csv.partial (or the file $3
-# names, %s for K) is there with its head (manifest and header: the shard
-# runs; a sweep's rows come in blocks up to a second apart, so a short shard
-# may show none before its end): waits up to $2 seconds; prints K, or
-# nothing.
-running_shard() {
+# kill_running_shard M LIMIT [PATTERN]: the first shard K of M whose
+# out/sweep.K.csv.partial (or the file PATTERN names, %s for K) is there
+# with its head (manifest and header: the shard runs; rows come in blocks up
+# to a second apart, so a short shard may show none before its end) and
+# whose process is still there (a short shard can end between the two looks;
+# another is taken then) gets SIGTERM; prints "K PID", or nothing when no
+# shard was seen running within LIMIT seconds.
+kill_running_shard() {
     m=$1 limit=$2 waited=0 pattern=${3:-sweep.%s.csv.partial}
     while [ "$waited" -lt $((limit * 20)) ]; do
         for k in $(seq 0 $((m - 1))); do
             # shellcheck disable=SC2059
             f=$work/out/$(printf "$pattern" "$k")
-            if [ -f "$f" ] && [ "$(wc -l <"$f")" -ge 2 ]; then
-                echo "$k"
-                return 0
+            [ -f "$f" ] && [ "$(wc -l <"$f")" -ge 2 ] || continue
+            if p=$(shard_pid "--shard $k/$m "); then
+                kill -TERM "$p" && echo "$k $p" && return 0
             fi
         done
         sleep 0.05

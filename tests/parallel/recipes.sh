@@ -33,8 +33,8 @@ sized parallel-sweep >"$tmp/sweep.sh"
 grep -q -- "--vary l1=50mm:64mm:$n1 " "$tmp/sweep.sh" && pass || fail "no recipe parallel-sweep over l1=50mm:64mm:100 in docs/batch.md"
 sh "$tmp/sweep.sh" >"$tmp/out" 2>"$tmp/err" &
 pid=$!
-k=$(running_shard 8 60)
-victim=$(shard_pid "--shard $k/8 ") && kill -TERM "$victim"
+set -- $(kill_running_shard 8 60)
+k=$1 victim=$2
 wait $pid
 status=$?
 if [ -n "$victim" ]; then
@@ -76,8 +76,8 @@ cp "$repo"/mechanisms/*.yaml mechanisms/
 for i in $(seq 100 $((99 + copies))); do cp "$repo/mechanisms/conveyor.yaml" "mechanisms/c$i.yaml"; done
 sh "$tmp/batch.sh" >"$tmp/out" 2>"$tmp/err" &
 pid=$!
-k=$(running_shard 4 60 'summary.%s.txt.partial')
-victim=$(shard_pid "--shard $k/4 ") && kill -TERM "$victim"
+set -- $(kill_running_shard 4 60 'summary.%s.txt.partial')
+k=$1 victim=$2
 wait $pid
 status=$?
 if [ -n "$victim" ]; then
