@@ -348,6 +348,9 @@ typedef struct mech_model {
                              from there by continuation */
     struct file_units *units; /* owned: the file's `units:` as written, for results in
                                  them (src/base/base.h); NULL when it gives none */
+    struct free_drivers *free_drivers; /* owned: the drivers of `drivers:` marked
+                                 `free: true` (docs/dynamics.md; src/load/load.h), moved by
+                                 their loads in `mech simulate`; NULL when none is */
 } mech_model;
 
 /* Read and validate a mechanism file. On success *out is the model and the
