@@ -447,7 +447,7 @@ static void print_params(const fit_setup *s, const mech_model *m, const double *
             double lo = output_in_file_units(m, s->unit[k], s->lo[k], buf, sizeof buf);
             double hi = output_in_file_units(m, s->unit[k], s->hi[k], buf, sizeof buf);
             double w = s->hi[k] - s->lo[k];
-            fprintf(out, "   (bounds %.10g .. %.10g%s)", lo, hi,
+            fprintf(out, "   (bounds %.10g .. %.10g %s%s)", lo, hi, buf,
                     p[k] - s->lo[k] <= 1e-6 * w   ? ", at the lower bound"
                     : s->hi[k] - p[k] <= 1e-6 * w ? ", at the upper bound"
                                                   : "");
@@ -641,7 +641,7 @@ static int report(fit_setup *s, const fit_args *a, const mech_model *m, fit_star
     fprintf(out, "mech fit: %s, %d free parameter%s, %d target row%s x %d column%s\n", a->file,
             s->fp.nfree, s->fp.nfree == 1 ? "" : "s", s->fp.nq, s->fp.nq == 1 ? "" : "s",
             s->fp.ncols, s->fp.ncols == 1 ? "" : "s");
-    fprintf(out, "starts       %d (%d assembled at every target and converged, %d rejected)\n",
+    fprintf(out, "starts       %d (%d assembled at every target, %d rejected)\n",
             n, ok, n - ok);
     fprintf(out, "solves       %ld (each the file loaded and the targets' rows solved)\n",
             solves);

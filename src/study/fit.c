@@ -62,7 +62,7 @@ static int eval_options(const fit_problem *fp, const mech_model *m, mech_outputs
     o->want = MECH_WANT_POSITION;
     o->forces = -1;
     if (mech_outputs_parse(m, fp->outputs, outs, err, sizeof err) != MECH_OK)
-        return diag_error(d, fp->path, (mech_mark){0, 0}, "target columns: %s", err);
+        return diag_error(d, fp->path, (mech_mark){0, 0}, "a target column names what mech solve does not output: %s", err);
     o->outputs = outs;
     return MECH_OK;
 }

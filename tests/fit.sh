@@ -1,0 +1,134 @@
+#!/bin/sh
+# tests/fit.sh: mech fit (docs/synthesis.md) against known answers. The
+# targets are solved from a known four-bar (tests/fit/fourbar.yaml: r 20,
+# l 60, b 50, d 70 mm, P at 40 mm and 30 deg from AB); a copy with some
+# dimensions changed must fit back to the known ones: path generation (P.x,
+# P.y), function generation (the rocker's angle against the crank's),
+# motion generation (P and the coupler's angle); a bound that excludes the
+# answer gives the bound and a residual, honestly reported; targets no
+# mechanism within the bounds reaches give exit 1 and no file; the file
+# written solves to the targets and keeps the comments; bad input.
+# Run from the repository root:  MECH=build/mech sh tests/fit.sh
+NAME=fit . tests/lib.sh
+F=tests/fit/fourbar.yaml
+
+# value NAME FILE: the number of parameter NAME's line in FILE
+value() { sed -n "s/^  $1: \\({value: \\)\\{0,1\\}\\([-0-9.e+]*\\).*/\\2/p" "$2"; }
+# near A B TOL: |A - B| <= TOL
+near() { awk -v a="$1" -v b="$2" -v t="$3" 'BEGIN { d = a - b; if (d < 0) d = -d; exit !(a != "" && d <= t) }'; }
+
+# the targets: 12 crank angles of the known mechanism, in the file's units
+"$MECH" solve "$F" --from 0 --to 330 --steps 11 --outputs P,rocker,coupler --level positions \
+    --units file -o "$tmp/all.csv" 2>/dev/null || fail "solve the targets"
+cut -d, -f1-3 "$tmp/all.csv" >"$tmp/path.csv"
+cut -d, -f1,4 "$tmp/all.csv" >"$tmp/function.csv"
+cut -d, -f1-3,5 "$tmp/all.csv" >"$tmp/motion.csv"
+has_line "$tmp/path.csv" '^q \[deg\],P.x \[mm\],P.y \[mm\]$' "targets: the path's header"
+has_line "$tmp/function.csv" '^q \[deg\],rocker.angle \[deg\]$' "targets: the function's header"
+has_line "$tmp/motion.csv" '^q \[deg\],P.x \[mm\],P.y \[mm\],coupler.angle \[deg\]$' "targets: the motion's header"
+# the generator itself against a closed form: at q = 90 deg, A = (0, 20);
+# B is where the circles |B - A| = 60 and |B - C| = 50 meet, above AC
+# (turn A -> B -> C clockwise); P = A + 40 mm along AB turned by 30 deg
+awk -F, 'NR == 5 {
+    ax = 0; ay = 20; cx = 70; cy = 0; l = 60; b = 50
+    dx = cx - ax; dy = cy - ay; dd = sqrt(dx * dx + dy * dy)
+    a = (l * l - b * b + dd * dd) / (2 * dd); h = sqrt(l * l - a * a)
+    mx = ax + a * dx / dd; my = ay + a * dy / dd
+    bx = mx - h * dy / dd; by = my + h * dx / dd
+    t = atan2(by - ay, bx - ax) + atan2(1, 1) * 4 / 6
+    px = ax + 40 * cos(t); py = ay + 40 * sin(t)
+    d = ($2 - px) ^ 2 + ($3 - py) ^ 2
+    exit !($1 > 90 - 1e-9 && $1 < 90 + 1e-9 && d < 1e-20)
+}' "$tmp/path.csv" && pass || fail "the targets at q = 90 deg are not the four-bar's P by hand"
+
+# 1. path generation: three dimensions changed by 10 % or less, recovered
+sed -e 's/^  r: 20 mm/  r: 22 mm/' -e 's/^  l: 60 mm/  l: 55 mm/' -e 's/^  b: 50 mm/  b: 53 mm/' \
+    "$F" >"$tmp/moved.yaml"
+if run "path" 0 "$MECH" fit "$tmp/moved.yaml" --free r,l,b --target "$tmp/path.csv" -o "$tmp/best.yaml"; then
+    near "$(value r "$tmp/best.yaml")" 20 1e-6 && pass || fail "path: r = $(value r "$tmp/best.yaml"), expected 20"
+    near "$(value l "$tmp/best.yaml")" 60 1e-6 && pass || fail "path: l = $(value l "$tmp/best.yaml"), expected 60"
+    near "$(value b "$tmp/best.yaml")" 50 1e-6 && pass || fail "path: b = $(value b "$tmp/best.yaml"), expected 50"
+    obj=$(sed -n 's/^objective *\([^ ]*\).*/\1/p' "$tmp/out")
+    near "$obj" 0 1e-20 && pass || fail "path: objective $obj, expected about 0"
+    has_line "$tmp/out" '^solves  *[1-9][0-9]* ' "path: the number of solves"
+    has_line "$tmp/out" '^time  *[0-9.e+-]* s$' "path: the time"
+    has_line "$tmp/out" '^  P.x  *worst error [0-9.e+-]* mm (at q = [0-9.]* deg)' "path: the worst error"
+    # 4. the file written: comments kept, only the three values changed, and
+    # it solves to the targets
+    has_line "$tmp/best.yaml" '^  r: 20 mm  *# crank O-A$' "best: r's line with its comment"
+    has_line "$tmp/best.yaml" '^# A crank-rocker four-bar with its dimensions' "best: the header comment"
+    [ "$(diff "$tmp/moved.yaml" "$tmp/best.yaml" | grep -c '^>')" -eq 3 ] && pass ||
+        fail "best: $(diff "$tmp/moved.yaml" "$tmp/best.yaml" | grep -c '^>') lines changed, expected 3"
+    if run "best solves" 0 "$MECH" solve "$tmp/best.yaml" --from 0 --to 330 --steps 11 --outputs P \
+        --level positions --units file -o "$tmp/best.csv"; then
+        run "best meets the targets" 0 "$MECH" compare "$tmp/best.csv" "$tmp/path.csv" --rtol 0 --atol 1e-6 && pass
+    fi
+fi
+
+# the same from 8 (QUICK: 4) starts on 2 threads, within bounds
+n=8; [ "${MECH_QUICK:-}" = 1 ] && n=4
+if run "path, bounded starts" 0 "$MECH" fit "$tmp/moved.yaml" --free r=15:25,l=50:70,b=40:60 \
+    --target "$tmp/path.csv" --starts $n -j 2; then
+    has_line "$tmp/out" "^starts  *$n ($n assembled" "starts: all assemble"
+    has_line "$tmp/out" '^  r  *20 mm   (bounds 15 .. 25 mm)$' "starts: r"
+    has_line "$tmp/out" '^  1\. objective [0-9.e-]*: r=20 l=60 b=50$' "starts: the best distinct solution"
+fi
+
+# 2. function generation: the rocker's angle against the crank's
+if run "function" 0 "$MECH" fit "$tmp/moved.yaml" --free r,l,b --target "$tmp/function.csv" -o "$tmp/fn.yaml"; then
+    near "$(value r "$tmp/fn.yaml")" 20 1e-6 && pass || fail "function: r = $(value r "$tmp/fn.yaml")"
+    near "$(value l "$tmp/fn.yaml")" 60 1e-6 && pass || fail "function: l = $(value l "$tmp/fn.yaml")"
+    near "$(value b "$tmp/fn.yaml")" 50 1e-6 && pass || fail "function: b = $(value b "$tmp/fn.yaml")"
+    has_line "$tmp/out" '^  rocker.angle worst error [0-9.e+-]* deg' "function: the error in degrees"
+fi
+
+# motion generation: P and the coupler's angle; the coupler point's
+# distance e ({value:, tolerance:}) and angle phi free with the crank
+sed -e 's/^  r: 20 mm/  r: 21 mm/' -e 's/value: 40 mm/value: 37 mm/' -e 's/^  phi: 30 deg/  phi: 34 deg/' \
+    "$F" >"$tmp/motion.yaml"
+if run "motion" 0 "$MECH" fit "$tmp/motion.yaml" --free r,e,phi --target "$tmp/motion.csv" -o "$tmp/mo.yaml"; then
+    near "$(value r "$tmp/mo.yaml")" 20 1e-6 && pass || fail "motion: r = $(value r "$tmp/mo.yaml")"
+    near "$(value e "$tmp/mo.yaml")" 40 1e-6 && pass || fail "motion: e = $(value e "$tmp/mo.yaml")"
+    near "$(value phi "$tmp/mo.yaml")" 30 1e-6 && pass || fail "motion: phi = $(value phi "$tmp/mo.yaml")"
+    has_line "$tmp/mo.yaml" '^  e: {value: 40 mm, tolerance: 0.1 mm}' "motion: e's tolerance kept"
+fi
+
+# 3. bounds: r must stay in 21..25 mm, the answer 20 is outside: the fit
+# ends on the bound with a residual it reports
+if run "bound" 0 "$MECH" fit "$tmp/moved.yaml" --free r=21:25,l=50mm:70mm,b=4cm:6cm \
+    --target "$tmp/path.csv" --starts 4 -o "$tmp/bound.yaml"; then
+    near "$(value r "$tmp/bound.yaml")" 21 1e-9 && pass || fail "bound: r = $(value r "$tmp/bound.yaml"), expected 21"
+    has_line "$tmp/out" '^  r  *21 mm   (bounds 21 .. 25 mm, at the lower bound)$' "bound: said"
+    obj=$(sed -n 's/^objective *\([^ ]*\).*/\1/p' "$tmp/out")
+    near "$obj" 0 1e-8 && fail "bound: objective $obj, expected a residual" || pass
+fi
+# no mechanism within the bounds assembles at every target: exit 1, no file
+sed 's/^  r: 22 mm/  r: 50 mm/' "$tmp/moved.yaml" >"$tmp/far.yaml"
+if run "infeasible" 1 "$MECH" fit "$tmp/far.yaml" --free r=45:60 --target "$tmp/path.csv" --starts 4 \
+    -o "$tmp/none.yaml"; then
+    has_line "$tmp/err" 'no start assembles at every target' "infeasible: message"
+    has_line "$tmp/out" '^starts  *4 (0 assembled' "infeasible: the starts"
+    [ ! -e "$tmp/none.yaml" ] && pass || fail "infeasible: a file was written"
+fi
+
+# bad input: each a precise message, exit 2, no file written
+sed '1s/P.x/Q.x/' "$tmp/path.csv" >"$tmp/unknown.csv"
+run "unknown column" 2 "$MECH" fit "$tmp/moved.yaml" --free r --target "$tmp/unknown.csv" -o "$tmp/x.yaml" &&
+    has_line "$tmp/err" "'Q' is not a point, moving link or slider" "unknown column: message"
+run "not a parameter" 2 "$MECH" fit "$tmp/moved.yaml" --free r,zz --target "$tmp/path.csv" -o "$tmp/x.yaml" &&
+    has_line "$tmp/err" "no parameter 'zz' in the file (its parameters: r, l, b, d, e, phi)" "not a parameter: message"
+sed '1s/P.x \[mm\]/P.x [deg]/' "$tmp/path.csv" >"$tmp/units.csv"
+run "wrong unit" 2 "$MECH" fit "$tmp/moved.yaml" --free r --target "$tmp/units.csv" -o "$tmp/x.yaml" &&
+    has_line "$tmp/err" "column 'P.x' is in 'deg', where mech solve's is in m" "wrong unit: message"
+run "velocity column" 2 "$MECH" fit "$tmp/moved.yaml" --free r --target "$tmp/path.csv" --column P.vx -o "$tmp/x.yaml" &&
+    has_line "$tmp/err" "no such column" "velocity column: message"
+run "bounds exclude the start" 2 "$MECH" fit "$tmp/moved.yaml" --free r=10:15 --target "$tmp/path.csv" -o "$tmp/x.yaml" &&
+    has_line "$tmp/err" ":7:3: error: the bounds 10:15 of 'r' exclude its value in the file (22 mm)" "bounds: message"
+run "no --free" 2 "$MECH" fit "$tmp/moved.yaml" --target "$tmp/path.csv" &&
+    has_line "$tmp/err" "free NAME,... is needed" "no --free: message"
+run "output over the input" 2 "$MECH" fit "$tmp/moved.yaml" --free r --target "$tmp/path.csv" -o "$tmp/moved.yaml" &&
+    has_line "$tmp/err" "is the input file" "output over the input: message"
+[ ! -e "$tmp/x.yaml" ] && pass || fail "bad input: a file was written"
+cmp -s "$tmp/moved.yaml" "$tmp/far.yaml" && fail "the input changed" || pass
+
+summary
