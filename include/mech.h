@@ -348,6 +348,8 @@ typedef struct mech_model {
                              from there by continuation */
     struct file_units *units; /* owned: the file's `units:` as written, for results in
                                  them (src/base/base.h); NULL when it gives none */
+    struct model_fit *fit; /* owned: the file's `fit:` section, mech fit's problem
+                              (src/base/base.h, docs/synthesis.md); NULL when none */
 } mech_model;
 
 /* Read and validate a mechanism file. On success *out is the model and the

@@ -111,6 +111,51 @@ if run "infeasible" 1 "$MECH" fit "$tmp/far.yaml" --free r=45:60 --target "$tmp/
     [ ! -e "$tmp/none.yaml" ] && pass || fail "infeasible: a file was written"
 fi
 
+# the problem in the file's fit: section (the target relative to the file),
+# bounds, columns, a weight and the starts from there
+cp "$tmp/moved.yaml" "$tmp/section.yaml"
+cat >>"$tmp/section.yaml" <<'END'
+fit:
+  free:
+    r: [15 mm, 25 mm]
+    l: [5 cm, 7 cm]
+    b: ~
+  target: path.csv
+  columns: [P.x, P.y]
+  weights: {P.y: 2}
+  starts: 3
+END
+if run "fit: section" 0 "$MECH" fit "$tmp/section.yaml" -o "$tmp/sbest.yaml"; then
+    near "$(value r "$tmp/sbest.yaml")" 20 1e-6 && pass || fail "fit: section: r = $(value r "$tmp/sbest.yaml")"
+    near "$(value b "$tmp/sbest.yaml")" 50 1e-6 && pass || fail "fit: section: b = $(value b "$tmp/sbest.yaml")"
+    has_line "$tmp/out" '^starts  *3 (3 assembled' "fit: section: starts"
+    has_line "$tmp/out" '^  l  *60 mm   (bounds 50 .. 70 mm)$' "fit: section: l's bounds"
+    has_line "$tmp/sbest.yaml" '^  weights: {P.y: 2}$' "fit: section: kept in the file written"
+fi
+sed 's/^    r: \[15 mm, 25 mm\]/    rr: [15 mm, 25 mm]/' "$tmp/section.yaml" >"$tmp/section-bad.yaml"
+run "fit: section, not a parameter" 2 "$MECH" fit "$tmp/section-bad.yaml" &&
+    has_line "$tmp/err" "section-bad.yaml:[0-9]*:5: error: fit: 'rr' is not one of the file's parameters" "fit: section: message"
+
+# a constraint the unconstrained optimum violates: targets of a four-bar
+# whose crank cannot turn fully (r 45 mm: s + l = 45 + 70 > 60 + 50, not
+# Grashof), over the part of the turn where it assembles. Free r finds 45;
+# with --whole-range (a full turn) every fit is rejected (or one that turns)
+sed 's/^  r: 20 mm/  r: 45 mm/' "$F" >"$tmp/ng.yaml"
+"$MECH" solve "$tmp/ng.yaml" --from 0 --to 60 --steps 6 --outputs P --level positions --units file \
+    -o "$tmp/ng.csv" 2>/dev/null || fail "solve the non-Grashof targets"
+sed 's/^  r: 45 mm/  r: 30 mm/' "$tmp/ng.yaml" >"$tmp/ng30.yaml"
+run "unconstrained" 0 "$MECH" fit "$tmp/ng30.yaml" --free r=15:48 --target "$tmp/ng.csv" --starts 3 &&
+    has_line "$tmp/out" '^  r  *45 mm ' "unconstrained: r 45"
+"$MECH" fit "$tmp/ng30.yaml" --free r=15:48 --target "$tmp/ng.csv" --starts 3 --whole-range \
+    -o "$tmp/ng-best.yaml" >"$tmp/out" 2>"$tmp/err"
+case $? in
+1) has_line "$tmp/err" 'no start assembles at every target and over the whole range' "whole range: message"
+   [ ! -e "$tmp/ng-best.yaml" ] && pass || fail "whole range: a file was written" ;;
+0) "$MECH" solve "$tmp/ng-best.yaml" -o "$tmp/ng-best.csv" 2>/dev/null && pass ||
+       fail "whole range: the solution does not turn fully" ;;
+*) fail "whole range: exit status $?" ;;
+esac
+
 # bad input: each a precise message, exit 2, no file written
 sed '1s/P.x/Q.x/' "$tmp/path.csv" >"$tmp/unknown.csv"
 run "unknown column" 2 "$MECH" fit "$tmp/moved.yaml" --free r --target "$tmp/unknown.csv" -o "$tmp/x.yaml" &&

@@ -25,6 +25,7 @@ typedef struct fit_args {
     fit_list columns;            /* --column NAME (repeatable) */
     fit_list weights;            /* --weight NAME=W (repeatable) */
     int starts, jobs, quiet;
+    int whole_range;             /* --whole-range */
 } fit_args;
 
 /* A repeatable option's value appended to its list. */
@@ -60,8 +61,15 @@ static const cmd_opt options[] = {
     {.names = "--starts", .kind = CMD_OPT_INT, .at = AT(starts), .lo = 1, .hi = 100000,
      .expect = "needs a whole number from 1 to 100000", .label = "--starts N",
      .help = "local fits from N starts: the file's values, then a\n"
-             "Halton sequence over the bounds (default 16 when every\n"
-             "free parameter has bounds, else 1)"},
+             "Halton sequence over the bounds (a parameter without\n"
+             "bounds keeps its value; default 16 when every free\n"
+             "parameter has bounds, else 1)"},
+    {.names = "--whole-range", .kind = CMD_OPT_FLAG, .at = AT(whole_range), .flag = 1,
+     .label = "--whole-range",
+     .help = "a constraint: the solution must assemble over the file's\n"
+             "whole driver range (a crank from 0 to 360 deg turns\n"
+             "fully: a Grashof crank); a solution that does not is\n"
+             "rejected"},
     {.names = "-o|--output", .kind = CMD_OPT_TEXT, .at = AT(out), .label = "-o, --output FILE",
      .help = "write the best solution as a copy of the mechanism file\n"
              "with the free parameters' values replaced (comments kept;\n"
@@ -77,7 +85,8 @@ const cmd_spec cmd_fit_spec = {
     .summary = "fit parameters so that outputs meet targets (synthesis)",
     .usage = "usage: mech fit FILE --free NAME[=LO:HI],... --target TARGETS.csv\n"
              "                [--column NAME]... [--weight NAME=W]... [--starts N]\n"
-             "                [-j N] [-o BEST.yaml] [--quiet]\n",
+             "                [--whole-range] [-j N] [-o BEST.yaml] [--quiet]\n"
+             "       mech fit FILE [-o BEST.yaml]   (the file's fit: section)\n",
     .about = "Dimensional synthesis: find the values of the file's free parameters that\n"
              "make the solved outputs meet the targets at the targets' driver positions:\n"
              "path generation (a point's x and y), function generation (a link's angle\n"
@@ -85,7 +94,8 @@ const cmd_spec cmd_fit_spec = {
              "MINPACK's Levenberg-Marquardt (lmder) with the exact Jacobian from the\n"
              "sensitivities (docs/sensitivity.md); bounds by a change of variable; many\n"
              "starts. A start or a solution where the mechanism does not assemble at\n"
-             "every target is rejected (docs/synthesis.md).\n",
+             "every target is rejected (docs/synthesis.md). The file's 'fit:' section\n"
+             "(docs/format.md) states the same problem; the options replace its parts.\n",
     .opts = options,
     .column = 22,
     .exits = "exit status: 0 a solution found (the summary says how close it is), 1 no\n"
@@ -113,6 +123,9 @@ typedef struct fit_setup {
     int csv_col[MAX_COLS];  /* the CSV's column of each target column */
     compare_table csv;
     double *q, *target;
+    char target_path[4096];
+    int bounds_given;  /* the bounds are the fit: section's, already in SI */
+    int whole_range;
 } fit_setup;
 
 static void setup_free(fit_setup *s)
@@ -193,6 +206,8 @@ static int parse_quantity(const mech_model *m, const char *text, const char *si_
 static int read_bounds(fit_setup *s, const mech_model *m)
 {
     for (int k = 0; k < s->fp.nfree; k++) {
+        if (s->bounds_given)
+            continue;  /* the fit: section's, checked by the loader */
         s->lo[k] = -INFINITY;
         s->hi[k] = INFINITY;
         if (!s->bound_text[k][0])
@@ -222,30 +237,37 @@ static int read_bounds(fit_setup *s, const mech_model *m)
     return -1;
 }
 
-/* The target columns: --column's, or every CSV column after the first. */
-static int choose_columns(fit_setup *s, const fit_args *a)
+/* The target columns: --column's, the fit: section's, or every CSV column
+ * after the first. */
+static int choose_columns(fit_setup *s, const fit_args *a, const model_fit *mf)
 {
     const compare_table *t = &s->csv;
+    fit_list file_cols = {{0}, 0};
+    if (!a->columns.n && mf && mf->ncolumns)
+        for (int j = 0; j < mf->ncolumns && j < MAX_COLS; j++)
+            file_cols.v[file_cols.n++] = mf->columns[j];
+    const fit_list *cl = a->columns.n ? &a->columns : &file_cols;
     if (t->ncols < 2 || t->nrows < 1) {
         fprintf(stderr, "mech fit: %s: the targets need a driver column, a target column "
-                "and a row at least\n", a->target);
+                "and a row at least\n", s->target_path);
         return MECH_EXIT_INPUT;
     }
-    int n = a->columns.n ? a->columns.n : (int)t->ncols - 1;
+    int n = cl->n ? cl->n : (int)t->ncols - 1;
     if (n > MAX_COLS)
         n = MAX_COLS;
     for (int j = 0; j < n; j++) {
-        const char *name = a->columns.n ? a->columns.v[j] : t->names[j + 1];
+        const char *name = cl->n ? cl->v[j] : t->names[j + 1];
         s->csv_col[j] = -1;
         for (size_t c = 1; c < t->ncols; c++)
             if (strcmp(t->names[c], name) == 0)
                 s->csv_col[j] = (int)c;
         if (s->csv_col[j] < 0) {
-            fprintf(stderr, "mech fit: --column %s: %s has no such column\n", name, a->target);
+            fprintf(stderr, "mech fit: target column %s: %s has no such column\n", name,
+                    s->target_path);
             return MECH_EXIT_INPUT;
         }
         s->cols[j] = name;
-        s->weight[j] = 1.0;
+        s->weight[j] = cl == &file_cols && file_cols.n ? mf->weights[j] : 1.0;
     }
     s->fp.ncols = n;
     for (int w = 0; w < a->weights.n; w++) {
@@ -268,7 +290,7 @@ static int choose_columns(fit_setup *s, const fit_args *a)
 
 /* The CSV's driver and target values in SI, checked against the units of
  * mech solve's columns. */
-static int convert_targets(fit_setup *s, const fit_args *a)
+static int convert_targets(fit_setup *s)
 {
     const compare_table *t = &s->csv;
     int nq = (int)t->nrows, nc = s->fp.ncols;
@@ -284,7 +306,7 @@ static int convert_targets(fit_setup *s, const fit_args *a)
         const char *rest = u;
         char du[32] = "";
         if (*u && (!unit_parse(u, &scale, &d, &rest) || *rest)) {
-            fprintf(stderr, "mech fit: %s: column '%s': unknown unit '%s'\n", a->target,
+            fprintf(stderr, "mech fit: %s: column '%s': unknown unit '%s'\n", s->target_path,
                     t->names[c], u);
             return MECH_EXIT_INPUT;
         }
@@ -292,14 +314,14 @@ static int convert_targets(fit_setup *s, const fit_args *a)
             dim_format(d, du, sizeof du);
         if (strcmp(du, si) != 0 && !(*u == '\0' && strcmp(si, "-") == 0)) {
             fprintf(stderr, "mech fit: %s: column '%s' is in '%s', where mech solve's is in "
-                    "%s (write the unit in the header: '%s [%s]')\n", a->target, t->names[c], u,
+                    "%s (write the unit in the header: '%s [%s]')\n", s->target_path, t->names[c], u,
                     si, t->names[c], si);
             return MECH_EXIT_INPUT;
         }
         for (int i = 0; i < nq; i++) {
             double v = t->values[(size_t)i * t->ncols + (size_t)c] * scale;
             if (j < 0 && isnan(v)) {
-                fprintf(stderr, "mech fit: %s: row %d has no driver position\n", a->target,
+                fprintf(stderr, "mech fit: %s: row %d has no driver position\n", s->target_path,
                         i + 2);
                 return MECH_EXIT_INPUT;
             }
@@ -311,7 +333,7 @@ static int convert_targets(fit_setup *s, const fit_args *a)
     }
     if (strcmp(t->names[0], "q") != 0 && strcmp(t->names[0], "t") != 0) {
         fprintf(stderr, "mech fit: %s: the first column must be the driver position 'q' (or "
-                "the time 't'), as in mech solve's CSV, not '%s'\n", a->target, t->names[0]);
+                "the time 't'), as in mech solve's CSV, not '%s'\n", s->target_path, t->names[0]);
         return MECH_EXIT_INPUT;
     }
     s->fp.nq = nq;
@@ -325,16 +347,59 @@ static int convert_targets(fit_setup *s, const fit_args *a)
     return -1;
 }
 
+/* The free parameters of the file's fit: section (names, bounds in SI). */
+static int free_of_file(fit_setup *s, const model_fit *mf)
+{
+    if (!mf || !mf->nfree)
+        return cmd_usage_error("fit", "%s", "--free NAME,... is needed (or a 'fit:' section "
+                               "with 'free:' in the file): which parameters to fit");
+    if (mf->nfree > MAX_FREE)
+        return cmd_usage_error("fit", "%s", "at most 32 free parameters");
+    for (int k = 0; k < mf->nfree; k++) {
+        s->names[k] = mf->free[k].name;
+        s->lo[k] = mf->free[k].lo;
+        s->hi[k] = mf->free[k].hi;
+    }
+    s->fp.nfree = mf->nfree;
+    s->bounds_given = 1;
+    return -1;
+}
+
+/* The targets' CSV: --target, or the fit: section's (relative to the file's
+ * folder), refused when it is also the output. */
+static int target_path(fit_setup *s, const fit_args *a, const model_fit *mf)
+{
+    const char *t = a->target ? a->target : mf ? mf->target : NULL;
+    if (!t)
+        return cmd_usage_error("fit", "%s", "--target CSV is needed (or 'target:' in the "
+                               "file's 'fit:' section): what to fit to");
+    const char *slash = strrchr(a->file, '/');
+    int rel = !a->target && t[0] != '/' && slash;
+    int len = rel ? (int)(slash - a->file) + 1 : 0;
+    if ((size_t)snprintf(s->target_path, sizeof s->target_path, "%.*s%s", len, a->file, t) >=
+        sizeof s->target_path)
+        return cmd_usage_error("fit", "the targets' path is too long: %s", t);
+    const char *inputs[2] = {a->file, s->target_path};
+    return cmd_refuse_input("fit", a->out, inputs, 2);
+}
+
 static int setup(fit_setup *s, const fit_args *a, mech_model **m)
 {
-    mech_diag d;
-    mech_diag_init(&d);
-    int code = split_free(s, a->free);
+    int code = cmd_load_checked(a->file, m);
+    if (code != MECH_EXIT_OK)
+        return code;
+    const model_fit *mf = (*m)->fit;
+    code = a->free ? split_free(s, a->free) : free_of_file(s, mf);
+    if (code < 0)
+        code = target_path(s, a, mf);
     if (code >= 0)
         return code;
-    int rc = compare_read_csv(a->target, &s->csv, &d);
+    s->whole_range = a->whole_range || (mf && mf->whole_range);
+    mech_diag d;
+    mech_diag_init(&d);
+    int rc = compare_read_csv(s->target_path, &s->csv, &d);
     if (rc == MECH_OK) {
-        code = choose_columns(s, a);
+        code = choose_columns(s, a, mf);
         if (code >= 0) {
             mech_diag_free(&d);
             return code;
@@ -352,11 +417,8 @@ static int setup(fit_setup *s, const fit_args *a, mech_model **m)
     mech_diag_free(&d);
     if (rc != MECH_OK)
         return cmd_exit_status(rc);
-    code = convert_targets(s, a);
+    code = convert_targets(s);
     if (code >= 0)
-        return code;
-    code = cmd_load_checked(a->file, m);
-    if (code != MECH_EXIT_OK)
         return code;
     return read_bounds(s, *m);
 }
@@ -411,6 +473,12 @@ static void run_start(void *ctx, long i)
     start_point(s, i, st->p);
     st->objective = INFINITY;
     st->rc = r ? fit_lm(&fp, s->lo, s->hi, st->p, r, &st->objective, &st->info) : MECH_ENOMEM;
+    if (st->rc == MECH_OK && s->whole_range) {
+        mech_diag d;
+        mech_diag_init(&d);
+        st->rc = fit_check_range(&fp, st->p, &d);  /* a violated constraint: rejected */
+        mech_diag_free(&d);
+    }
     if (st->rc != MECH_OK)
         st->objective = INFINITY;
     st->solves = fp.nsolves;
@@ -641,15 +709,16 @@ static int report(fit_setup *s, const fit_args *a, const mech_model *m, fit_star
     fprintf(out, "mech fit: %s, %d free parameter%s, %d target row%s x %d column%s\n", a->file,
             s->fp.nfree, s->fp.nfree == 1 ? "" : "s", s->fp.nq, s->fp.nq == 1 ? "" : "s",
             s->fp.ncols, s->fp.ncols == 1 ? "" : "s");
-    fprintf(out, "starts       %d (%d assembled at every target, %d rejected)\n",
-            n, ok, n - ok);
+    fprintf(out, "starts       %d (%d assembled at every target%s, %d rejected)\n", n, ok,
+            s->whole_range ? " and over the whole range" : "", n - ok);
     fprintf(out, "solves       %ld (each the file loaded and the targets' rows solved)\n",
             solves);
     fprintf(out, "time         %.3g s\n", seconds);
     if (!ok) {
-        fprintf(stderr, "mech fit: no start assembles at every target: the mechanism cannot "
-                "reach the targets' driver positions for any parameter values tried (bounds "
-                "too narrow, or a target past a limit position); no solution%s\n",
+        fprintf(stderr, "mech fit: no start assembles at every target%s: no solution (the "
+                "bounds too narrow, a target past a limit position for every value tried, or "
+                "the constraint excludes the fits found)%s\n",
+                s->whole_range ? " and over the whole range" : "",
                 a->out ? ", no file written" : "");
         return MECH_EXIT_SOLVE;
     }
@@ -691,26 +760,23 @@ int cmd_fit(int argc, char **argv)
     int code = cmd_opts_parse(&cmd_fit_spec, argc, argv, &a);
     if (code >= 0)
         return code;
-    if (!a.free)
-        return cmd_usage_error("fit", "%s", "--free NAME,... is needed: which parameters to fit");
-    if (!a.target)
-        return cmd_usage_error("fit", "%s", "--target CSV is needed: what to fit to");
-    const char *inputs[2] = {a.file, a.target};
-    code = cmd_refuse_input("fit", a.out, inputs, 2);
-    if (code >= 0)
-        return code;
     fit_setup *s = xcalloc(1, sizeof *s);
     mech_model *m = NULL;
     if (!s)
         return MECH_EXIT_IO;
     code = setup(s, &a, &m);
     if (code < 0) {
-        int bounded = 1;
-        for (int k = 0; k < s->fp.nfree; k++)
+        int bounded = 1, any = 0;  /* every free parameter has bounds; one has */
+        for (int k = 0; k < s->fp.nfree; k++) {
             bounded &= isfinite(s->lo[k]) && isfinite(s->hi[k]);
-        int n = a.starts ? a.starts : bounded ? 16 : 1;
-        if (n > 1 && !bounded) {
-            fprintf(stderr, "mech fit: --starts %d needs bounds on every free parameter "
+            any |= isfinite(s->lo[k]) && isfinite(s->hi[k]);
+        }
+        int n = a.starts                 ? a.starts
+                : m->fit && m->fit->starts ? m->fit->starts
+                : bounded                  ? 16
+                                           : 1;
+        if (n > 1 && !any) {
+            fprintf(stderr, "mech fit: %d starts need bounds on a free parameter at least "
                     "(NAME=LO:HI)\n", n);
             code = MECH_EXIT_INPUT;
         } else {

@@ -558,6 +558,8 @@ int load_get_vec2_expr(loader *ld, const ynode *n, quantity q, const char *what,
 /* A number computed from recorded ones (a polar point, a gear's radius). */
 pxq load_expr(loader *ld, px_op op, double k, pxq a, pxq b, pxq c, double value);
 int load_get_count(loader *ld, const ynode *n, const char *what, long lo, long hi, long *out);
+/* load_fit.c: the `fit:` section into m->fit (docs/synthesis.md). */
+void load_fit(loader *ld, const ynode *map);
 int load_get_bool(loader *ld, const ynode *n, const char *what, int *out);
 int load_get_vec2(loader *ld, const ynode *n, quantity q, const char *what, double out[2]);
 int load_errors_full(const loader *ld);

@@ -201,6 +201,46 @@ done:
     return rc;
 }
 
+int fit_check_range(fit_problem *fp, const double *p, mech_diag *d)
+{
+    int n = fp->nfree, rc;
+    mech_override *ov = xcalloc((size_t)n + 1, sizeof *ov);
+    char (*text)[64] = xcalloc((size_t)n + 1, sizeof *text);
+    mech_model *m = NULL;
+    mech_table t = {0};
+    mech_diag quiet;
+    mech_diag_init(&quiet);
+    if (!ov || !text) {
+        rc = diag_nomem(d, fp->path, (mech_mark){0, 0});
+        goto done;
+    }
+    for (int k = 0; k < n; k++) {
+        snprintf(text[k], sizeof text[k], "%.17g%s%s", p[k], fp->unit[k][0] ? " " : "",
+                 fp->unit[k]);
+        ov[k] = (mech_override){fp->names[k], text[k]};
+    }
+    fp->nsolves++;
+    mech_summary s;
+    mech_solve_options o;
+    mech_solve_options_default(&o);
+    o.want = MECH_WANT_POSITION;
+    o.forces = -1;
+    rc = mech_load_file_with(fp->path, ov, n, &m, &quiet);
+    if (rc == MECH_OK)
+        rc = mech_check(m, &s, &quiet);
+    if (rc == MECH_OK)
+        rc = mech_solve(m, &o, &t, NULL, &quiet);
+    if (rc != MECH_OK)
+        rc = rc == MECH_ENOMEM ? diag_nomem(d, fp->path, (mech_mark){0, 0}) : MECH_ESOLVE;
+done:
+    mech_diag_free(&quiet);
+    mech_table_free(&t);
+    mech_model_free(&m);
+    free(ov);
+    free(text);
+    return rc;
+}
+
 void fit_problem_free(fit_problem *fp)
 {
     free(fp->outputs);

@@ -266,6 +266,10 @@ int fit_prepare(fit_problem *fp, double *p0, mech_diag *d);
  * MECH_ESOLVE (nothing in d) when the mechanism does not assemble at
  * every target; MECH_ENOMEM. */
 int fit_eval(fit_problem *fp, const double *p, double *r, double *jac, mech_diag *d);
+/* The constraint whole-range: MECH_OK when the mechanism at p assembles at
+ * every row of the file's own driver range (a crank from 0 to 360 deg: it
+ * turns fully), else MECH_ESOLVE (nothing in d); one solve. */
+int fit_check_range(fit_problem *fp, const double *p, mech_diag *d);
 void fit_problem_free(fit_problem *fp);
 
 /* ==== flywheel ==== */
