@@ -49,9 +49,9 @@ static int bound(loader *ld, const ynode *n, int k, double *out)
     if (!q.bare)
         dim_format(q.d, du, sizeof du);
     if (q.bare != (p->unit[0] == '\0') || strcmp(du, p->unit) != 0)
-        return load_err(ld, n, "bound of '%s' must be a quantity in %s, as the parameter (e.g. "
-                        "[15 %s, 25 %s])", p->name, p->unit[0] ? p->unit : "a bare number",
-                        p->unit, p->unit), -1;
+        return load_err(ld, n, "bound of '%s' must be %s%s, as the parameter", p->name,
+                        p->unit[0] ? "a quantity in " : "a bare number",
+                        p->unit), -1;
     *out = q.value;
     return 0;
 }
