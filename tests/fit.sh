@@ -65,6 +65,14 @@ if run "path" 0 "$MECH" fit "$tmp/moved.yaml" --free r,l,b --target "$tmp/path.c
     fi
 fi
 
+# parameters in a flow mapping: only the values inside the braces change
+sed -e 's/^parameters:$/parameters: {r: 22 mm, l: 55 mm, b: 53 mm, d: 70 mm, e: 40 mm, phi: 30 deg}/' \
+    -e '/^  [rlbde]: /d' -e '/^  phi: /d' "$tmp/moved.yaml" >"$tmp/flow.yaml"
+if run "flow parameters" 0 "$MECH" fit "$tmp/flow.yaml" --free r,l,b --target "$tmp/path.csv" -o "$tmp/flow-best.yaml"; then
+    has_line "$tmp/flow-best.yaml" '^parameters: {r: 20 mm, l: 60 mm, b: 50 mm, d: 70 mm, e: 40 mm, phi: 30 deg}$' \
+        "flow parameters: the values replaced"
+fi
+
 # the same from 8 (QUICK: 4) starts on 2 threads, within bounds
 n=8; [ "${MECH_QUICK:-}" = 1 ] && n=4
 if run "path, bounded starts" 0 "$MECH" fit "$tmp/moved.yaml" --free r=15:25,l=50:70,b=40:60 \

@@ -595,7 +595,12 @@ static int find_value(const char *text, size_t len, mech_mark mk, size_t *from, 
     if (pos >= len)
         return -1;
     const char *eol = memchr(text + pos, '\n', len - pos);
-    size_t end = eol ? (size_t)(eol - text) : len;
+    size_t end = eol ? (size_t)(eol - text) : len, bol = pos;
+    while (bol > 0 && text[bol - 1] != '\n')
+        bol--;
+    int depth = 0;  /* inside a flow mapping: {r: 20 mm, l: 60 mm} */
+    for (size_t i = bol; i < pos; i++)
+        depth += text[i] == '{' ? 1 : text[i] == '}' ? -1 : 0;
     const char *colon = memchr(text + pos, ':', end - pos);
     if (!colon)
         return -1;
@@ -623,7 +628,8 @@ static int find_value(const char *text, size_t len, mech_mark mk, size_t *from, 
         return 0;
     } else {
         size_t e = v;
-        while (e < end && !(text[e] == '#' && e > v && (text[e - 1] == ' ' || text[e - 1] == '\t')))
+        while (e < end && !(text[e] == '#' && e > v && (text[e - 1] == ' ' || text[e - 1] == '\t')) &&
+               !(depth > 0 && (text[e] == ',' || text[e] == '}')))
             e++;
         *from = v;
         *to = e;
@@ -631,6 +637,38 @@ static int find_value(const char *text, size_t len, mech_mark mk, size_t *from, 
     while (*to > *from && (text[*to - 1] == ' ' || text[*to - 1] == '\t'))
         (*to)--;
     return *to > *from ? 0 : -1;
+}
+
+/* The edited text loaded again: MECH_OK when its free parameters have the
+ * values p (to 1e-12 relative: the text holds 15 digits), else an error in
+ * d and nothing is written. */
+static int check_edited(const fit_setup *s, const edited *e, const double *p, mech_diag *d)
+{
+    char *text = NULL;
+    size_t size = 0;
+    FILE *f = open_memstream(&text, &size);
+    if (!f)
+        return diag_nomem(d, s->fp.path, (mech_mark){0, 0});
+    emit_edited(f, e);
+    fclose(f);
+    mech_model *m = NULL;
+    mech_diag quiet;
+    mech_diag_init(&quiet);
+    int rc = text ? mech_load_string(text, size, s->fp.path, &m, &quiet) : MECH_ENOMEM;
+    mech_diag_free(&quiet);
+    for (int k = 0; rc == MECH_OK && k < s->fp.nfree; k++)
+        for (int i = 0; i < m->nparams; i++)
+            if (strcmp(m->params[i].name, s->names[k]) == 0 &&
+                !(fabs(m->params[i].value - p[k]) <= 1e-12 * fabs(p[k]) + 1e-300))
+                rc = MECH_EINPUT;
+    mech_model_free(&m);
+    free(text);
+    if (rc != MECH_OK)
+        return diag_error(d, s->fp.path, (mech_mark){0, 0}, "mech fit: the file with the "
+                          "parameters' values replaced in its text does not load with those "
+                          "values (a value written in a form this edit does not handle); no "
+                          "file written");
+    return MECH_OK;
 }
 
 static int write_best(const fit_setup *s, const mech_model *m, const double *p, const char *out)
@@ -681,7 +719,9 @@ static int write_best(const fit_setup *s, const mech_model *m, const double *p, 
     }
     mech_diag d;
     mech_diag_init(&d);
-    int rc = write_file_whole(out, emit_edited, &e, &d);
+    int rc = check_edited(s, &e, p, &d);
+    if (rc == MECH_OK)
+        rc = write_file_whole(out, emit_edited, &e, &d);
     mech_diag_print(&d, stderr);
     mech_diag_free(&d);
     free(text);
