@@ -3,7 +3,8 @@
 # targets are solved from a known four-bar (tests/fit/fourbar.yaml: r 20,
 # l 60, b 50, d 70 mm, P at 40 mm and 30 deg from AB); a copy with some
 # dimensions changed must fit back to the known ones: path generation (P.x,
-# P.y), function generation (the rocker's angle against the crank's),
+# P.y), function generation (the rocker's angle against the crank's; and
+# at three precision points against Freudenstein's equation solved here),
 # motion generation (P and the coupler's angle); a bound that excludes the
 # answer gives the bound and a residual, honestly reported; targets no
 # mechanism within the bounds reaches give exit 1 and no file; the file
@@ -88,6 +89,46 @@ if run "function" 0 "$MECH" fit "$tmp/moved.yaml" --free r,l,b --target "$tmp/fu
     near "$(value l "$tmp/fn.yaml")" 60 1e-6 && pass || fail "function: l = $(value l "$tmp/fn.yaml")"
     near "$(value b "$tmp/fn.yaml")" 50 1e-6 && pass || fail "function: b = $(value b "$tmp/fn.yaml")"
     has_line "$tmp/out" '^  rocker.angle worst error [0-9.e+-]* deg' "function: the error in degrees"
+fi
+
+# function generation against Freudenstein's equation at three precision
+# points (an exact solution): the input angles phi 30, 90, 150 deg and the
+# output angles psi of the four-bar r 20, l 60, b 50, d 70 mm computed here
+# by the circle intersection; Freudenstein's K1 cos(psi) - K2 cos(phi) + K3
+# = cos(phi - psi) with K1 = d/r, K2 = d/b, K3 = (r^2 - l^2 + b^2 + d^2) /
+# (2 r b) solved for K (Cramer's rule) gives the lengths with d fixed; mech
+# fit from 10 % off must find those
+awk 'BEGIN {
+    pi = atan2(0, -1); r = 20; l = 60; b = 50; d = 70
+    print "q [deg],rocker.angle [deg]"
+    for (i = 0; i < 3; i++) {
+        f = (30 + 60 * i) * pi / 180; ax = r * cos(f); ay = r * sin(f)
+        dx = d - ax; dy = -ay; dd = sqrt(dx * dx + dy * dy)
+        a = (l * l - b * b + dd * dd) / (2 * dd); h = sqrt(l * l - a * a)
+        bx = ax + a * dx / dd - h * dy / dd; by = ay + a * dy / dd + h * dx / dd
+        s = atan2(by, bx - d)
+        printf "%.17g,%.17g\n", (30 + 60 * i), s * 180 / pi
+        F[i] = f; S[i] = s
+    }
+    # rows: cos(psi) K1 - cos(phi) K2 + K3 = cos(phi - psi)
+    for (i = 0; i < 3; i++) { M[i,0] = cos(S[i]); M[i,1] = -cos(F[i]); M[i,2] = 1; R[i] = cos(F[i] - S[i]) }
+    det = M[0,0]*(M[1,1]*M[2,2]-M[1,2]*M[2,1]) - M[0,1]*(M[1,0]*M[2,2]-M[1,2]*M[2,0]) + M[0,2]*(M[1,0]*M[2,1]-M[1,1]*M[2,0])
+    for (k = 0; k < 3; k++) {
+        for (i = 0; i < 3; i++) for (j = 0; j < 3; j++) N[i,j] = (j == k) ? R[i] : M[i,j]
+        K[k] = (N[0,0]*(N[1,1]*N[2,2]-N[1,2]*N[2,1]) - N[0,1]*(N[1,0]*N[2,2]-N[1,2]*N[2,0]) + N[0,2]*(N[1,0]*N[2,1]-N[1,1]*N[2,0])) / det
+    }
+    fr = d / K[0]; fb = d / K[1]; fl = sqrt(fr * fr + fb * fb + d * d - 2 * K[2] * fr * fb)
+    printf "%.17g %.17g %.17g\n", fr, fl, fb > "/dev/stderr"
+}' >"$tmp/freud.csv" 2>"$tmp/freud.txt"
+read -r fr fl fb <"$tmp/freud.txt"
+near "$fr" 20 1e-9 && near "$fl" 60 1e-9 && near "$fb" 50 1e-9 && pass ||
+    fail "Freudenstein's solution $fr $fl $fb is not the four-bar's 20 60 50"
+if run "Freudenstein" 0 "$MECH" fit "$tmp/moved.yaml" --free r,l,b --target "$tmp/freud.csv" -o "$tmp/freud.yaml"; then
+    near "$(value r "$tmp/freud.yaml")" "$fr" 1e-6 && pass || fail "Freudenstein: r = $(value r "$tmp/freud.yaml"), expected $fr"
+    near "$(value l "$tmp/freud.yaml")" "$fl" 1e-6 && pass || fail "Freudenstein: l = $(value l "$tmp/freud.yaml"), expected $fl"
+    near "$(value b "$tmp/freud.yaml")" "$fb" 1e-6 && pass || fail "Freudenstein: b = $(value b "$tmp/freud.yaml"), expected $fb"
+    obj=$(sed -n 's/^objective *\([^ ]*\).*/\1/p' "$tmp/out")
+    near "$obj" 0 1e-20 && pass || fail "Freudenstein: objective $obj, expected 0 (an exact solution)"
 fi
 
 # motion generation: P and the coupler's angle; the coupler point's
