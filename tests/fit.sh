@@ -131,6 +131,24 @@ if run "Freudenstein" 0 "$MECH" fit "$tmp/moved.yaml" --free r,l,b --target "$tm
     near "$obj" 0 1e-20 && pass || fail "Freudenstein: objective $obj, expected 0 (an exact solution)"
 fi
 
+# free timing: the targets' crank angles given 3-4 deg off, each an
+# unknown: the dimensions and the true angles (0, 30, ..., 330) come back;
+# with the timing prescribed the same targets leave a residual
+awk -F, 'NR == 1 { print; next } { printf "%.10g,%s,%s\n", $1 + ((NR % 2) ? 4 : -3), $2, $3 }' \
+    "$tmp/path.csv" >"$tmp/shifted.csv"
+if run "prescribed timing, shifted" 0 "$MECH" fit "$tmp/moved.yaml" --free r,l,b --target "$tmp/shifted.csv"; then
+    obj=$(sed -n 's/^objective *\([^ ]*\).*/\1/p' "$tmp/out")
+    near "$obj" 0 1e-8 && fail "prescribed timing: objective $obj, expected a residual" || pass
+fi
+if run "free timing" 0 "$MECH" fit "$tmp/moved.yaml" --free r,l,b --target "$tmp/shifted.csv" --free-timing \
+    -o "$tmp/timed.yaml"; then
+    near "$(value r "$tmp/timed.yaml")" 20 1e-6 && pass || fail "free timing: r = $(value r "$tmp/timed.yaml")"
+    near "$(value l "$tmp/timed.yaml")" 60 1e-6 && pass || fail "free timing: l = $(value l "$tmp/timed.yaml")"
+    near "$(value b "$tmp/timed.yaml")" 50 1e-6 && pass || fail "free timing: b = $(value b "$tmp/timed.yaml")"
+    sed -n '/^timing/{n;p}' "$tmp/out" | awk '{ for (i = 1; i < NF; i++) { d = $i - 30 * (i - 1); if (d < 0) d = -d; if (d > 1e-6) bad = 1 } } END { exit bad }' &&
+        pass || fail "free timing: the angles $(sed -n '/^timing/{n;p}' "$tmp/out")"
+fi
+
 # motion generation: P and the coupler's angle; the coupler point's
 # distance e ({value:, tolerance:}) and angle phi free with the crank
 sed -e 's/^  r: 20 mm/  r: 21 mm/' -e 's/value: 40 mm/value: 37 mm/' -e 's/^  phi: 30 deg/  phi: 34 deg/' \

@@ -215,6 +215,7 @@ typedef struct model_fit {
     int ncolumns;
     int starts;        /* 0: the default */
     int whole_range;   /* 1: the solution must assemble over the file's whole range */
+    int free_timing;   /* 1: each target row's driver position is an unknown too */
     mech_mark mark;
 } model_fit;
 void model_fit_free_all(model_fit *f);  /* accepts NULL */

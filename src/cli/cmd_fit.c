@@ -14,6 +14,7 @@
 #include "study.h"
 
 enum { MAX_FREE = 32, MAX_COLS = 64, MAX_SHOWN = 5 };
+enum { MAX_TIMED = 512, MAX_VARS = MAX_FREE + MAX_TIMED };  /* free timing: rows, unknowns */
 
 typedef struct fit_list {
     const char *v[MAX_COLS];
@@ -26,6 +27,7 @@ typedef struct fit_args {
     fit_list weights;            /* --weight NAME=W (repeatable) */
     int starts, jobs, quiet;
     int whole_range;             /* --whole-range */
+    int free_timing;             /* --free-timing */
 } fit_args;
 
 /* A repeatable option's value appended to its list. */
@@ -70,6 +72,11 @@ static const cmd_opt options[] = {
              "whole driver range (a crank from 0 to 360 deg turns\n"
              "fully: a Grashof crank); a solution that does not is\n"
              "rejected"},
+    {.names = "--free-timing", .kind = CMD_OPT_FLAG, .at = AT(free_timing), .flag = 1,
+     .label = "--free-timing",
+     .help = "each target's driver position is an unknown too (the\n"
+             "CSV's is its start): a path through the points, whatever\n"
+             "the crank angle at each; needs position and rate columns"},
     {.names = "-o|--output", .kind = CMD_OPT_TEXT, .at = AT(out), .label = "-o, --output FILE",
      .help = "write the best solution as a copy of the mechanism file\n"
              "with the free parameters' values replaced (comments kept;\n"
@@ -85,7 +92,8 @@ const cmd_spec cmd_fit_spec = {
     .summary = "fit parameters so that outputs meet targets (synthesis)",
     .usage = "usage: mech fit FILE --free NAME[=LO:HI],... --target TARGETS.csv\n"
              "                [--column NAME]... [--weight NAME=W]... [--starts N]\n"
-             "                [--whole-range] [-j N] [-o BEST.yaml] [--quiet]\n"
+             "                [--whole-range] [--free-timing] [-j N] [-o BEST.yaml]\n"
+             "                [--quiet]\n"
              "       mech fit FILE [-o BEST.yaml]   (the file's fit: section)\n",
     .about = "Dimensional synthesis: find the values of the file's free parameters that\n"
              "make the solved outputs meet the targets at the targets' driver positions:\n"
@@ -116,7 +124,7 @@ typedef struct fit_setup {
     const char *bound_text[MAX_FREE][2];  /* LO, HI as given, or NULL */
     char unit[MAX_FREE][32];
     mech_mark mark[MAX_FREE];
-    double lo[MAX_FREE], hi[MAX_FREE], p0[MAX_FREE];
+    double lo[MAX_VARS], hi[MAX_VARS], p0[MAX_FREE];  /* lo, hi: also the timing's */
     const char *cols[MAX_COLS];
     char col_unit[MAX_COLS][16];
     double weight[MAX_COLS];
@@ -395,6 +403,7 @@ static int setup(fit_setup *s, const fit_args *a, mech_model **m)
     if (code >= 0)
         return code;
     s->whole_range = a->whole_range || (mf && mf->whole_range);
+    s->fp.free_timing = a->free_timing || (mf && mf->free_timing);
     mech_diag d;
     mech_diag_init(&d);
     int rc = compare_read_csv(s->target_path, &s->csv, &d);
@@ -420,13 +429,24 @@ static int setup(fit_setup *s, const fit_args *a, mech_model **m)
     code = convert_targets(s);
     if (code >= 0)
         return code;
+    if (s->fp.free_timing && s->fp.nq > MAX_TIMED)
+        return cmd_usage_error("fit", "free timing: at most 512 target rows%s", "");
+    if (s->fp.nq * s->fp.ncols < fit_nvars(&s->fp)) {
+        fprintf(stderr, "mech fit: %d target values for %d unknowns (free timing: one per "
+                "row too): give more targets\n", s->fp.nq * s->fp.ncols, fit_nvars(&s->fp));
+        return MECH_EXIT_INPUT;
+    }
+    for (int j = s->fp.nfree; j < fit_nvars(&s->fp); j++) {
+        s->lo[j] = -INFINITY;
+        s->hi[j] = INFINITY;
+    }
     return read_bounds(s, *m);
 }
 
 /* ---- the starts --------------------------------------------------------- */
 
 typedef struct fit_start {
-    double p[MAX_FREE];
+    double p[MAX_VARS];   /* the parameters, then (free timing) the driver positions */
     double objective;     /* sum of squared weighted residuals; INFINITY: rejected */
     int rc, info;
     long solves;
@@ -460,6 +480,8 @@ static void start_point(const fit_setup *s, long i, double *p)
         int b = isfinite(s->lo[k]) && isfinite(s->hi[k]);
         p[k] = i == 0 || !b ? s->p0[k] : s->lo[k] + (s->hi[k] - s->lo[k]) * halton(i, primes[k]);
     }
+    for (int j = 0; s->fp.free_timing && j < s->fp.nq; j++)
+        p[s->fp.nfree + j] = s->q[j];  /* the CSV's driver positions */
 }
 
 static void run_start(void *ctx, long i)
@@ -550,7 +572,8 @@ static void print_errors(fit_setup *s, const mech_model *m, const double *p, FIL
             double we = output_in_file_units(m, s->col_unit[j], worst, bu, sizeof bu);
             double rms = output_in_file_units(m, s->col_unit[j], sqrt(sum / (cnt ? cnt : 1)),
                                               bu, sizeof bu);
-            double qat = output_in_file_units(m, s->fp.qunit, s->q[at], bq, sizeof bq);
+            double qw = s->fp.free_timing ? p[s->fp.nfree + at] : s->q[at];
+            double qat = output_in_file_units(m, s->fp.qunit, qw, bq, sizeof bq);
             fprintf(out, "  %-12s worst error %.3g %s (at %s = %.6g %s), rms %.3g %s\n",
                     s->cols[j], we, bu, s->csv.names[0], qat, bq, rms, bu);
         }
@@ -765,6 +788,18 @@ static int report(fit_setup *s, const fit_args *a, const mech_model *m, fit_star
     fprintf(out, "objective    %.6g (sum of squared weighted residuals, SI)\n", st[0].objective);
     fprintf(out, "best solution:\n");
     print_params(s, m, st[0].p, out);
+    if (s->fp.free_timing) {
+        fprintf(out, "timing (the fitted driver position of each target row):\n ");
+        for (int j = 0; j < s->fp.nq; j++) {
+            char bq[32];
+            double v = output_in_file_units(m, s->fp.qunit, st[0].p[s->fp.nfree + j], bq,
+                                            sizeof bq);
+            fprintf(out, " %.10g%s", v, j + 1 < s->fp.nq ? "" : " ");
+            if (j + 1 == s->fp.nq)
+                fprintf(out, "%s", bq);
+        }
+        fputc('\n', out);
+    }
     fprintf(out, "target errors:\n");
     print_errors(s, m, st[0].p, out);
     if (!a->quiet && ok > 1) {

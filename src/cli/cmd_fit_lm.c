@@ -96,7 +96,7 @@ static double sum_squares(const double *r, int m)
 int fit_lm(fit_problem *fp, const double *lo, const double *hi, double *p, double *r,
            double *objective, int *info)
 {
-    int n = fp->nfree, m = fp->nq * fp->ncols;
+    int n = fit_nvars(fp), m = fp->nq * fp->ncols;
     size_t nn = (size_t)n, mm = (size_t)m;
     double *u = xcalloc(nn, sizeof *u), *fvec = xcalloc(mm, sizeof *fvec);
     double *fjac = xcalloc(mm * nn, sizeof *fjac), *diag = xcalloc(nn, sizeof *diag);

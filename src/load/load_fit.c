@@ -10,6 +10,7 @@
  *     weights: {P.y: 2}          # default 1
  *     starts: 16
  *     whole-range: true          # the solution assembles over the driver's range
+ *     free-timing: true          # each target's driver position an unknown too
  */
 #include <math.h>
 #include <stdlib.h>
@@ -148,7 +149,7 @@ static void weights(loader *ld, model_fit *f, const ynode *map)
 void load_fit(loader *ld, const ynode *map)
 {
     static const char *const keys[] = {"free", "target", "columns", "weights", "starts",
-                                       "whole-range"};
+                                       "whole-range", "free-timing"};
     if (!load_check_keys(ld, map, keys, COUNT(keys), "'fit'"))
         return;
     model_fit *f = xcalloc(1, sizeof *f);
@@ -170,4 +171,6 @@ void load_fit(loader *ld, const ynode *map)
         f->starts = (int)n;
     if ((v = ymap_get(map, "whole-range")))
         load_get_bool(ld, v, "'fit: whole-range'", &f->whole_range);
+    if ((v = ymap_get(map, "free-timing")))
+        load_get_bool(ld, v, "'fit: free-timing'", &f->free_timing);
 }

@@ -59,7 +59,7 @@ static int eval_options(const fit_problem *fp, const mech_model *m, mech_outputs
 {
     char err[256];
     mech_solve_options_default(o);
-    o->want = MECH_WANT_POSITION;
+    o->want = fp->free_timing ? MECH_WANT_POSITION | MECH_WANT_VELOCITY : MECH_WANT_POSITION;
     o->forces = -1;
     if (mech_outputs_parse(m, fp->outputs, outs, err, sizeof err) != MECH_OK)
         return diag_error(d, fp->path, (mech_mark){0, 0}, "a target column names what mech solve does not output: %s", err);
@@ -101,6 +101,10 @@ int fit_prepare(fit_problem *fp, double *p0, mech_diag *d)
     }
     if (rc == MECH_OK)
         rc = outputs_list(fp, d);
+    if (rc == MECH_OK && fp->free_timing &&
+        (m->driver.kind == MECH_DRIVE_TIME || m->ndrivers != 1 || !(m->driver.speed != 0.0)))
+        rc = diag_error(d, m->file, (mech_mark){0, 0}, "free timing needs one driver "
+                        "('driver:', with a speed other than 0), not laws of time");
     mech_solve_options o;
     if (rc == MECH_OK)
         rc = eval_options(fp, m, &outs, &o, d);
@@ -125,6 +129,16 @@ done:
     mech_outputs_free(&outs);
     mech_model_free(&m);
     return rc;
+}
+
+/* The rate column of a position column: "P.x" -> "P.vx", "rocker.angle" ->
+ * "rocker.omega", "slider.s" -> "slider.v". */
+static void rate_name(const char *col, char *buf, size_t size)
+{
+    const char *dot = strrchr(col, '.');
+    const char *sfx = strcmp(dot + 1, "x") == 0 ? "vx" : strcmp(dot + 1, "y") == 0 ? "vy"
+                      : strcmp(dot + 1, "angle") == 0 ? "omega" : "v";
+    snprintf(buf, size, "%.*s.%s", (int)(dot - col), col, sfx);
 }
 
 /* y - y*, an angle's difference taken in (-pi, pi]. */
@@ -162,7 +176,8 @@ int fit_eval(fit_problem *fp, const double *p, double *r, double *jac, mech_diag
     if (rc == MECH_OK)
         rc = eval_options(fp, m, &outs, &o, &quiet);
     if (rc == MECH_OK)
-        rc = sens_table_at(m, &o, fp->q, fp->nq, fp->names, jac ? n : 0, &t, &quiet);
+        rc = sens_table_at(m, &o, fp->free_timing ? p + n : fp->q, fp->nq, fp->names,
+                           jac ? n : 0, &t, &quiet);
     if (rc == MECH_OK && t.nrows != fp->nq)
         rc = MECH_ESOLVE;
     if (rc != MECH_OK) {
@@ -179,6 +194,19 @@ int fit_eval(fit_problem *fp, const double *p, double *r, double *jac, mech_diag
         for (int i = 0; i < fp->nq; i++) {
             double y = mech_table_get(&t, i, c), y0 = fp->target[(size_t)i * fp->ncols + j];
             r[i * fp->ncols + j] = isnan(y0) ? 0.0 : w * difference(fp->col_unit[j], y, y0);
+        }
+        if (jac && fp->free_timing) {
+            /* dr/dq_i = w dy/dq = w (dy/dt) / (dq/dt), on row i only */
+            char name[300];
+            rate_name(fp->cols[j], name, sizeof name);
+            int vc = mech_table_column(&t, name);
+            for (int i = 0; i < fp->nq; i++) {
+                double y0 = fp->target[(size_t)i * fp->ncols + j];
+                for (int i2 = 0; i2 < fp->nq; i2++)
+                    jac[(size_t)(n + i2) * mrows + i * fp->ncols + j] =
+                        i2 != i || isnan(y0) || vc < 0
+                            ? 0.0 : w * mech_table_get(&t, i, vc) / m->driver.speed;
+            }
         }
         for (int k = 0; jac && k < n; k++) {
             char name[300];

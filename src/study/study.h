@@ -255,13 +255,22 @@ typedef struct fit_problem {
     const double *weight;      /* [ncols] or NULL (all 1) */
     char *outputs;             /* the objects the columns need, "P,rocker"; owned */
     long nsolves;              /* evaluations so far */
+    int free_timing;           /* 1: the driver positions are unknowns too, p[nfree + i]
+                                  (q is then only the start); dr/dq from the rates */
 } fit_problem;
+
+/* The unknowns of the problem: the free parameters, and with free timing
+ * one driver position per target row. */
+static inline int fit_nvars(const fit_problem *fp)
+{
+    return fp->nfree + (fp->free_timing ? fp->nq : 0);
+}
 
 /* Load and check the file, find the free parameters (their values into
  * p0[nfree], units and marks into fp) and the columns (their units):
  * MECH_OK, or an error in d naming the unknown parameter or column. */
 int fit_prepare(fit_problem *fp, double *p0, mech_diag *d);
-/* r[nq ncols] at p[nfree] and, when jac is not NULL, dr/dp into
+/* r[nq ncols] at p[fit_nvars] and, when jac is not NULL, dr/dp into
  * jac[k * nq ncols + row] (column-major, MINPACK's layout). MECH_OK;
  * MECH_ESOLVE (nothing in d) when the mechanism does not assemble at
  * every target; MECH_ENOMEM. */
