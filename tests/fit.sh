@@ -52,6 +52,7 @@ if run "path" 0 "$MECH" fit "$tmp/moved.yaml" --free r,l,b --target "$tmp/path.c
     obj=$(sed -n 's/^objective *\([^ ]*\).*/\1/p' "$tmp/out")
     near "$obj" 0 1e-20 && pass || fail "path: objective $obj, expected about 0"
     has_line "$tmp/out" '^solves  *[1-9][0-9]* ' "path: the number of solves"
+    has_line "$tmp/out" '^stopped      converged: .* (lmder info [1-4])$' "path: lmder converged"
     has_line "$tmp/out" '^time  *[0-9.e+-]* s$' "path: the time"
     has_line "$tmp/out" '^  P.x  *worst error [0-9.e+-]* mm (at q = [0-9.]* deg)' "path: the worst error"
     # 4. the file written: comments kept, only the three values changed, and

@@ -785,7 +785,16 @@ static int report(fit_setup *s, const fit_args *a, const mech_model *m, fit_star
                 a->out ? ", no file written" : "");
         return MECH_EXIT_SOLVE;
     }
+    static const char *const why[] = {
+        "improper input", "the sum of squares cannot fall by more than 1e-15 (ftol)",
+        "the relative step is below 1e-12 (xtol)", "both ftol and xtol",
+        "the gradient is orthogonal to the residuals", "the evaluation limit",
+        "ftol is too small", "xtol is too small", "gtol is too small"};
+    int info = st[0].info;
     fprintf(out, "objective    %.6g (sum of squared weighted residuals, SI)\n", st[0].objective);
+    fprintf(out, "stopped      %s%s (lmder info %d)\n",
+            info >= 1 && info <= 4 ? "converged: " : "not converged: ",
+            info >= 0 && info <= 8 ? why[info] : "interrupted", info);
     fprintf(out, "best solution:\n");
     print_params(s, m, st[0].p, out);
     if (s->fp.free_timing) {
