@@ -350,6 +350,9 @@ typedef struct mech_model {
                                  them (src/base/base.h); NULL when it gives none */
     struct model_fit *fit; /* owned: the file's `fit:` section, mech fit's problem
                               (src/base/base.h, docs/synthesis.md); NULL when none */
+    struct free_drivers *free_drivers; /* owned: the drivers of `drivers:` marked
+                                 `free: true` (docs/dynamics.md; src/load/load.h), moved by
+                                 their loads in `mech simulate`; NULL when none is */
 } mech_model;
 
 /* Read and validate a mechanism file. On success *out is the model and the
