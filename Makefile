@@ -62,7 +62,10 @@ SONAME   = libmech.so.$(SOABI)
 
 SRC_INC = $(addprefix -I,$(SRC_DIRS))
 CFLAGS  = $(CFLAGS_BASE) $(OPT) $(SAN) -Iinclude $(SRC_INC) $(YAML_CFLAGS) $(KLU_CFLAGS) $(MINPACK_CFLAGS)
-LDLIBS  = $(YAML_LIBS) $(KLU_LIBS) -lm -pthread
+# SUNDIALS CVODE (mech simulate, docs/dynamics.md): Debian's libsundials-dev
+SUNDIALS_LIBS = -lsundials_cvode -lsundials_sunlinsoldense -lsundials_sunmatrixdense \
+                -lsundials_nvecserial -lsundials_generic
+LDLIBS  = $(YAML_LIBS) $(KLU_LIBS) $(SUNDIALS_LIBS) -lm -pthread
 LDFLAGS = $(SAN) -pthread
 
 # src/ is one folder per stage of the pipeline, each with one header
@@ -353,7 +356,7 @@ install: all $(if $(filter 1,$(WITH_PYTHON)),python)
 	install -m 755 $(BUILD)/libmech.so.$(VERSION) $(DESTDIR)$(PREFIX)/lib/libmech.so.$(VERSION)
 	ln -sf libmech.so.$(VERSION) $(DESTDIR)$(PREFIX)/lib/$(SONAME)
 	ln -sf $(SONAME) $(DESTDIR)$(PREFIX)/lib/libmech.so
-	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@VERSION@|$(VERSION)|' -e 's|@KLU_LIBS@|$(KLU_LIBS)|' \
+	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@VERSION@|$(VERSION)|' -e 's|@KLU_LIBS@|$(KLU_LIBS) $(SUNDIALS_LIBS)|' \
 	    mech.pc.in >$(DESTDIR)$(PREFIX)/lib/pkgconfig/mech.pc
 	install -m 644 include/mech.h $(DESTDIR)$(PREFIX)/include/mech.h
 	install -m 644 docs/mech.1 $(DESTDIR)$(PREFIX)/share/man/man1/mech.1

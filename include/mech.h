@@ -611,6 +611,45 @@ int mech_pose_guess(const mech_model *m, double q, mech_pose *out, mech_diag *d)
 void mech_pose_point(const mech_model *m, const mech_pose *p, int link, int k, double xy[2]);
 void mech_pose_free(mech_pose *p);
 
+/* ---- Forward dynamics (src/study/simulate.c, docs/dynamics.md) -----------
+ * The drivers of `drivers:` marked `free: true` move as the loads make them
+ * move: mech_simulate integrates the equations of motion in those free
+ * coordinates with SUNDIALS CVODE and writes one row per output time: the
+ * columns of mech_solve with forces (t, the outputs, reactions, driver
+ * loads, power residual), then energy.kinetic, energy.gravity,
+ * energy.springs, work.loads, work.drivers, work.dampers and
+ * energy.balance (J). */
+enum { MECH_SIM_BDF = 0, MECH_SIM_ADAMS = 1 };
+
+typedef struct mech_simulate_options {
+    double to;         /* last time, s (NAN: the sweep's last) */
+    double step;       /* output spacing, s (0: the sweep's) */
+    double rtol, atol; /* CVODE's tolerances (default 1e-8, 1e-10) */
+    int method;        /* MECH_SIM_BDF (default) or MECH_SIM_ADAMS */
+    long max_steps;    /* integration steps between two output times (default 1e6) */
+} mech_simulate_options;
+
+typedef struct mech_simulate_stats {
+    long steps, rhs_evals, jac_evals; /* CVODE's */
+    long evaluations;      /* states evaluated (positions, rates, mass matrix) */
+    long force_solves;
+    int rows;              /* output rows written */
+    double worst_residual; /* largest Newton residual of the loops, m */
+    double worst_free_load;/* largest |load| a free driver still needed at an output row
+                              (0 in exact arithmetic: the equations of motion's residual) */
+    double stop_time;      /* where the run ended, s */
+    double seconds;        /* wall time */
+} mech_simulate_stats;
+
+void mech_simulate_options_default(mech_simulate_options *o);
+/* Simulate a checked model with free drivers. MECH_OK; MECH_ESOLVE when the
+ * run stopped early (a limit position, a dead point, an integrator failure:
+ * d says where and why; out holds the rows so far); MECH_EINPUT when the
+ * model has no free driver or has what the simulation does not model
+ * (Coulomb friction, loads of accelerations). stats may be NULL. */
+int mech_simulate(const mech_model *m, const mech_simulate_options *o, mech_table *out,
+                  mech_simulate_stats *stats, mech_diag *d);
+
 /* Sensitivities (src/study/sensitivity.c, docs/sensitivity.md): to `table`, the
  * result of mech_solve(m, o, ...), add for each parameter names[k] and each
  * kinematic column COL (points' x, y, vx, vy, ax, ay; links' angle, omega,

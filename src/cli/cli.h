@@ -263,6 +263,10 @@ int cmd_equations(int argc, char **argv);
 extern const cmd_spec cmd_solve_spec;
 int cmd_solve(int argc, char **argv);
 
+/* `mech simulate FILE` (cmd_simulate.c, docs/dynamics.md): forward dynamics. */
+extern const cmd_spec cmd_simulate_spec;
+int cmd_simulate(int argc, char **argv);
+
 extern const cmd_spec cmd_batch_spec;
 int cmd_batch(int argc, char **argv);
 

@@ -353,6 +353,18 @@ step_status solver_newton(solver *sv, double q);
 /* dx/dq and d2x/dq2 at the converged position (both always: the predictor
  * uses them). */
 void solver_rates(solver *sv);
+/* Free coordinates (mech simulate, docs/dynamics.md): Newton for
+ * f(x, q) = shift[0..nr-1] (the solved rows; a driver's row x_k - p_k(q)
+ * shifted by X_k - p_k(q) holds x_k at X_k), from sv->x. */
+step_status solver_newton_shifted(solver *sv, double q, const double *shift);
+/* After solver_newton_shifted, for the time as sweep variable (qdot 1,
+ * qddot 0): sv->xq := x' from J x' = -f_q + vshift, sv->xqq := x'' from
+ * J x'' = (the acceleration right-hand side at x') + ashift (NULL: 0);
+ * solver_publish(sv, t, 1, 0) then publishes them. */
+void solver_rates_shifted(solver *sv, const double *vshift, const double *ashift);
+/* x'' again for another ashift at the same position and velocities (after
+ * solver_rates_shifted; one solve). */
+void solver_accel_shifted(solver *sv, const double *ashift);
 /* Scatter x, and the rates for driver speed qd and acceleration qdd, into
  * pos, vel, acc and update the link frames. */
 void solver_publish(solver *sv, double q, double qd, double qdd);  /* again: no work */
