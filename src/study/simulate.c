@@ -136,6 +136,8 @@ static void powers(sim *s)
     double pd = 0.0;
     for (int k = 0; k < s->m->ndrivers; k++) {
         const rt_drive *dr = &fn->drive[k];
+        if (drivers_free_of(s->m, k))
+            continue;  /* its load is 0 but for rounding: no work (docs/dynamics.md) */
         double rate = dr->link > 0 ? F[dr->link].om : dr->var >= 0 ? s->sv.vel[dr->var] : 0.0;
         pd += forces_drive_of(&s->fc, 1, k) * rate;
     }
@@ -506,6 +508,15 @@ static int integrate(sim *s, const mech_simulate_options *o, double t0, double t
         stats->rhs_evals = v;
         CVodeGetNumJacEvals(cv, &v);
         stats->jac_evals = v;
+        if (getenv("MECH_SIM_DEBUG")) {
+            long a1 = 0, a2 = 0, a3 = 0;
+            int q = 0;
+            CVodeGetNumErrTestFails(cv, &a1);
+            CVodeGetNumNonlinSolvConvFails(cv, &a2);
+            CVodeGetNumNonlinSolvIters(cv, &a3);
+            CVodeGetLastOrder(cv, &q);
+            fprintf(stderr, "cvode: %ld error test fails, %ld conv fails, %ld nl iters, order %d\n", a1, a2, a3, q);
+        }
     }
 done:
     if (cv)
