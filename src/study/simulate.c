@@ -425,6 +425,12 @@ static const char *cvode_why(int flag)
     }
 }
 
+static void quiet_errors(int code, const char *module, const char *function, char *msg,
+                         void *user)
+{
+    (void)code, (void)module, (void)function, (void)msg, (void)user;
+}
+
 static int integrate(sim *s, const mech_simulate_options *o, double t0, double t1, int nrows,
                      double h, mech_table *out, mech_simulate_stats *stats)
 {
@@ -461,7 +467,7 @@ static int integrate(sim *s, const mech_simulate_options *o, double t0, double t
         rc = diag_error(s->d, m->file, m->driver.mark, "CVODE could not be set up");
         goto done;
     }
-    CVodeSetErrHandlerFn(cv, NULL, NULL);
+    CVodeSetErrHandlerFn(cv, quiet_errors, NULL);  /* the failure is reported by fail_at */
     for (int i = 1; i < nrows; i++) {
         double tout = i == nrows - 1 ? t1 : t0 + h * i, tret = t0;
         int flag = CVode(cv, tout, y, &tret, CV_NORMAL);
