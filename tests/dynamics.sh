@@ -26,7 +26,9 @@ col() { head -n 1 "$1" | tr ',' '\n' | grep -n "^$2 \[" | cut -d: -f1; }
 
 # within LABEL VALUE LIMIT: pass when |VALUE| <= LIMIT
 within() {
-    if awk -v v="$2" -v l="$3" 'BEGIN { if (v < 0) v = -v; exit !(v <= l) }'; then
+    if [ -z "$2" ]; then
+        fail "$1: no value"
+    elif awk -v v="$2" -v l="$3" 'BEGIN { if (v < 0) v = -v; exit !(v <= l) }'; then
         pass
     else
         fail "$1: $2, expected at most $3 in size"
@@ -62,7 +64,7 @@ balance_ratio() {
     awk -F, -v b="$(col "$1" energy.balance)" 'NR > 1 {
             v = $b < 0 ? -$b : $b; if (v > w) w = v
             for (i = b - 6; i < b; i++) { e = $i < 0 ? -$i : $i; if (e > s) s = e } }
-        END { printf "%.3g\n", s > 0 ? w / s : 1 }' "$1"
+        END { printf "%.3g\n", (s > 0 ? w / s : 1) }' "$1"
 }
 
 # ---- 1. the compound pendulum ------------------------------------------------
@@ -100,11 +102,11 @@ if run "slider-crank run-up" 0 "$MECH" simulate $D/slider-crank-torque.yaml --rt
     a=$(col "$tmp/sc.csv" crank.angle)
     k=$(col "$tmp/sc.csv" energy.kinetic)
     # T = 0.5 N*m from theta0 = 30 deg: KE = T (theta - theta0) at every row
-    within "run-up: kinetic energy against T (theta - theta0)" "$(awk -F, -v a="$a" -v k="$k" 'NR > 1 { w = 0.5 * ($a - 0.5235987755982988); d = ($k - w) / (w > 1e-3 ? w : 1e-3); if (d < 0) d = -d; if (d > m) m = d } END { print m }' "$tmp/sc.csv")" 1e-6
+    within "run-up: kinetic energy against T (theta - theta0)" "$(awk -F, -v a="$a" -v k="$k" 'NR > 1 { w = 0.5 * ($a - 0.5235987755982988); d = ($k - w) / (w > 1e-3 ? w : 1e-3); if (d < 0) d = -d; if (d > m) m = d } END { print m + 0 }' "$tmp/sc.csv")" 1e-6
     # and it turned: at least five turns in 0.5 s
-    within "run-up: the crank turned" "$(awk -F, -v a="$a" 'END { print ($a > 31.4) ? 0 : 1 }' "$tmp/sc.csv")" 0
+    within "run-up: the crank turned" "$(awk -F, -v a="$a" 'END { print (($a > 31.4) ? 0 : 1) }' "$tmp/sc.csv")" 0
     # a free driver needs no load: its column is 0 to rounding
-    within "run-up: the free driver's load" "$(awk -F, -v c="$(col "$tmp/sc.csv" crank.torque)" 'NR > 1 { v = $c < 0 ? -$c : $c; if (v > m) m = v } END { print m }' "$tmp/sc.csv")" 1e-8
+    within "run-up: the free driver's load" "$(awk -F, -v c="$(col "$tmp/sc.csv" crank.torque)" 'NR > 1 { v = $c < 0 ? -$c : $c; if (v > m) m = v } END { print m + 0 }' "$tmp/sc.csv")" 1e-8
     has_line "$tmp/err" "simulated to t = 0.5 s, 101 rows" "--stats: the summary"
 fi
 
@@ -112,15 +114,15 @@ fi
 
 if run "five-bar, two free cranks" 0 "$MECH" simulate $D/five-bar-free.yaml --to 2s --rtol 1e-10 -o "$tmp/fb.csv"; then
     within "five-bar: energy balance" "$(balance_ratio "$tmp/fb.csv")" 1e-8
-    within "five-bar: crank1 swings" "$(awk -F, -v c="$(col "$tmp/fb.csv" crank1.angle)" 'NR == 2 { lo = hi = $c } NR > 1 { if ($c < lo) lo = $c; if ($c > hi) hi = $c } END { print (hi - lo > 0.5) ? 0 : 1 }' "$tmp/fb.csv")" 0
-    within "five-bar: crank2 swings" "$(awk -F, -v c="$(col "$tmp/fb.csv" crank2.angle)" 'NR == 2 { lo = hi = $c } NR > 1 { if ($c < lo) lo = $c; if ($c > hi) hi = $c } END { print (hi - lo > 0.5) ? 0 : 1 }' "$tmp/fb.csv")" 0
+    within "five-bar: crank1 swings" "$(awk -F, -v c="$(col "$tmp/fb.csv" crank1.angle)" 'NR == 2 { lo = hi = $c } NR > 1 { if ($c < lo) lo = $c; if ($c > hi) hi = $c } END { print ((hi - lo > 0.5) ? 0 : 1) }' "$tmp/fb.csv")" 0
+    within "five-bar: crank2 swings" "$(awk -F, -v c="$(col "$tmp/fb.csv" crank2.angle)" 'NR == 2 { lo = hi = $c } NR > 1 { if ($c < lo) lo = $c; if ($c > hi) hi = $c } END { print ((hi - lo > 0.5) ? 0 : 1) }' "$tmp/fb.csv")" 0
 fi
 sed 's/^  - {link: crank1, free: true.*/  - {link: crank1, angle: "90 deg + 3 rad\/s * t"}/' $D/five-bar-free.yaml >"$tmp/mixed.yaml"
 if run "five-bar, crank1 a law, crank2 free" 0 "$MECH" simulate "$tmp/mixed.yaml" --rtol 1e-10 -o "$tmp/mixed.csv"; then
     # crank1 follows its law exactly
-    within "mixed: crank1's law" "$(awk -F, -v c="$(col "$tmp/mixed.csv" crank1.angle)" 'NR > 1 { d = $c - (1.5707963267948966 + 3 * $1); if (d < 0) d = -d; if (d > m) m = d } END { print m }' "$tmp/mixed.csv")" 1e-12
+    within "mixed: crank1's law" "$(awk -F, -v c="$(col "$tmp/mixed.csv" crank1.angle)" 'NR > 1 { d = $c - (1.5707963267948966 + 3 * $1); if (d < 0) d = -d; if (d > m) m = d } END { print m + 0 }' "$tmp/mixed.csv")" 1e-12
     within "mixed: energy balance with the driver's work" "$(balance_ratio "$tmp/mixed.csv")" 1e-8
-    within "mixed: the prescribed driver works" "$(awk -F, -v c="$(col "$tmp/mixed.csv" work.drivers)" 'END { print ($c != 0) ? 0 : 1 }' "$tmp/mixed.csv")" 0
+    within "mixed: the prescribed driver works" "$(awk -F, -v c="$(col "$tmp/mixed.csv" work.drivers)" 'END { print (($c != 0) ? 0 : 1) }' "$tmp/mixed.csv")" 0
 fi
 
 # ---- 4. a stiff speed controller reproduces mech solve's torque --------------
