@@ -227,6 +227,7 @@ define SUITES
 	$(TIMED) watch $(SUITE_ENV) sh tests/watch.sh
 	$(TIMED) drivers $(SUITE_ENV) sh tests/drivers.sh
 	$(TIMED) fit $(SUITE_ENV) sh tests/fit.sh
+	$(TIMED) dynamics $(SUITE_ENV) sh tests/dynamics.sh
 	$(TIMED) drawn $(SUITE_ENV) sh tests/drawn.sh
 	$(TIMED) warn $(SUITE_ENV) sh tests/warn.sh
 	$(TIMED) parallel $(SUITE_ENV) sh tests/parallel/recipes.sh
