@@ -622,6 +622,8 @@ void mech_pose_free(mech_pose *p);
 enum { MECH_SIM_BDF = 0, MECH_SIM_ADAMS = 1 };
 
 typedef struct mech_simulate_options {
+    size_t size;       /* sizeof the struct, set by mech_simulate_options_default (the
+                          library refuses another size, as for mech_solve_options) */
     double to;         /* last time, s (NAN: the sweep's last) */
     double step;       /* output spacing, s (0: the sweep's) */
     double rtol, atol; /* CVODE's tolerances (default 1e-8, 1e-10) */
@@ -641,6 +643,7 @@ typedef struct mech_simulate_stats {
     double seconds;        /* wall time */
 } mech_simulate_stats;
 
+/* The defaults in *o (and o->size): call it before setting any field. */
 void mech_simulate_options_default(mech_simulate_options *o);
 /* Simulate a checked model with free drivers. MECH_OK; MECH_ESOLVE when the
  * run stopped early (a limit position, a dead point, an integrator failure:

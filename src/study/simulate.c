@@ -359,6 +359,7 @@ static int first_position(sim *s, double t0)
 void mech_simulate_options_default(mech_simulate_options *o)
 {
     memset(o, 0, sizeof *o);
+    o->size = sizeof *o;
     o->to = NAN;
     o->step = 0.0;
     o->rtol = 1e-8;
@@ -537,8 +538,8 @@ done:
     return rc;
 }
 
-int mech_simulate(const mech_model *m, const mech_simulate_options *o, mech_table *out,
-                  mech_simulate_stats *stats, mech_diag *d)
+static int simulate_checked(const mech_model *m, const mech_simulate_options *o,
+                            mech_table *out, mech_simulate_stats *stats, mech_diag *d)
 {
     mech_simulate_options def;
     if (!o) {
@@ -546,9 +547,18 @@ int mech_simulate(const mech_model *m, const mech_simulate_options *o, mech_tabl
         o = &def;
     }
     if (!m || !out)
-        return diag_error(d, m ? m->file : "mech_simulate", (mech_mark){0, 0},
-                          "mech_simulate: %s is NULL", m ? "out" : "m");
+        return api_null(d, "mech_simulate", m ? "out" : "m");
     memset(out, 0, sizeof *out);
+    if (o->size != sizeof *o)
+        return diag_error(d, "mech_simulate", (mech_mark){0, 0},
+                          "the simulation options' size is %zu, and this library (%s) knows "
+                          "%zu: set them with mech_simulate_options_default", o->size,
+                          MECH_VERSION, sizeof *o);
+    if (!(o->rtol > 0.0) || !(o->atol > 0.0) || o->max_steps < 1 ||
+        (o->method != MECH_SIM_BDF && o->method != MECH_SIM_ADAMS))
+        return diag_error(d, "mech_simulate", (mech_mark){0, 0},
+                          "the simulation options need rtol > 0, atol > 0, max_steps >= 1 and "
+                          "method MECH_SIM_BDF or MECH_SIM_ADAMS");
     if (stats)
         memset(stats, 0, sizeof *stats);
     int rc = refuse(m, d);
@@ -593,5 +603,14 @@ int mech_simulate(const mech_model *m, const mech_simulate_options *o, mech_tabl
     sim_free(&s);
     if (rc != MECH_OK && out->nrows == 0)
         mech_table_free(out);
+    return rc;
+}
+
+int mech_simulate(const mech_model *m, const mech_simulate_options *o, mech_table *out,
+                  mech_simulate_stats *stats, mech_diag *d)
+{
+    mech_diag own, *dd = api_diag(d, &own);
+    int rc = simulate_checked(m, o, out, stats, dd);
+    api_diag_end(d, &own);
     return rc;
 }
