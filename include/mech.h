@@ -629,6 +629,8 @@ typedef struct mech_simulate_options {
     double rtol, atol; /* CVODE's tolerances (default 1e-8, 1e-10) */
     int method;        /* MECH_SIM_BDF (default) or MECH_SIM_ADAMS */
     long max_steps;    /* integration steps between two output times (default 1e6) */
+    int stop_at_rest;  /* 1: end the run where a free coordinate's rate crosses zero
+                          (CVODE's root finding; the last row is at that time) */
 } mech_simulate_options;
 
 typedef struct mech_simulate_stats {
@@ -640,6 +642,8 @@ typedef struct mech_simulate_stats {
     double worst_free_load;/* largest |load| a free driver still needed at an output row
                               (0 in exact arithmetic: the equations of motion's residual) */
     double stop_time;      /* where the run ended, s */
+    int stopped_at_rest;   /* the free driver (index in drivers) whose rate crossed zero
+                              there (stop_at_rest), else -1 */
     double seconds;        /* wall time */
 } mech_simulate_stats;
 

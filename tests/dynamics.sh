@@ -96,6 +96,14 @@ if run "pendulum, adams" 0 "$MECH" simulate $D/pendulum.yaml --method adams --to
     within "adams: period" "$(awk -v p="$(period "$tmp/adams.csv")" -v t="$(exact_period 10)" 'BEGIN { print (p - t) / t }')" 1e-7
 fi
 
+# released from rest at 10 deg, the pendulum is at rest again half a period
+# later, at the other extreme: CVODE's root finding on the rate
+if run "pendulum --stop-at-rest" 0 "$MECH" simulate $D/pendulum.yaml --stop-at-rest --rtol 1e-10 --atol 1e-12 -o "$tmp/rest.csv"; then
+    has_line "$tmp/err" "note: stopped at rest: the rate of 'bar' crossed zero at t = 0.5802" "stop at rest: the note"
+    within "stop at rest: the half period" "$(awk -F, -v h="$(exact_period 10)" 'END { print ($1 - h / 2) / h }' "$tmp/rest.csv")" 1e-8
+    within "stop at rest: the other extreme, -100 deg" "$(awk -F, -v c="$(col "$tmp/rest.csv" bar.angle)" 'END { print $c + 100 * 3.14159265358979323846 / 180 }' "$tmp/rest.csv")" 1e-8
+fi
+
 # ---- 2. a slider-crank run up by a constant torque, no gravity ---------------
 
 if run "slider-crank run-up" 0 "$MECH" simulate $D/slider-crank-torque.yaml --rtol 1e-10 --atol 1e-12 -o "$tmp/sc.csv" --stats; then

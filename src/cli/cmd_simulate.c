@@ -46,6 +46,10 @@ static const cmd_opt options[] = {
      .hi = 1000000000L, .expect = "needs a whole number from 1 to 1000000000",
      .label = "--max-steps N",
      .help = "integration steps allowed between two rows (default 1e6)"},
+    {.names = "--stop-at-rest", .kind = CMD_OPT_FLAG, .at = AT(opt.stop_at_rest), .flag = 1,
+     .label = "--stop-at-rest",
+     .help = "end the run where a free driver's rate crosses zero\n"
+             "(CVODE's root finding: the last row is at that time)"},
     {.names = "--stats", .kind = CMD_OPT_FLAG, .at = AT(stats), .flag = 1, .label = "--stats",
      .help = "print the integrator's steps, evaluations, the worst\n"
              "loop residual, the energy balance and the time to\n"
@@ -60,7 +64,7 @@ const cmd_spec cmd_simulate_spec = {
     .summary = "forward dynamics: the motion that the loads give the free drivers",
     .usage = "usage: mech simulate FILE [-o OUT.csv] [--to T] [--step DT] [--rtol R]\n"
              "                     [--atol A] [--method bdf|adams] [--max-steps N]\n"
-             "                     [--stats] [--quiet]\n",
+             "                     [--stop-at-rest] [--stats] [--quiet]\n",
     .about = "Integrate the equations of motion of a file whose drivers: list has free\n"
              "drivers ('free: true' with 'initial: {value, speed}' and a 'load:';\n"
              "docs/dynamics.md) with SUNDIALS CVODE, and write one CSV row per output\n"

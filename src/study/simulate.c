@@ -52,6 +52,8 @@ typedef struct sim {
     double worst_resid;    /* largest Newton residual */
     int det_sign;
     long evals, force_solves;
+    double end_time;       /* where a stop at rest ended the run, else NAN */
+    int rest_driver;       /* and the driver whose rate crossed zero, else -1 */
     int failed;            /* MECH_ESOLVE reported */
     double fail_t;
 } sim;
@@ -426,6 +428,17 @@ static const char *cvode_why(int flag)
     }
 }
 
+/* stop_at_rest: the free coordinates' rates. */
+static int rates_root(sunrealtype t, N_Vector y, sunrealtype *g, void *user)
+{
+    const sim *s = user;
+    const double *Y = N_VGetArrayPointer(y);
+    (void)t;
+    for (int k = 0; k < s->nf; k++)
+        g[k] = Y[s->nf + k];
+    return 0;
+}
+
 static void quiet_errors(int code, const char *module, const char *function, char *msg,
                          void *user)
 {
@@ -469,6 +482,12 @@ static int integrate(sim *s, const mech_simulate_options *o, double t0, double t
         goto done;
     }
     CVodeSetErrHandlerFn(cv, quiet_errors, NULL);  /* the failure is reported by fail_at */
+    if (o->stop_at_rest && CVodeRootInit(cv, nf, rates_root) != CV_SUCCESS) {
+        rc = diag_nomem(s->d, m->file, m->driver.mark);
+        goto done;
+    }
+    if (stats)
+        stats->stopped_at_rest = -1;
     for (int i = 1; i < nrows; i++) {
         double tout = i == nrows - 1 ? t1 : t0 + h * i, tret = t0;
         int flag = CVode(cv, tout, y, &tret, CV_NORMAL);
@@ -489,10 +508,25 @@ static int integrate(sim *s, const mech_simulate_options *o, double t0, double t
             rc = MECH_ESOLVE;
             break;
         }
+        if (flag == CV_ROOT_RETURN)
+            tout = tret;
         int orc = output_row(s, tout, Y, e0, out);
         if (orc != 0) {
             fail_at(s, tout, "%s", "the position at an output time cannot be solved");
             rc = MECH_ESOLVE;
+            break;
+        }
+        if (flag == CV_ROOT_RETURN) {
+            int found[64] = {0}, k = 0;
+            if (nf <= 64)
+                CVodeGetRootInfo(cv, found);
+            while (k + 1 < nf && k < 63 && !found[k])
+                k++;
+            diag_note(s->d, m->file, m->free_drivers->d[k].mark,
+                      "stopped at rest: the rate of '%s' crossed zero at t = %.12g s",
+                      drivers_name(m, s->fdrv[k]), tret);
+            s->end_time = tret;
+            s->rest_driver = s->fdrv[k];
             break;
         }
         int sign = solver_det_sign(&s->sv);
@@ -584,6 +618,8 @@ static int simulate_checked(const mech_model *m, const mech_simulate_options *o,
     double start = clock_seconds();
     sim s;
     memset(&s, 0, sizeof s);
+    s.end_time = NAN;
+    s.rest_driver = -1;
     rc = sim_setup(&s, m, d);
     if (rc == MECH_OK)
         rc = first_position(&s, t0);
@@ -598,7 +634,8 @@ static int simulate_checked(const mech_model *m, const mech_simulate_options *o,
         stats->worst_residual = s.worst_resid;
         stats->worst_free_load = s.worst_load;
         stats->rows = out->nrows;
-        stats->stop_time = s.failed ? s.fail_t : t1;
+        stats->stop_time = s.failed ? s.fail_t : !isnan(s.end_time) ? s.end_time : t1;
+        stats->stopped_at_rest = s.rest_driver;
     }
     sim_free(&s);
     if (rc != MECH_OK && out->nrows == 0)
