@@ -8,9 +8,12 @@
 #   2. a slider-crank run up from rest by a constant torque, no gravity:
 #      the kinetic energy is the torque's work T (theta - theta0), from the
 #      CSV's own angle column;
-#   3. a five-bar with two free cranks swinging under gravity: energy kept;
+#   3. a crank-rocker released under gravity: energy kept to 1e-9;
+#      a five-bar with two free cranks swinging under gravity: energy kept;
 #      with one crank's law of time and the other free, the energy balance
-#      closes with the work of the prescribed driver;
+#      closes with the work of the prescribed driver; a pendulum on linear
+#      and torsion spring-dampers: the springs' energy and the dampers' work
+#      close it too;
 #   4. a free crank under a stiff speed controller (a load of its own
 #      omega) reproduces the torque `mech solve --forces` gives the same
 #      crank at that constant speed;
@@ -134,6 +137,20 @@ if run "five-bar, crank1 a law, crank2 free" 0 "$MECH" simulate "$tmp/mixed.yaml
     within "mixed: crank1's law" "$(awk -F, -v c="$(col "$tmp/mixed.csv" crank1.angle)" 'NR > 1 { d = $c - (1.5707963267948966 + 3 * $1); if (d < 0) d = -d; if (d > m) m = d } END { print m + 0 }' "$tmp/mixed.csv")" 1e-12
     within "mixed: energy balance with the driver's work" "$(balance_ratio "$tmp/mixed.csv")" 1e-8
     within "mixed: the prescribed driver works" "$(awk -F, -v c="$(col "$tmp/mixed.csv" work.drivers)" 'END { print (($c != 0) ? 0 : 1) }' "$tmp/mixed.csv")" 0
+fi
+
+# the crank-rocker released under gravity whirls round: energy kept to 1e-9
+# with tight tolerances (Adams: the motion is not stiff)
+if run "four-bar under gravity" 0 "$MECH" simulate $D/fourbar-gravity.yaml --method adams --rtol 1e-11 --atol 1e-14 -o "$tmp/fb4.csv"; then
+    within "four-bar: energy balance" "$(balance_ratio "$tmp/fb4.csv")" 1e-9
+    within "four-bar: the crank turns past a whole turn" "$(awk -F, -v c="$(col "$tmp/fb4.csv" crank.angle)" 'NR == 2 { lo = $c } NR > 1 && $c < lo { lo = $c } END { print ((lo < -3.2) ? 0 : 1) }' "$tmp/fb4.csv")" 0
+fi
+
+# springs and dampers: their energy and the dampers' work close the balance
+if run "spring pendulum" 0 "$MECH" simulate $D/spring-pendulum.yaml --rtol 1e-10 -o "$tmp/sp.csv"; then
+    within "spring pendulum: energy balance with springs and dampers" "$(balance_ratio "$tmp/sp.csv")" 1e-8
+    within "spring pendulum: the dampers take energy" "$(awk -F, -v c="$(col "$tmp/sp.csv" work.dampers)" 'END { print (($c < -0.05) ? 0 : 1) }' "$tmp/sp.csv")" 0
+    within "spring pendulum: the springs hold energy" "$(awk -F, -v c="$(col "$tmp/sp.csv" energy.springs)" 'NR == 2 { print (($c > 1) ? 0 : 1) }' "$tmp/sp.csv")" 0
 fi
 
 # ---- 4. a stiff speed controller reproduces mech solve's torque --------------
