@@ -650,6 +650,10 @@ void load_default_outputs(mech_model *m);
  *      constant quantity; load_state_load compiles them into m->state_loads. */
 int load_state_wanted(loader *ld, const ynode *value);
 void load_state_load(loader *ld, const ynode *map, const ynode *value, int link, int point);
+/* A force of size `value` (a force, constant or of the motion) along the
+ * direction dir (rad, ground frame) at point `point` of `link`. */
+void load_state_along(loader *ld, const ynode *map, const ynode *value, int link, int point,
+                      double dir);
 /* {force: TENSION, between: [P, Q], links: [a, b]}: a force along a line. */
 void load_state_line(loader *ld, const ynode *map);
 

@@ -52,12 +52,17 @@ static int load_free(loader *ld, const ynode *e, mech_motion *mo, int is_link, c
     if (w && !load_get_quantity(ld, w, is_link ? Q_ANGULAR_SPEED : Q_SPEED, "initial speed",
                                 &fd.speed))
         return 0;
-    if (lo && !is_link)
-        return load_err(ld, load_key_of(e, "load"), "a free slider's 'load' is not supported: "
-                        "give the force on the slider block in 'loads:'"), 0;
+    const mech_joint *jt = is_link ? NULL : &m->joints[mo->index];
+    if (lo && jt && jt->link[1] != 0)
+        return load_err(ld, load_key_of(e, "load"), "a free slider's 'load' needs a guide on "
+                        "the ground ('%s' slides on '%s'): give the force on the moving link "
+                        "in 'loads:'", jt->name, m->links[jt->link[1]].name), 0;
     if (lo) {
         int before = m->state_loads ? m->state_loads->nloads : 0;
-        load_state_load(ld, e, lo, mo->index, -1);
+        if (jt)  /* along the guide's line, at the sliding point, + along the displacement */
+            load_state_along(ld, e, lo, jt->link[0], jt->point[0], jt->angle);
+        else
+            load_state_load(ld, e, lo, mo->index, -1);
         if (m->state_loads && m->state_loads->nloads > before)
             fd.load = m->state_loads->nloads - 1;
         else

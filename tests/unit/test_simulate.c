@@ -1,7 +1,8 @@
 /* tests/unit/test_simulate.c: mech_simulate (forward dynamics,
  * docs/dynamics.md) through the C API, against closed forms:
- *   - a block on a free slider pushed by a constant force along its guide,
- *     no gravity: s(t) = s0 + v0 t + F t^2 / (2 m) at every row;
+ *   - a block on a free slider pushed by a constant force along its guide
+ *     (a load of the file, or the free slider's own `load:`), no gravity:
+ *     s(t) = s0 + v0 t + F t^2 / (2 m) at every row;
  *   - a compound pendulum: its angular acceleration at the first row,
  *     -(m g d / I_O) cos(theta), and its first row's energies;
  *   - the refusals: no free driver, Coulomb friction. */
@@ -29,9 +30,26 @@ static const char *const BLOCK =
     "  - {slider: s, free: true, initial: {value: 100 mm, speed: -0.5 m/s}}\n"
     "outputs: {sliders: [s]}\n";
 
-Test(simulate, block_under_a_constant_force)
+/* the same force as the free slider's own load: along its guide's line */
+static const char *const BLOCK_LOAD =
+    "name: pushed block\n"
+    "ground: {O: [0, 0]}\n"
+    "links:\n"
+    "  block:\n"
+    "    points: {B: [0, 0]}\n"
+    "    mass: 2 kg\n"
+    "    center: [0, 0]\n"
+    "    inertia: 0.1 kg*m^2\n"
+    "joints:\n"
+    "  - {slider: B, link: block, on: ground, through: O, angle: 30 deg, name: s}\n"
+    "sweep: {time: {from: 0 s, to: 2 s, steps: 20}}\n"
+    "drivers:\n"
+    "  - {slider: s, free: true, initial: {value: 100 mm, speed: -0.5 m/s}, load: 3 N}\n"
+    "outputs: {sliders: [s]}\n";
+
+static void block_case(const char *text)
 {
-    mech_model *m = load_text(BLOCK);
+    mech_model *m = load_text(text);
     mech_simulate_options o;
     mech_simulate_options_default(&o);
     o.rtol = 1e-10;
@@ -62,6 +80,10 @@ Test(simulate, block_under_a_constant_force)
     mech_diag_free(&d);
     mech_model_free(&m);
 }
+
+Test(simulate, block_under_a_constant_force) { block_case(BLOCK); }
+
+Test(simulate, block_pushed_by_its_free_slider_load) { block_case(BLOCK_LOAD); }
 
 static const char *const PENDULUM =
     "name: pendulum\n"
