@@ -211,7 +211,7 @@ fi
 # run stops there (exit 1), names the loop, and writes the rows before
 sed 's/^gravity: .*/gravity: [0, -9.81]/' $D/five-bar-free.yaml >"$tmp/fold.yaml"
 if run "a singular position stops the run" 1 "$MECH" simulate "$tmp/fold.yaml" -o "$tmp/fold.csv"; then
-    has_line "$tmp/err" "error: at t = 0.2[0-9]* s: .*loop 1 (P-B-E-O-A-P)" "stop: the time and the loop"
+    has_line "$tmp/err" "error: at t = 0.2[0-9]* s: .*: arm1 and arm2 folded in line; .*loop 1 (P-B-E-O-A-P)" "stop: the time, the links in line and the loop"
     has_line "$tmp/err" "^mech simulate: stopped at t = 0.2" "stop: the summary"
     [ "$(wc -l <"$tmp/fold.csv")" -gt 5 ] && pass || fail "stop: the rows before are not written"
 fi

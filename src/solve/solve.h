@@ -551,6 +551,10 @@ typedef struct start_failure {
 
 /* Row 0 could not be found at q: why, reported; the kind reported. */
 mech_fail_kind diagnose_start(cont *c, double q, const start_failure *f);
+/* The two moving links pinned together most nearly in line at the published
+ * position, when the cosine of their angle is above cos_min: "arm1 and arm2
+ * extended in line" (or "folded"); "" when none is. */
+void diagnose_links_in_line(solver *sv, double cos_min, char *buf, size_t size);
 /* The owners of the rows that depend at the current (nearly singular)
  * factors, e.g. "loop 1 (A-B-C-D-A), gear pair 'g'"; "" when unknown (a
  * large system). */

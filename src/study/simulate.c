@@ -497,8 +497,11 @@ static int integrate(sim *s, const mech_simulate_options *o, double t0, double t
                 snprintf(why, sizeof why, "%s", cvode_why(flag));
                 if (flag == CV_RHSFUNC_FAIL || flag == CV_REPTD_RHSFUNC_ERR ||
                     flag == CV_UNREC_RHSFUNC_ERR || flag == CV_CONV_FAILURE) {
-                    char rows[200];
+                    char rows[200], line[160];
                     diagnose_dependent_rows(&s->sv, rows, sizeof rows);
+                    diagnose_links_in_line(&s->sv, cos(0.2), line, sizeof line);
+                    if (line[0])
+                        snprintf(why + strlen(why), sizeof why - strlen(why), ": %s", line);
                     if (rows[0])
                         snprintf(why + strlen(why), sizeof why - strlen(why),
                                  "; the equations that depend there: %s", rows);
