@@ -207,6 +207,10 @@ if run "simulate --to 500 ms --step 100 ms" 0 "$MECH" simulate $D/pendulum.yaml 
     has_line "$tmp/u.csv" "^0.5," "--to 500 ms: the last row"
     has_line "$tmp/u.csv" ",energy.kinetic \[J\],energy.gravity \[J\],energy.springs \[J\],work.loads \[J\],work.drivers \[J\],work.dampers \[J\],energy.balance \[J\]\$" "the energy columns"
 fi
+# a table too large for memory is refused before the run
+run "simulate 10^7 rows of the shaper" 2 "$MECH" simulate $D/shaper-runup.yaml --to 1000s --step 1e-4 -o "$tmp/x.csv" &&
+    has_line "$tmp/err" "the results would take 5.76 GB in memory (10000001 rows of 72 columns)" "too large: message"
+
 # released upside down, the five-bar folds until its arms are in line: the
 # run stops there (exit 1), names the loop, and writes the rows before
 sed 's/^gravity: .*/gravity: [0, -9.81]/' $D/five-bar-free.yaml >"$tmp/fold.yaml"

@@ -626,6 +626,12 @@ static int simulate_checked(const mech_model *m, const mech_simulate_options *o,
     rc = sim_setup(&s, m, d);
     if (rc == MECH_OK)
         rc = first_position(&s, t0);
+    if (rc == MECH_OK && (double)nrows * (s.cl.ncols + NENERGY) * sizeof(double) > 2147483648.0)
+        rc = diag_error(d, m->file, m->driver.mark,
+                        "the results would take %.3g GB in memory (%d rows of %d columns): ask "
+                        "for a longer --step or a shorter --to",
+                        (double)nrows * (s.cl.ncols + NENERGY) * 8e-9, nrows,
+                        s.cl.ncols + NENERGY);
     if (rc == MECH_OK && make_table(&s, out, nrows) != MECH_OK)
         rc = diag_nomem(d, m->file, m->driver.mark);
     if (rc == MECH_OK)
