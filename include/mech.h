@@ -631,6 +631,9 @@ typedef struct mech_simulate_options {
     long max_steps;    /* integration steps between two output times (default 1e6) */
     int stop_at_rest;  /* 1: end the run where a free coordinate's rate crosses zero
                           (CVODE's root finding; the last row is at that time) */
+    const char *stop_when; /* NULL, or "NAME.MEMBER=VALUE": end the run where a point's x
+                          or y, a link's angle or a slider's s crosses VALUE (bare numbers
+                          mm or deg, or with a unit: "x_C.s=150 mm", "crank.angle=2 rad") */
 } mech_simulate_options;
 
 typedef struct mech_simulate_stats {

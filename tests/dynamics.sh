@@ -110,6 +110,14 @@ if run "pendulum --stop-at-rest" 0 "$MECH" simulate $D/pendulum.yaml --stop-at-r
     within "stop at rest: the other extreme, -100 deg" "$(awk -F, -v c="$(col "$tmp/rest.csv" bar.angle)" 'END { print $c + 100 * 3.14159265358979323846 / 180 }' "$tmp/rest.csv")" 1e-8
 fi
 
+# --stop-when: the pendulum passes the vertical a quarter period after release
+if run "pendulum --stop-when bar.angle=-90" 0 "$MECH" simulate $D/pendulum.yaml --stop-when "bar.angle=-90" --rtol 1e-10 --atol 1e-12 -o "$tmp/when.csv"; then
+    has_line "$tmp/err" "note: stopped: the condition bar.angle=-90 was met at t = 0.2901" "stop when: the note"
+    within "stop when: the quarter period" "$(awk -F, -v h="$(exact_period 10)" 'END { print ($1 - h / 4) / h }' "$tmp/when.csv")" 1e-8
+fi
+run "--stop-when on a rate" 2 "$MECH" simulate $D/pendulum.yaml --stop-when "bar.omega=1" -o "$tmp/x.csv" &&
+    has_line "$tmp/err" "'bar.omega' is not a point's x or y, a moving link's angle or a slider's s" "stop when: a rate refused"
+
 # ---- 2. a slider-crank run up by a constant torque, no gravity ---------------
 
 if run "slider-crank run-up" 0 "$MECH" simulate $D/slider-crank-torque.yaml --rtol 1e-10 --atol 1e-12 -o "$tmp/sc.csv" --stats; then

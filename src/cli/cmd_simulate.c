@@ -50,6 +50,11 @@ static const cmd_opt options[] = {
      .label = "--stop-at-rest",
      .help = "end the run where a free driver's rate crosses zero\n"
              "(CVODE's root finding: the last row is at that time)"},
+    {.names = "--stop-when", .kind = CMD_OPT_TEXT, .at = AT(opt.stop_when),
+     .label = "--stop-when NAME.MEMBER=V",
+     .help = "end the run where a point's x or y, a link's angle or a\n"
+             "slider's s crosses V (bare numbers mm or deg, or with a\n"
+             "unit): --stop-when 'x_C.s=150 mm'"},
     {.names = "--stats", .kind = CMD_OPT_FLAG, .at = AT(stats), .flag = 1, .label = "--stats",
      .help = "print the integrator's steps, evaluations, the worst\n"
              "loop residual, the energy balance and the time to\n"
@@ -64,7 +69,8 @@ const cmd_spec cmd_simulate_spec = {
     .summary = "forward dynamics: the motion that the loads give the free drivers",
     .usage = "usage: mech simulate FILE [-o OUT.csv] [--to T] [--step DT] [--rtol R]\n"
              "                     [--atol A] [--method bdf|adams] [--max-steps N]\n"
-             "                     [--stop-at-rest] [--stats] [--quiet]\n",
+             "                     [--stop-at-rest] [--stop-when NAME.MEMBER=V]\n"
+             "                     [--stats] [--quiet]\n",
     .about = "Integrate the equations of motion of a file whose drivers: list has free\n"
              "drivers ('free: true' with 'initial: {value, speed}' and a 'load:';\n"
              "docs/dynamics.md) with SUNDIALS CVODE, and write one CSV row per output\n"

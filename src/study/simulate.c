@@ -52,6 +52,13 @@ typedef struct sim {
     double worst_resid;    /* largest Newton residual */
     int det_sign;
     long evals, force_solves;
+    int nroots;            /* root functions: nf rates (stop_at_rest), then the condition */
+    int rates_watched;     /* stop_at_rest */
+    int cond_kind;         /* stop_when: 0 none, 1 point x, 2 point y, 3 link angle,
+                              4 slider s */
+    int cond_obj;          /* its point name id, link or joint */
+    double cond_value;     /* SI */
+    int cond_failed;       /* the root function could not evaluate a state */
     double end_time;       /* where a stop at rest ended the run, else NAN */
     int rest_driver;       /* and the driver whose rate crossed zero, else -1 */
     int failed;            /* MECH_ESOLVE reported */
@@ -428,15 +435,85 @@ static const char *cvode_why(int flag)
     }
 }
 
-/* stop_at_rest: the free coordinates' rates. */
-static int rates_root(sunrealtype t, N_Vector y, sunrealtype *g, void *user)
+/* The value the condition of stop_when watches, at the published state. */
+static double cond_now(const sim *s)
 {
-    const sim *s = user;
+    double p[2];
+    switch (s->cond_kind) {
+    case 1: case 2:
+        kin_point(&s->sp.tree, &s->sv.ks, s->cond_obj, p, NULL, NULL);
+        return p[s->cond_kind - 1];
+    case 3: return s->sv.ks.F[s->cond_obj].th;
+    default: {
+        int var = s->sp.tree.slide_var[s->cond_obj];
+        return var >= 0 ? s->sv.pos[var] : 0.0;
+    }
+    }
+}
+
+/* The root functions: the free coordinates' rates (stop_at_rest), then the
+ * watched value minus its target (stop_when; the state evaluated at t, y). */
+static int roots(sunrealtype t, N_Vector y, sunrealtype *g, void *user)
+{
+    sim *s = user;
     const double *Y = N_VGetArrayPointer(y);
-    (void)t;
-    for (int k = 0; k < s->nf; k++)
-        g[k] = Y[s->nf + k];
+    int k = 0;
+    if (s->rates_watched)
+        for (; k < s->nf; k++)
+            g[k] = Y[s->nf + k];
+    if (s->cond_kind) {
+        if (evaluate_state(s, t, Y, Y + s->nf) != 0) {
+            s->cond_failed = 1;
+            return -1;
+        }
+        g[k] = cond_now(s) - s->cond_value;
+    }
     return 0;
+}
+
+/* stop_when "NAME.MEMBER=VALUE" (docs/dynamics.md): a point's x or y, a
+ * link's angle or a slider's s, and the value as on the command line
+ * (mech_parse_value: bare numbers are mm or deg). */
+static int parse_condition(sim *s, const char *text)
+{
+    const mech_model *m = s->m;
+    const char *eq = strchr(text, '='), *dot = NULL;
+    for (const char *c = text; eq && c < eq; c++)
+        if (*c == '.')
+            dot = c;
+    if (!eq || !dot || dot == text)
+        return diag_error(s->d, m->file, m->driver.mark,
+                          "stop condition '%s': write NAME.MEMBER=VALUE (a point's x or y, a "
+                          "link's angle, a slider's s), e.g. 'x_C.s=150 mm'", text);
+    char name[128], mem[16];
+    snprintf(name, sizeof name, "%.*s", (int)(dot - text), text);
+    snprintf(mem, sizeof mem, "%.*s", (int)(eq - dot - 1), dot + 1);
+    int is_angle = 0;
+    s->cond_kind = 0;
+    for (int i = 0; i < m->npoint_names && !s->cond_kind; i++)
+        if (strcmp(m->point_names[i], name) == 0 && (!strcmp(mem, "x") || !strcmp(mem, "y"))) {
+            s->cond_kind = mem[0] == 'x' ? 1 : 2;
+            s->cond_obj = i;
+        }
+    for (int l = 1; l < m->nlinks && !s->cond_kind; l++)
+        if (strcmp(m->links[l].name, name) == 0 && !strcmp(mem, "angle")) {
+            s->cond_kind = 3, s->cond_obj = l, is_angle = 1;
+        }
+    for (int j = 0; j < m->njoints && !s->cond_kind; j++)
+        if (m->joints[j].kind == MECH_JOINT_SLIDER && strcmp(m->joints[j].name, name) == 0 &&
+            !strcmp(mem, "s")) {
+            s->cond_kind = 4, s->cond_obj = j;
+        }
+    if (!s->cond_kind)
+        return diag_error(s->d, m->file, m->driver.mark,
+                          "stop condition '%s': '%s.%s' is not a point's x or y, a moving "
+                          "link's angle or a slider's s", text, name, mem);
+    char err[200];
+    if (mech_parse_value(eq + 1, is_angle, &s->cond_value, err, sizeof err) != MECH_OK) {
+        s->cond_kind = 0;
+        return diag_error(s->d, m->file, m->driver.mark, "stop condition '%s': %s", text, err);
+    }
+    return MECH_OK;
 }
 
 static void quiet_errors(int code, const char *module, const char *function, char *msg,
@@ -482,7 +559,9 @@ static int integrate(sim *s, const mech_simulate_options *o, double t0, double t
         goto done;
     }
     CVodeSetErrHandlerFn(cv, quiet_errors, NULL);  /* the failure is reported by fail_at */
-    if (o->stop_at_rest && CVodeRootInit(cv, nf, rates_root) != CV_SUCCESS) {
+    s->rates_watched = o->stop_at_rest != 0;
+    s->nroots = (s->rates_watched ? nf : 0) + (s->cond_kind ? 1 : 0);
+    if (s->nroots > 0 && CVodeRootInit(cv, s->nroots, roots) != CV_SUCCESS) {
         rc = diag_nomem(s->d, m->file, m->driver.mark);
         goto done;
     }
@@ -492,6 +571,8 @@ static int integrate(sim *s, const mech_simulate_options *o, double t0, double t
         double tout = i == nrows - 1 ? t1 : t0 + h * i, tret = t0;
         int flag = CVode(cv, tout, y, &tret, CV_NORMAL);
         if (flag < 0) {
+            if (s->cond_failed && !s->failed)
+                fail_at(s, tret, "%s", "the stop condition's state cannot be solved");
             if (!s->failed) {
                 char why[520];
                 snprintf(why, sizeof why, "%s", cvode_why(flag));
@@ -520,16 +601,23 @@ static int integrate(sim *s, const mech_simulate_options *o, double t0, double t
             break;
         }
         if (flag == CV_ROOT_RETURN) {
-            int found[64] = {0}, k = 0;
-            if (nf <= 64)
+            int found[65] = {0}, k = 0;
+            if (s->nroots <= 65)
                 CVodeGetRootInfo(cv, found);
-            while (k + 1 < nf && k < 63 && !found[k])
+            int nr = s->rates_watched ? nf : 0;
+            while (k < nr && !found[k])
                 k++;
-            diag_note(s->d, m->file, m->free_drivers->d[k].mark,
-                      "stopped at rest: the rate of '%s' crossed zero at t = %.12g s",
-                      drivers_name(m, s->fdrv[k]), tret);
             s->end_time = tret;
-            s->rest_driver = s->fdrv[k];
+            if (k < nr) {
+                diag_note(s->d, m->file, m->free_drivers->d[k].mark,
+                          "stopped at rest: the rate of '%s' crossed zero at t = %.12g s",
+                          drivers_name(m, s->fdrv[k]), tret);
+                s->rest_driver = s->fdrv[k];
+            } else {
+                diag_note(s->d, m->file, m->driver.mark,
+                          "stopped: the condition %s was met at t = %.12g s", o->stop_when,
+                          tret);
+            }
             break;
         }
         int sign = solver_det_sign(&s->sv);
@@ -624,6 +712,8 @@ static int simulate_checked(const mech_model *m, const mech_simulate_options *o,
     s.end_time = NAN;
     s.rest_driver = -1;
     rc = sim_setup(&s, m, d);
+    if (rc == MECH_OK && o->stop_when && o->stop_when[0])
+        rc = parse_condition(&s, o->stop_when);
     if (rc == MECH_OK)
         rc = first_position(&s, t0);
     if (rc == MECH_OK && (double)nrows * (s.cl.ncols + NENERGY) * sizeof(double) > 2147483648.0)
