@@ -673,15 +673,19 @@ static PyObject *py_solve(PyObject *self, PyObject *args, PyObject *kw)
  * -> (names, units, arrays, stats, messages): mech_simulate (docs/dynamics.md) */
 static PyObject *py_simulate(PyObject *self, PyObject *args, PyObject *kw)
 {
-    static char *kwlist[] = {"path", "to", "step", "rtol", "atol", "method", NULL};
+    static char *kwlist[] = {"path", "to", "step", "rtol", "atol", "method", "stop_at_rest",
+                             "stop_when", NULL};
     PyObject *path, *to = Py_None, *step = Py_None, *rtol = Py_None, *atol = Py_None;
-    const char *method = NULL;
+    const char *method = NULL, *stop_when = NULL;
+    int stop_at_rest = 0;
     (void)self;
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "O|OOOOz", kwlist, &path, &to, &step, &rtol,
-                                     &atol, &method))
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "O|OOOOzpz", kwlist, &path, &to, &step, &rtol,
+                                     &atol, &method, &stop_at_rest, &stop_when))
         return NULL;
     mech_simulate_options o;
     mech_simulate_options_default(&o);
+    o.stop_at_rest = stop_at_rest;
+    o.stop_when = stop_when;
     PyObject *nums[] = {to, step, rtol, atol};
     double *into[] = {&o.to, &o.step, &o.rtol, &o.atol};
     for (int k = 0; k < 4; k++)
@@ -919,7 +923,8 @@ static PyMethodDef methods[] = {
      "tol=None, level=None, friction=None, diagnostics=False, all=False) -> "
      "(names, units, arrays, stats, messages)"},
     {"simulate", (PyCFunction)(void (*)(void))py_simulate, METH_VARARGS | METH_KEYWORDS,
-     "simulate(path, to=None, step=None, rtol=None, atol=None, method=None) -> "
+     "simulate(path, to=None, step=None, rtol=None, atol=None, method=None, "
+     "stop_at_rest=False, stop_when=None) -> "
      "(names, units, arrays, stats, messages): mech_simulate"},
     {NULL, NULL, 0, NULL}};
 

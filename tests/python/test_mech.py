@@ -336,3 +336,8 @@ def test_simulate_equals_the_cli_and_keeps_energy():
         mech.simulate('mechanisms/fourbar.yaml')
     with pytest.raises(ValueError):
         mech.simulate(path, method='rk4')
+    # the events: at rest half a period after release, at the vertical a quarter
+    h = mech.simulate(path, stop_at_rest=True, rtol=1e-10, atol=1e-12)
+    q = mech.simulate(path, stop_when='bar.angle=-90', rtol=1e-10, atol=1e-12)
+    assert abs(h['t'][-1] - 2 * q['t'][-1]) < 1e-7
+    assert abs(q['bar.angle'][-1] + math.pi / 2) < 1e-9
