@@ -51,10 +51,10 @@ static const cmd_opt options[] = {
      .help = "end the run where a free driver's rate crosses zero\n"
              "(CVODE's root finding: the last row is at that time)"},
     {.names = "--stop-when", .kind = CMD_OPT_TEXT, .at = AT(opt.stop_when),
-     .label = "--stop-when NAME.MEMBER=V",
-     .help = "end the run where a point's x or y, a link's angle or a\n"
-             "slider's s crosses V (bare numbers mm or deg, or with a\n"
-             "unit): --stop-when 'x_C.s=150 mm'"},
+     .label = "--stop-when COND",
+     .help = "COND is NAME.MEMBER=V: end the run where a point's x or\n"
+             "y, a link's angle or a slider's s crosses V (bare\n"
+             "numbers mm or deg): --stop-when 'x_C.s=150 mm'"},
     {.names = "--stats", .kind = CMD_OPT_FLAG, .at = AT(stats), .flag = 1, .label = "--stats",
      .help = "print the integrator's steps, evaluations, the worst\n"
              "loop residual, the energy balance and the time to\n"
