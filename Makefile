@@ -29,6 +29,11 @@ KLU_LIBS   := $(shell pkg-config --libs klu 2>/dev/null || echo -lklu -lbtf -lam
 YAML_CFLAGS := $(shell pkg-config --cflags yaml-0.1 2>/dev/null)
 YAML_LIBS   := $(shell pkg-config --libs yaml-0.1 2>/dev/null || echo -lyaml)
 CRIT_LIBS   := $(shell pkg-config --libs criterion 2>/dev/null || echo -lcriterion)
+# MINPACK (libcminpack-dev): mech fit's least squares, in the mech binary and
+# the unit tests only (src/cli/cmd_fit_lm.c), never in libmech: Debian ships
+# no static libcminpack.a for a `pkg-config --static` link of the library.
+MINPACK_CFLAGS := $(shell pkg-config --cflags cminpack 2>/dev/null || echo -I/usr/include/cminpack-1)
+MINPACK_LIBS   := $(shell pkg-config --libs cminpack 2>/dev/null || echo -lcminpack)
 # The Python the module is built for: Debian's python3 (python3-dev,
 # python3-numpy), not a python3 earlier in PATH, unless PYTHON names another
 # (a pyenv or venv python with its own numpy). python/buildinfo.py asks that
@@ -56,8 +61,11 @@ SOABI    = $(if $(filter 0,$(SOMAJOR)),0.$(SOMINOR),$(SOMAJOR))
 SONAME   = libmech.so.$(SOABI)
 
 SRC_INC = $(addprefix -I,$(SRC_DIRS))
-CFLAGS  = $(CFLAGS_BASE) $(OPT) $(SAN) -Iinclude $(SRC_INC) $(YAML_CFLAGS) $(KLU_CFLAGS)
-LDLIBS  = $(YAML_LIBS) $(KLU_LIBS) -lm -pthread
+CFLAGS  = $(CFLAGS_BASE) $(OPT) $(SAN) -Iinclude $(SRC_INC) $(YAML_CFLAGS) $(KLU_CFLAGS) $(MINPACK_CFLAGS)
+# SUNDIALS CVODE (mech simulate, docs/dynamics.md): Debian's libsundials-dev
+SUNDIALS_LIBS = -lsundials_cvode -lsundials_sunlinsoldense -lsundials_sunmatrixdense \
+                -lsundials_nvecserial -lsundials_generic
+LDLIBS  = $(YAML_LIBS) $(KLU_LIBS) $(SUNDIALS_LIBS) -lm -pthread
 LDFLAGS = $(SAN) -pthread
 
 # src/ is one folder per stage of the pipeline, each with one header
@@ -143,7 +151,7 @@ $(BUILD)/python/mech/__init__.py: python/mech/__init__.py
 	cp $< $@
 
 $(BUILD)/mech: $(CMD_OBJ) $(BUILD)/libmech.a
-	$(CC) $(LDFLAGS) -o $@ $^ $(LDLIBS)
+	$(CC) $(LDFLAGS) -o $@ $^ $(MINPACK_LIBS) $(LDLIBS)
 
 $(BUILD)/tests/%.o: tests/unit/%.c $(HEADERS) $(wildcard tests/unit/*.h) | $(BUILD)/tests
 	$(CC) $(CFLAGS) -c $< -o $@
@@ -154,7 +162,7 @@ $(BUILD)/tests/%.o: tests/unit/%.c $(HEADERS) $(wildcard tests/unit/*.h) | $(BUI
 # test_http.c the request parser of mech watch (cmd_http.c)
 CMD_TESTED = $(filter-out $(BUILD)/obj/main.o,$(CMD_OBJ))
 $(BUILD)/unit-tests: $(TEST_OBJ) $(CMD_TESTED) $(BUILD)/libmech.a
-	$(CC) $(LDFLAGS) -o $@ $^ $(CRIT_LIBS) $(LDLIBS)
+	$(CC) $(LDFLAGS) -o $@ $^ $(CRIT_LIBS) $(MINPACK_LIBS) $(LDLIBS)
 
 # parallel_run with a pthread_create failing half-way (tests/pool/pool_fail.c
 # replaces pthread_create and pthread_join)
@@ -218,6 +226,8 @@ define SUITES
 	$(TIMED) draw $(SUITE_ENV) sh tests/draw.sh
 	$(TIMED) watch $(SUITE_ENV) sh tests/watch.sh
 	$(TIMED) drivers $(SUITE_ENV) sh tests/drivers.sh
+	$(TIMED) fit $(SUITE_ENV) sh tests/fit.sh
+	$(TIMED) dynamics $(SUITE_ENV) sh tests/dynamics.sh
 	$(TIMED) drawn $(SUITE_ENV) sh tests/drawn.sh
 	$(TIMED) warn $(SUITE_ENV) sh tests/warn.sh
 	$(TIMED) parallel $(SUITE_ENV) sh tests/parallel/recipes.sh
@@ -273,9 +283,9 @@ test-san:
 # Fuzzing with clang's libFuzzer (tests/fuzz/README.md): fuzz runs
 # FUZZ_SECONDS (default 60); fuzz-replay only the regression inputs.
 fuzz:
-	FUZZ_BUILD=$(BUILD)/fuzz sh tests/fuzz/run.sh
+	FUZZ_BUILD=$(BUILD)/fuzz FUZZ_LIBS="$(SUNDIALS_LIBS)" sh tests/fuzz/run.sh
 fuzz-replay:
-	FUZZ_BUILD=$(BUILD)/fuzz sh tests/fuzz/run.sh replay
+	FUZZ_BUILD=$(BUILD)/fuzz FUZZ_LIBS="$(SUNDIALS_LIBS)" sh tests/fuzz/run.sh replay
 
 # mech under valgrind on every mechanism: no invalid accesses, no leaks.
 test-valgrind: $(BUILD)/mech
@@ -302,6 +312,7 @@ bench:
 	  build/bench/bench-accuracy mechanisms build/bench && \
 	  build/bench/bench-scale build/bench && \
 	  MECH=build/bench/mech sh bench/bench_batch.sh && \
+	  MECH=build/bench/mech sh bench/bench_simulate.sh && \
 	  build/bench/bench-sweep mechanisms/conveyor.yaml l1 55 65 && \
 	  build/bench/bench-alloc mechanisms/*.yaml; } 2>&1 | tee build/bench/report.txt
 	sh bench/report.sh build/bench/report.txt
@@ -347,7 +358,7 @@ install: all $(if $(filter 1,$(WITH_PYTHON)),python)
 	install -m 755 $(BUILD)/libmech.so.$(VERSION) $(DESTDIR)$(PREFIX)/lib/libmech.so.$(VERSION)
 	ln -sf libmech.so.$(VERSION) $(DESTDIR)$(PREFIX)/lib/$(SONAME)
 	ln -sf $(SONAME) $(DESTDIR)$(PREFIX)/lib/libmech.so
-	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@VERSION@|$(VERSION)|' -e 's|@KLU_LIBS@|$(KLU_LIBS)|' \
+	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@VERSION@|$(VERSION)|' -e 's|@KLU_LIBS@|$(KLU_LIBS) $(SUNDIALS_LIBS)|' \
 	    mech.pc.in >$(DESTDIR)$(PREFIX)/lib/pkgconfig/mech.pc
 	install -m 644 include/mech.h $(DESTDIR)$(PREFIX)/include/mech.h
 	install -m 644 docs/mech.1 $(DESTDIR)$(PREFIX)/share/man/man1/mech.1

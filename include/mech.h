@@ -348,6 +348,11 @@ typedef struct mech_model {
                              from there by continuation */
     struct file_units *units; /* owned: the file's `units:` as written, for results in
                                  them (src/base/base.h); NULL when it gives none */
+    struct model_fit *fit; /* owned: the file's `fit:` section, mech fit's problem
+                              (src/base/base.h, docs/synthesis.md); NULL when none */
+    struct free_drivers *free_drivers; /* owned: the drivers of `drivers:` marked
+                                 `free: true` (docs/dynamics.md; src/load/load.h), moved by
+                                 their loads in `mech simulate`; NULL when none is */
 } mech_model;
 
 /* Read and validate a mechanism file. On success *out is the model and the
@@ -605,6 +610,55 @@ int mech_pose_guess(const mech_model *m, double q, mech_pose *out, mech_diag *d)
  * is empty or not of m, or m has no such point). */
 void mech_pose_point(const mech_model *m, const mech_pose *p, int link, int k, double xy[2]);
 void mech_pose_free(mech_pose *p);
+
+/* ---- Forward dynamics (src/study/simulate.c, docs/dynamics.md) -----------
+ * The drivers of `drivers:` marked `free: true` move as the loads make them
+ * move: mech_simulate integrates the equations of motion in those free
+ * coordinates with SUNDIALS CVODE and writes one row per output time: the
+ * columns of mech_solve with forces (t, the outputs, reactions, driver
+ * loads, power residual), then energy.kinetic, energy.gravity,
+ * energy.springs, work.loads, work.drivers, work.dampers and
+ * energy.balance (J). */
+enum { MECH_SIM_BDF = 0, MECH_SIM_ADAMS = 1 };
+
+typedef struct mech_simulate_options {
+    size_t size;       /* sizeof the struct, set by mech_simulate_options_default (the
+                          library refuses another size, as for mech_solve_options) */
+    double to;         /* last time, s (NAN: the sweep's last) */
+    double step;       /* output spacing, s (0: the sweep's) */
+    double rtol, atol; /* CVODE's tolerances (default 1e-8, 1e-10) */
+    int method;        /* MECH_SIM_BDF (default) or MECH_SIM_ADAMS */
+    long max_steps;    /* integration steps between two output times (default 1e6) */
+    int stop_at_rest;  /* 1: end the run where a free coordinate's rate crosses zero
+                          (CVODE's root finding; the last row is at that time) */
+    const char *stop_when; /* NULL, or "NAME.MEMBER=VALUE": end the run where a point's x
+                          or y, a link's angle or a slider's s crosses VALUE (bare numbers
+                          mm or deg, or with a unit: "x_C.s=150 mm", "crank.angle=2 rad") */
+} mech_simulate_options;
+
+typedef struct mech_simulate_stats {
+    long steps, rhs_evals, jac_evals; /* CVODE's */
+    long evaluations;      /* states evaluated (positions, rates, mass matrix) */
+    long force_solves;
+    int rows;              /* output rows written */
+    double worst_residual; /* largest Newton residual of the loops, m */
+    double worst_free_load;/* largest |load| a free driver still needed at an output row
+                              (0 in exact arithmetic: the equations of motion's residual) */
+    double stop_time;      /* where the run ended, s */
+    int stopped_at_rest;   /* the free driver (index in drivers) whose rate crossed zero
+                              there (stop_at_rest), else -1 */
+    double seconds;        /* wall time */
+} mech_simulate_stats;
+
+/* The defaults in *o (and o->size): call it before setting any field. */
+void mech_simulate_options_default(mech_simulate_options *o);
+/* Simulate a checked model with free drivers. MECH_OK; MECH_ESOLVE when the
+ * run stopped early (a limit position, a dead point, an integrator failure:
+ * d says where and why; out holds the rows so far); MECH_EINPUT when the
+ * model has no free driver or has what the simulation does not model
+ * (Coulomb friction, loads of accelerations). stats may be NULL. */
+int mech_simulate(const mech_model *m, const mech_simulate_options *o, mech_table *out,
+                  mech_simulate_stats *stats, mech_diag *d);
 
 /* Sensitivities (src/study/sensitivity.c, docs/sensitivity.md): to `table`, the
  * result of mech_solve(m, o, ...), add for each parameter names[k] and each

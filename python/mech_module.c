@@ -578,10 +578,19 @@ static PyObject *stats_dict(const mech_solve_stats *s)
         "failure_q", s->failure_q);
 }
 
+static PyObject *table_tuple_with(const mech_table *t, PyObject *stats, const mech_diag *d);
+
 /* (names, units, arrays, stats, messages): one contiguous float64 array of
  * nrows per column, the table's doubles copied as they are. */
 static PyObject *table_tuple(const mech_table *t, const mech_solve_stats *s, const mech_diag *d)
 {
+    return table_tuple_with(t, stats_dict(s), d);
+}
+
+static PyObject *table_tuple_with(const mech_table *t, PyObject *stats, const mech_diag *d)
+{
+    if (!stats)
+        return NULL;
     PyObject *names = PyList_New(t->ncolumns), *units = PyList_New(t->ncolumns);
     PyObject *arrays = PyList_New(t->ncolumns);
     if (!names || !units || !arrays)
@@ -606,8 +615,9 @@ static PyObject *table_tuple(const mech_table *t, const mech_solve_stats *s, con
         PyList_SET_ITEM(units, c, u);
         PyList_SET_ITEM(arrays, c, a);
     }
-    return Py_BuildValue("(NNNNN)", names, units, arrays, stats_dict(s), diag_list(d));
+    return Py_BuildValue("(NNNNN)", names, units, arrays, stats, diag_list(d));
 fail:
+    Py_XDECREF(stats);
     Py_XDECREF(names);
     Py_XDECREF(units);
     Py_XDECREF(arrays);
@@ -655,6 +665,66 @@ static PyObject *py_solve(PyObject *self, PyObject *args, PyObject *kw)
     }
     if (has_sel)
         mech_outputs_free(&sel);
+    mech_model_free(&m);
+    return result;
+}
+
+/* _mech.simulate(path, to=None, step=None, rtol=None, atol=None, method=None)
+ * -> (names, units, arrays, stats, messages): mech_simulate (docs/dynamics.md) */
+static PyObject *py_simulate(PyObject *self, PyObject *args, PyObject *kw)
+{
+    static char *kwlist[] = {"path", "to", "step", "rtol", "atol", "method", "stop_at_rest",
+                             "stop_when", NULL};
+    PyObject *path, *to = Py_None, *step = Py_None, *rtol = Py_None, *atol = Py_None;
+    const char *method = NULL, *stop_when = NULL;
+    int stop_at_rest = 0;
+    (void)self;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "O|OOOOzpz", kwlist, &path, &to, &step, &rtol,
+                                     &atol, &method, &stop_at_rest, &stop_when))
+        return NULL;
+    mech_simulate_options o;
+    mech_simulate_options_default(&o);
+    o.stop_at_rest = stop_at_rest;
+    o.stop_when = stop_when;
+    PyObject *nums[] = {to, step, rtol, atol};
+    double *into[] = {&o.to, &o.step, &o.rtol, &o.atol};
+    for (int k = 0; k < 4; k++)
+        if (nums[k] != Py_None) {
+            *into[k] = PyFloat_AsDouble(nums[k]);
+            if (*into[k] == -1.0 && PyErr_Occurred())
+                return NULL;
+        }
+    if (method && strcmp(method, "bdf") != 0 && strcmp(method, "adams") != 0)
+        return PyErr_Format(PyExc_ValueError, "method is 'bdf' or 'adams', not '%s'", method);
+    o.method = method && strcmp(method, "adams") == 0 ? MECH_SIM_ADAMS : MECH_SIM_BDF;
+    if (!(o.rtol > 0.0) || !(o.atol > 0.0) || (step != Py_None && !(o.step > 0.0)))
+        return PyErr_Format(PyExc_ValueError, "rtol, atol and step must be positive");
+    mech_summary sm;
+    mech_model *m = load_model(path, Py_None, 1, &sm);
+    if (!m)
+        return NULL;
+    mech_table t = {0};
+    mech_simulate_stats st;
+    mech_diag d;
+    int rc;
+    memset(&st, 0, sizeof st);
+    mech_diag_init(&d);
+    Py_BEGIN_ALLOW_THREADS
+    rc = mech_simulate(m, &o, &t, &st, &d);
+    Py_END_ALLOW_THREADS
+    PyObject *stats = Py_BuildValue(
+        "{s:l,s:l,s:l,s:l,s:l,s:i,s:d,s:d,s:d,s:d}", "steps", st.steps, "rhs_evals",
+        st.rhs_evals, "jac_evals", st.jac_evals, "evaluations", st.evaluations,
+        "force_solves", st.force_solves, "rows", st.rows, "worst_residual", st.worst_residual,
+        "worst_free_load", st.worst_free_load, "stop_time", st.stop_time, "seconds",
+        st.seconds);
+    PyObject *result = table_tuple_with(&t, stats, &d);
+    if (result && rc != MECH_OK) {
+        raise_mech(rc, &d, NULL, result);
+        Py_CLEAR(result);
+    }
+    mech_table_free(&t);
+    mech_diag_free(&d);
     mech_model_free(&m);
     return result;
 }
@@ -852,6 +922,10 @@ static PyMethodDef methods[] = {
      "solve(path, set=None, from_=None, to=None, steps=None, outputs=None, forces=None, "
      "tol=None, level=None, friction=None, diagnostics=False, all=False) -> "
      "(names, units, arrays, stats, messages)"},
+    {"simulate", (PyCFunction)(void (*)(void))py_simulate, METH_VARARGS | METH_KEYWORDS,
+     "simulate(path, to=None, step=None, rtol=None, atol=None, method=None, "
+     "stop_at_rest=False, stop_when=None) -> "
+     "(names, units, arrays, stats, messages): mech_simulate"},
     {NULL, NULL, 0, NULL}};
 
 static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "mech._mech",

@@ -2,7 +2,7 @@
 that runs it (pip install ./python; docs/api.md, "Python"). The extension
 mech._mech is python/mech_module.c with libmech's own sources (src/*/*.c but
 the command line's, src/cli/) compiled in, so it needs no installed libmech, only
-Debian's libyaml and SuiteSparse KLU; numpy's headers are those of the
+Debian's libyaml, SuiteSparse KLU and SUNDIALS CVODE; numpy's headers are those of the
 running interpreter's numpy (python/buildinfo.py, which the Makefile's
 `make install PYTHON=...` uses too), and the extension records what it was
 built for, to say so when another interpreter imports it."""
@@ -92,6 +92,15 @@ klu_libs = pkg_config('--libs', 'klu', ['-lklu', '-lbtf', '-lamd', '-lcolamd',
                                          '-lsuitesparseconfig'])
 yaml_libs = pkg_config('--libs', 'yaml-0.1', ['-lyaml'])
 
+
+def sundials_libs():
+    """SUNDIALS CVODE's libraries for mech_simulate (src/study/simulate.c),
+    read from the Makefile's SUNDIALS_LIBS so that they are written once."""
+    with open(os.path.join(ROOT, 'Makefile')) as f:
+        m = re.search(r'^SUNDIALS_LIBS\s*=\s*((?:.*\\\n)*.*)$', f.read(), re.M)
+    return m.group(1).replace('\\\n', ' ').split()
+
+
 extension = Extension(
     'mech._mech',
     sources=['mech_module.c'] + library_sources() + [runtime_text()],
@@ -102,7 +111,7 @@ extension = Extension(
              sorted(glob.glob(os.path.join(ROOT, 'src', '*', '*.h')))],
     define_macros=buildinfo.define_macros(),
     extra_compile_args=['-std=c11', '-D_POSIX_C_SOURCE=200809L'] + klu_cflags,
-    extra_link_args=yaml_libs + klu_libs + ['-lm', '-pthread'],
+    extra_link_args=yaml_libs + klu_libs + sundials_libs() + ['-lm', '-pthread'],
 )
 
 setup(

@@ -132,7 +132,7 @@ fi
 
 # every option of every command's --help (printed from its option table,
 # src/cli/cmd_opts.c) is documented in docs/ (the man page: tests/install.sh)
-for c in check equations solve compare batch sweep merge plot animate codegen report; do
+for c in check equations solve compare batch sweep merge plot animate codegen report fit simulate; do
     "$MECH" "$c" --help | grep -o -- '--[a-z][a-z-]*' | sort -u | while read -r opt; do
         grep -q -- "$opt" docs/*.md || echo "$c $opt"
     done

@@ -136,14 +136,14 @@ if [ -n "$how" ]; then
     if [ -s "$tmp/man.txt" ] && [ ! -s "$tmp/man.err" ]; then pass; else
         fail "$how $man_page: $(head -n 3 "$tmp/man.err")"; fi
     sed 's/.\x08//g' "$tmp/man.txt" >"$tmp/man.plain"
-    for c in check equations solve compare batch sweep merge plot animate codegen report; do
+    for c in check equations solve compare batch sweep merge plot animate codegen report fit; do
         has_line "$tmp/man.plain" "^ *mech $c " "man page: section of mech $c"
     done
     for h in SYNOPSIS 'EXIT STATUS' FILES; do
         has_line "$tmp/man.plain" "^$h" "man page: $h"
     done
     # every option of every command's --help is in the man page
-    for c in check equations solve compare batch sweep merge plot animate codegen report; do
+    for c in check equations solve compare batch sweep merge plot animate codegen report fit; do
         "$P/bin/mech" "$c" --help | grep -o -- '--[a-z][a-z-]*' | sort -u | while read -r opt; do
             grep -q -- "$opt" "$tmp/man.plain" || echo "$c $opt"
         done

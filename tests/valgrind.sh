@@ -1,6 +1,6 @@
 #!/bin/sh
 # tests/valgrind.sh: `mech solve` (with forces) on every mechanism, the
-# failure cases and the other commands (mech watch served, edited and
+# failure cases and the other commands (simulate and fit among them) (mech watch served, edited and
 # stopped by SIGINT) under valgrind: no invalid reads or writes, no leaks.
 # Run from the repository root:  MECH=build/mech sh tests/valgrind.sh
 MECH=${MECH:-build/mech}
@@ -48,6 +48,15 @@ check "mech report, a partial sweep" report tests/hard/non-grashof-crank.yaml -o
 check "mech draw (a guessed pose)" draw mechanisms/fourbar.yaml --frame 30 -o "$tmp/d.svg"
 check "mech check --draw" check mechanisms/offset-slider-crank.yaml --draw "$tmp/d.svg"
 check "mech draw, no assembly" draw tests/hard/non-grashof-crank.yaml --at 180 -o "$tmp/d.svg"
+check "mech simulate (BDF)" simulate tests/dynamics/pendulum.yaml --to 1 --step 0.05 -o "$tmp/sim.csv"
+check "mech simulate (two free cranks, Adams)" simulate tests/dynamics/five-bar-free.yaml --to 0.5 --method adams -o "$tmp/sim.csv"
+check "mech simulate --stop-at-rest" simulate tests/dynamics/pendulum.yaml --stop-at-rest -o "$tmp/sim.csv"
+"$MECH" solve tests/fit/fourbar.yaml --from 0 --to 330 --steps 11 --outputs P --level positions \
+    --units file -o "$tmp/all.csv" && cut -d, -f1-3 "$tmp/all.csv" >"$tmp/path.csv"
+sed -e 's/^  r: 20 mm/  r: 22 mm/' -e 's/^  l: 60 mm/  l: 55 mm/' tests/fit/fourbar.yaml >"$tmp/moved.yaml"
+check "mech fit (4 starts on 2 threads)" fit "$tmp/moved.yaml" --free r=15:25,l=50:70 --target "$tmp/path.csv" \
+    --starts 4 -j 2 -o "$tmp/best.yaml"
+check "mech fit, unknown column" fit "$tmp/moved.yaml" --free r --target "$tmp/all.csv" --column Q.x
 
 # mech watch: served, saved (good, broken, good again), requests refused,
 # a long poll and an idle connection open at SIGINT; nothing may leak

@@ -45,7 +45,8 @@ except ModuleNotFoundError as e:
     raise _another_python() from None
 from . import _mech
 
-__all__ = ['MechError', 'Result', 'SweepResult', 'load', 'check', 'solve', 'sweep', 'VERSION',
+__all__ = ['MechError', 'Result', 'SweepResult', 'load', 'check', 'solve', 'simulate', 'sweep',
+           'VERSION',
            'EINPUT', 'ENOMEM', 'EIO', 'ESOLVE', 'FAIL_KINDS', 'VARIANT_STATUS']
 __version__ = VERSION
 
@@ -153,6 +154,36 @@ def solve(path, set=None, from_=None, to=None, steps=None, outputs=None, forces=
         names, units, arrays, stats, messages = _mech.solve(
             path, set=set, from_=from_, to=to, steps=steps, outputs=outputs, forces=forces,
             tol=tol, level=level, friction=friction, diagnostics=diagnostics, all=all)
+    except MechError as e:
+        if isinstance(getattr(e, 'partial', None), tuple):
+            e.partial = Result(*e.partial)
+        raise
+    return Result(names, units, arrays, stats, messages)
+
+
+def simulate(path, to=None, step=None, rtol=None, atol=None, method=None, stop_at_rest=False,
+             stop_when=None):
+    """Forward dynamics of a file with free drivers, as `mech simulate`
+    (docs/dynamics.md): the motion the loads give the drivers marked
+    `free: true`, integrated by SUNDIALS CVODE.
+
+    to          the last time, s (default: the sweep's last)
+    step        the output spacing, s (default: the sweep's)
+    rtol, atol  the integration's tolerances (default 1e-8, 1e-10)
+    method      'bdf' (default) or 'adams'
+    stop_at_rest  True: end where a free driver's rate crosses zero
+    stop_when   'NAME.MEMBER=VALUE': end where a point's x or y, a link's
+                angle or a slider's s crosses VALUE ('x_C.s=150 mm')
+
+    Returns a Result: 't', the outputs, reactions, driver loads, then
+    energy.kinetic, energy.gravity, energy.springs, work.loads,
+    work.drivers, work.dampers, energy.balance (J); r.stats has the
+    integrator's figures. Raises MechError (with .partial, a Result of the
+    rows before, when the run stopped early)."""
+    try:
+        names, units, arrays, stats, messages = _mech.simulate(
+            path, to=to, step=step, rtol=rtol, atol=atol, method=method,
+            stop_at_rest=stop_at_rest, stop_when=stop_when)
     except MechError as e:
         if isinstance(getattr(e, 'partial', None), tuple):
             e.partial = Result(*e.partial)

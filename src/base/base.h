@@ -198,6 +198,28 @@ int load_doc_numbers(const load_doc *doc, const mech_override *ov, int nov, mech
                      mech_diag *d);
 void load_doc_free(load_doc **doc);
 
+/* ---- the file's `fit:` section (src/load/load_fit.c, docs/synthesis.md):
+ *      mech fit's problem as the file states it; the command line's options
+ *      replace its parts. */
+typedef struct model_fit_free {
+    char *name;        /* a parameter of the file */
+    double lo, hi;     /* bounds, SI; -INFINITY, INFINITY when none */
+    mech_mark mark;
+} model_fit_free;
+typedef struct model_fit {
+    model_fit_free *free;  /* [nfree] */
+    int nfree;
+    char *target;      /* the targets' CSV as written (relative: to the file's folder), or NULL */
+    char **columns;    /* [ncolumns] the target columns, or none: every column */
+    double *weights;   /* [ncolumns] */
+    int ncolumns;
+    int starts;        /* 0: the default */
+    int whole_range;   /* 1: the solution must assemble over the file's whole range */
+    int free_timing;   /* 1: each target row's driver position is an unknown too */
+    mech_mark mark;
+} model_fit;
+void model_fit_free_all(model_fit *f);  /* accepts NULL */
+
 /* ---- yamltree.c: a bounded YAML document tree with marks. */
 typedef enum { YNODE_SCALAR, YNODE_SEQ, YNODE_MAP } ynode_kind;
 typedef struct ynode ynode;

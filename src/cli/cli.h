@@ -230,6 +230,19 @@ int cmd_check(int argc, char **argv);
 extern const cmd_spec cmd_convert_spec;
 int cmd_convert(int argc, char **argv);
 
+/* `mech fit FILE --free ... --target CSV` (cmd_fit.c, docs/synthesis.md). */
+extern const cmd_spec cmd_fit_spec;
+int cmd_fit(int argc, char **argv);
+/* cmd_fit_lm.c: one local fit of fp from p[nfree] (in: the start, in the
+ * bounds lo[k] < hi[k], or both infinite: none; out: the solution) by
+ * MINPACK's lmder with the bounds as a change of variable; r[nq ncols]:
+ * the solution's residuals, *objective their sum of squares, *info
+ * lmder's. MECH_OK; MECH_ESOLVE when the start (or, never expected, the
+ * solution) does not assemble at every target; MECH_ENOMEM. */
+typedef struct fit_problem fit_problem;  /* src/study/study.h */
+int fit_lm(fit_problem *fp, const double *lo, const double *hi, double *p, double *r,
+           double *objective, int *info);
+
 /* `mech draw FILE -o OUT.svg` (cmd_draw.c, docs/plots.md): the assembled
  * position with names, and the stated pose beside it when they differ;
  * cmd_draw_model draws a checked model (mech check --draw too). */
@@ -249,6 +262,10 @@ int cmd_equations(int argc, char **argv);
 
 extern const cmd_spec cmd_solve_spec;
 int cmd_solve(int argc, char **argv);
+
+/* `mech simulate FILE` (cmd_simulate.c, docs/dynamics.md): forward dynamics. */
+extern const cmd_spec cmd_simulate_spec;
+int cmd_simulate(int argc, char **argv);
 
 extern const cmd_spec cmd_batch_spec;
 int cmd_batch(int argc, char **argv);

@@ -22,6 +22,8 @@ static const command commands[] = {
     {&cmd_animate_spec, cmd_animate}, {&cmd_draw_spec, cmd_draw},
     {&cmd_report_spec, cmd_report},   {&cmd_watch_spec, cmd_watch},
     {&cmd_codegen_spec, cmd_codegen}, {&cmd_convert_spec, cmd_convert},
+    {&cmd_fit_spec, cmd_fit},
+    {&cmd_simulate_spec, cmd_simulate},
 };
 #define NCOMMANDS (sizeof commands / sizeof commands[0])
 

@@ -469,8 +469,41 @@ int drivers_same(const mech_model *a, const mech_model *b)
     return 1;
 }
 
+struct mech_law *law_linear(double a, double b)
+{
+    struct mech_law *l = xcalloc(1, sizeof *l);
+    law_node *n = l ? xcalloc(5, sizeof *n) : NULL;
+    if (!n) {
+        free(l);
+        return NULL;
+    }
+    n[0] = (law_node){LAW_CONST, -1, -1, a};
+    n[1] = (law_node){LAW_CONST, -1, -1, b};
+    n[2] = (law_node){LAW_T, -1, -1, 0.0};
+    n[3] = (law_node){LAW_MUL, 1, 2, 0.0};
+    n[4] = (law_node){LAW_ADD, 0, 3, 0.0};
+    l->nodes = n;
+    l->n = l->cap = 5;
+    l->root = 4;
+    return l;
+}
+
+const free_driver *drivers_free_of(const mech_model *m, int k)
+{
+    const struct free_drivers *f = m->free_drivers;
+    for (int i = 0; f && i < f->n; i++)
+        if (f->d[i].driver == k)
+            return &f->d[i];
+    return NULL;
+}
+
 void drivers_free(mech_model *m)
 {
+    if (m->free_drivers) {
+        free(m->free_drivers->d);
+        free(m->free_drivers);
+        m->free_drivers = NULL;
+    }
     for (int i = 0; i < m->ndrivers; i++) {
         free(m->drivers[i].text);
         law_free(m->drivers[i].law);

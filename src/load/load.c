@@ -51,7 +51,7 @@ static void load_document(loader *ld, const ynode *root)
     static const char *const keys[] = {"name", "description", "units", "parameters", "gravity",
                                        "ground", "links", "joints", "driver", "initial",
                                        "branch", "loops", "loads", "springs", "gears",
-                                       "outputs", "sweep", "drivers", "drawing"};
+                                       "outputs", "sweep", "drivers", "drawing", "fit"};
     mech_model *m = ld->m;
     size_t errors = ld->d->nerrors;
     if (!load_check_keys(ld, root, keys, COUNT(keys), "the mechanism"))
@@ -123,6 +123,8 @@ static void load_document(loader *ld, const ynode *root)
         load_outputs(ld, v);
     else
         load_default_outputs(m);
+    if ((v = ymap_get(root, "fit")))
+        load_fit(ld, v);
 }
 
 static int load_string_with(const char *text, size_t len, const char *name,

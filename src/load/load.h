@@ -351,6 +351,30 @@ int drivers_move_link(const mech_model *m, int l);
  * laws, every number bit for bit? (The system folds the laws' numbers.) */
 int drivers_same(const mech_model *a, const mech_model *b);
 
+/* ---- free coordinates (docs/dynamics.md, docs/format.md 7.4) -----------
+ * A driver of `drivers:` with `free: true` has no law of its own: its
+ * coordinate moves as the loads make it move (mech simulate). For every
+ * other command its law is value + speed (t - t0), t0 the sweep's first
+ * time: it turns on at its initial speed. Its `load:` (a torque on the
+ * driven link) is one more load of m->state_loads. */
+typedef struct free_driver {
+    int driver;        /* index in m->drivers */
+    double value;      /* initial coordinate, rad or m */
+    double speed;      /* initial rate, rad/s or m/s */
+    int load;          /* index of its load in m->state_loads->loads, -1 when none */
+    mech_mark mark;
+} free_driver;
+
+struct free_drivers {
+    free_driver *d;    /* [n] */
+    int n;
+};
+
+/* The law a + b t (a free driver's for the commands other than simulate). */
+struct mech_law *law_linear(double a, double b);
+/* Driver k of m is free: its entry in m->free_drivers, or NULL. */
+const free_driver *drivers_free_of(const mech_model *m, int k);
+
 /* model.c: free the model's drivers. */
 void drivers_free(mech_model *m);
 
@@ -558,6 +582,8 @@ int load_get_vec2_expr(loader *ld, const ynode *n, quantity q, const char *what,
 /* A number computed from recorded ones (a polar point, a gear's radius). */
 pxq load_expr(loader *ld, px_op op, double k, pxq a, pxq b, pxq c, double value);
 int load_get_count(loader *ld, const ynode *n, const char *what, long lo, long hi, long *out);
+/* load_fit.c: the `fit:` section into m->fit (docs/synthesis.md). */
+void load_fit(loader *ld, const ynode *map);
 int load_get_bool(loader *ld, const ynode *n, const char *what, int *out);
 int load_get_vec2(loader *ld, const ynode *n, quantity q, const char *what, double out[2]);
 int load_errors_full(const loader *ld);
@@ -624,6 +650,10 @@ void load_default_outputs(mech_model *m);
  *      constant quantity; load_state_load compiles them into m->state_loads. */
 int load_state_wanted(loader *ld, const ynode *value);
 void load_state_load(loader *ld, const ynode *map, const ynode *value, int link, int point);
+/* A force of size `value` (a force, constant or of the motion) along the
+ * direction dir (rad, ground frame) at point `point` of `link`. */
+void load_state_along(loader *ld, const ynode *map, const ynode *value, int link, int point,
+                      double dir);
 /* {force: TENSION, between: [P, Q], links: [a, b]}: a force along a line. */
 void load_state_line(loader *ld, const ynode *map);
 

@@ -27,10 +27,69 @@ static void load_sweep(loader *ld, const ynode *map)
     dr->accel = 0.0;
 }
 
-/* One entry: {link: NAME, angle: LAW} or {slider: NAME, displacement: LAW}. */
+/* A free driver (docs/format.md 7.4): `free: true`, `initial: {value, speed}`,
+ * `load:` (a torque on a link driver). Its law for the other commands:
+ * value + speed (t - t0). Returns 0 when it was reported. */
+static int load_free(loader *ld, const ynode *e, mech_motion *mo, int is_link, const ynode *ini,
+                     const ynode *lo)
+{
+    static const char *const ikeys[] = {"value", "speed"};
+    mech_model *m = ld->m;
+    if (!ini)
+        return load_err(ld, e, "a free driver needs 'initial: {value: ..., speed: ...}' (its %s "
+                               "and %s at the first time)", is_link ? "angle" : "displacement",
+                        is_link ? "angular speed" : "speed"), 0;
+    if (!load_want_kind(ld, ini, YNODE_MAP, "'initial'") ||
+        !load_check_keys(ld, ini, ikeys, COUNT(ikeys), "initial"))
+        return 0;
+    const ynode *v = ymap_get(ini, "value"), *w = ymap_get(ini, "speed");
+    if (!v)
+        return load_err(ld, ini, "'initial' needs 'value: ...' (the %s at the first time)",
+                        is_link ? "angle" : "displacement"), 0;
+    free_driver fd = {(int)(mo - m->drivers), 0.0, 0.0, -1, e->mark};
+    if (!load_get_quantity(ld, v, is_link ? Q_ANGLE : Q_LENGTH, "initial value", &fd.value))
+        return 0;
+    if (w && !load_get_quantity(ld, w, is_link ? Q_ANGULAR_SPEED : Q_SPEED, "initial speed",
+                                &fd.speed))
+        return 0;
+    const mech_joint *jt = is_link ? NULL : &m->joints[mo->index];
+    if (lo && jt && jt->link[1] != 0)
+        return load_err(ld, load_key_of(e, "load"), "a free slider's 'load' needs a guide on "
+                        "the ground ('%s' slides on '%s'): give the force on the moving link "
+                        "in 'loads:'", jt->name, m->links[jt->link[1]].name), 0;
+    if (lo) {
+        int before = m->state_loads ? m->state_loads->nloads : 0;
+        if (jt)  /* along the guide's line, at the sliding point, + along the displacement */
+            load_state_along(ld, e, lo, jt->link[0], jt->point[0], jt->angle);
+        else
+            load_state_load(ld, e, lo, mo->index, -1);
+        if (m->state_loads && m->state_loads->nloads > before)
+            fd.load = m->state_loads->nloads - 1;
+        else
+            return 0;
+    }
+    struct free_drivers *f = m->free_drivers;
+    if (!f && !(f = m->free_drivers = xcalloc(1, sizeof *f)))
+        return load_nomem(ld, e), 0;
+    free_driver *grown = realloc(f->d, (size_t)(f->n + 1) * sizeof *grown);
+    if (!grown)
+        return load_nomem(ld, e), 0;
+    f->d = grown;
+    f->d[f->n++] = fd;
+    double t0 = m->driver.nvalues > 0 ? m->driver.values[0] : 0.0;
+    mo->law = law_linear(fd.value - fd.speed * t0, fd.speed);
+    mo->text = xstrdup("free");
+    if (!mo->law || !mo->text)
+        return load_nomem(ld, e), 0;
+    return 1;
+}
+
+/* One entry: {link: NAME, angle: LAW} or {slider: NAME, displacement: LAW},
+ * or a free one: {link: NAME, free: true, initial: {...}, load: ...}. */
 static void load_motion(loader *ld, const ynode *e, mech_motion *mo)
 {
-    static const char *const keys[] = {"link", "slider", "angle", "displacement"};
+    static const char *const keys[] = {"link", "slider", "angle", "displacement", "free",
+                                       "initial", "load"};
     mech_model *m = ld->m;
     mo->index = -1;
     mo->mark = e->mark;
@@ -44,11 +103,26 @@ static void load_motion(loader *ld, const ynode *e, mech_motion *mo)
                                         : "a driver needs 'link: NAME' with 'angle: LAW' or "
                                           "'slider: NAME' with 'displacement: LAW'");
     const ynode *law = ln ? ang : disp, *wrong = ln ? disp : ang;
+    const ynode *fr = ymap_get(e, "free"), *ini = ymap_get(e, "initial"),
+                *lo = ymap_get(e, "load");
+    int is_free = 0;
+    if (fr && !load_get_bool(ld, fr, "'free'", &is_free))
+        return;
+    if (is_free && law)
+        return (void)load_err(ld, load_key_of(e, ln ? "angle" : "displacement"),
+                              "a free driver has no law: its motion follows from the loads "
+                              "(remove '%s' or 'free: true')", ln ? "angle" : "displacement");
+    if (!is_free && (ini || lo))
+        return (void)load_err(ld, load_key_of(e, ini ? "initial" : "load"),
+                              "'%s' belongs to a free driver ('free: true')",
+                              ini ? "initial" : "load");
+    if (is_free)
+        law = NULL;
     if (wrong)
         return (void)load_err(ld, load_key_of(e, ln ? "displacement" : "angle"),
                               ln ? "a link driver takes 'angle', not 'displacement'"
                                  : "a slider driver takes 'displacement', not 'angle'");
-    if (!law)
+    if (!law && !is_free)
         return (void)load_err(ld, e, "the driver has no '%s' (its law of the time t, such as "
                                      "'%s')", ln ? "angle" : "displacement",
                               ln ? "10 rad/s * t" : "0.1 m + 0.02 m/s * t");
@@ -72,6 +146,11 @@ static void load_motion(loader *ld, const ynode *e, mech_motion *mo)
     } else {
         mo->kind = MECH_DRIVE_SLIDER;
         mo->index = load_slider_by_name(ld, sn, "driver slider");
+    }
+    if (is_free) {
+        if (mo->index >= 0 && !load_free(ld, e, mo, ln != NULL, ini, lo))
+            mo->index = -1;
+        return;
     }
     if (!load_want_kind(ld, law, YNODE_SCALAR, "a driver's law"))
         return;

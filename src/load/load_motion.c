@@ -133,6 +133,10 @@ void load_driver(loader *ld, const ynode *map)
                                        "acceleration"};
     mech_model *m = ld->m;
     mech_driver *dr = &m->driver;
+    const ynode *fk = map && map->kind == YNODE_MAP ? load_key_of(map, "free") : NULL;
+    if (fk)
+        return (void)load_err(ld, fk, "a free driver is an entry of 'drivers:' with 'sweep: "
+                                      "{time: ...}', not 'driver:' (docs/format.md 7.4)");
     if (!load_check_keys(ld, map, keys, COUNT(keys), "driver"))
         return;
     dr->mark = map->mark;

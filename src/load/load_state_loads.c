@@ -502,6 +502,23 @@ void load_state_load(loader *ld, const ynode *map, const ynode *value, int link,
         load_nomem(ld, map);
 }
 
+/* A force of size `value` along the direction dir (rad, ground frame) at
+ * point `point` of `link`: a free slider's load (load_drivers.c). */
+void load_state_along(loader *ld, const ynode *map, const ynode *value, int link, int point,
+                      double dir)
+{
+    int r = component(ld, value, Q_FORCE, "force");
+    if (r < 0)
+        return;
+    state_loads *s = ld->m->state_loads;
+    int c = sl_const(s, cos(dir)), sn = sl_const(s, sin(dir));
+    sl_load l = {0, link, point, {-1, -1}, map->mark};
+    l.reg[0] = c < 0 ? -1 : sl_emit(s, SLOP_MUL, r, c, 0);
+    l.reg[1] = sn < 0 ? -1 : sl_emit(s, SLOP_MUL, r, sn, 0);
+    if (l.reg[0] < 0 || l.reg[1] < 0 || sl_add_load(s, &l) < 0)
+        load_nomem(ld, map);
+}
+
 /* ---- a force along a line ------------------------------------------ */
 
 void load_state_line(loader *ld, const ynode *map)

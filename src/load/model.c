@@ -86,6 +86,7 @@ void mech_model_free(mech_model **pm)
     state_loads_free(m->state_loads);
     pexpr_free(m->pexpr);
     free(m->units);
+    model_fit_free_all(m->fit);
     for (int i = 0; i < m->ngears; i++)
         free(m->gears[i].name);
     free(m->gears);

@@ -27,7 +27,14 @@ static void driver_lines(const mech_model *m, char *b, size_t n, describe_emit e
             snprintf(b, n, "%s of %s '%s', %d position%s", angle ? "angle" : "displacement",
                      angle ? "link" : "slider", drivers_name(m, i), dr->nvalues,
                      dr->nvalues == 1 ? "" : "s");
-        else
+        else if (drivers_free_of(m, i)) {
+            const free_driver *f = drivers_free_of(m, i);
+            snprintf(b, n, "%s of %s '%s' = free, from %.6g %s at %.6g %s%s",
+                     angle ? "angle" : "displacement", angle ? "link" : "slider",
+                     drivers_name(m, i), angle ? f->value * 57.29577951308232 : f->value * 1e3,
+                     angle ? "deg" : "mm", f->speed, angle ? "rad/s" : "m/s",
+                     f->load >= 0 ? ", with its load" : "");
+        } else
             snprintf(b, n, "%s of %s '%s' = %s", angle ? "angle" : "displacement",
                      angle ? "link" : "slider", drivers_name(m, i), m->drivers[i].text);
         emit(ctx, "driver", b);

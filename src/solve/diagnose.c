@@ -173,12 +173,17 @@ static int other_pin(const mech_model *m, int li, int j)
  * 1e-3 rad of it. Publishes x (diagnostics only). */
 static void in_line_text(solver *sv, double q, const double *x, char *buf, size_t size)
 {
-    const mech_model *m = sv->p->m;
     memcpy(sv->x, x, (size_t)sv->p->ns * sizeof *sv->x);
     sv->generation++;
     solver_publish(sv, q, 0.0, 0.0);
+    diagnose_links_in_line(sv, 1.0 - 5e-7, buf, size);  /* cos of 1e-3 rad */
+}
+
+void diagnose_links_in_line(solver *sv, double cos_min, char *buf, size_t size)
+{
+    const mech_model *m = sv->p->m;
     kin_refresh_all(&sv->p->tree, &sv->ks);  /* kin_point on any link below */
-    double best = 1.0 - 5e-7;  /* cos of 1e-3 rad */
+    double best = cos_min;
     buf[0] = '\0';
     for (int j = 0; j < m->njoints; j++) {
         const mech_joint *jt = &m->joints[j];

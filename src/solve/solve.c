@@ -651,12 +651,18 @@ static void linear_solve(solver *sv, const double *b, double *dx)
 typedef struct newton_ctx {
     solver *sv;
     double q;
+    const double *shift;  /* [nr] f(x, q) = shift is solved (NULL: 0) */
 } newton_ctx;
 
 static double newton_evaluate(void *c, const double *x, double *f)
 {
     newton_ctx *n = c;
-    return evaluate(n->sv, x, n->q, f);
+    double r = evaluate(n->sv, x, n->q, f);
+    if (!n->shift)
+        return r;
+    for (int i = 0; i < n->sv->p->nr; i++)
+        f[i] -= n->shift[i];
+    return vec_norm_inf(f, n->sv->p->nr);
 }
 
 static int newton_factor(void *c) { return factor(((newton_ctx *)c)->sv); }
@@ -681,7 +687,9 @@ static double newton_rcond_at_solution(void *c) { return condition(((newton_ctx 
 static const rt_newton_ops newton_ops = {newton_evaluate, newton_factor, newton_rcond_whole,
                                          newton_solve, newton_rcond_at_solution};
 
-step_status solver_newton(solver *sv, double q)
+step_status solver_newton(solver *sv, double q) { return solver_newton_shifted(sv, q, NULL); }
+
+step_status solver_newton_shifted(solver *sv, double q, const double *shift)
 {
     const solver_plan *sp = sv->p;
     sv->generation++;  /* x changes: what was published is stale */
@@ -695,7 +703,7 @@ step_status solver_newton(solver *sv, double q)
     rt_newton_par par = {sp->ns, sp->nr, sp->unit, sp->opt.tol, sp->ftol, sp->opt.min_rcond,
                          sp->opt.max_iter > 0 ? sp->opt.max_iter : 50, sp->aug ? 3 : 0};
     rt_newton_vec v = {sv->x, sv->f, sv->ft, sv->dx, sv->xt};
-    newton_ctx ctx = {sv, q};
+    newton_ctx ctx = {sv, q, shift};
     int st = rt_newton(&newton_ops, &ctx, &par, &v, &sv->resid, &sv->iters);
     return st == RT_NEWTON_CONVERGED ? STEP_OK
            : st == RT_NEWTON_SINGULAR ? STEP_SINGULAR : STEP_NO_ASSEMBLY;
@@ -737,6 +745,40 @@ void solver_rates(solver *sv)
     tape_run(t, reg, PHASE_ACCELERATION);
     for (int i = 0; i < sp->nr; i++)
         sv->ft[i] = reg[sp->areg[i]];
+    linear_solve(sv, sv->ft, sv->xqq);
+}
+
+void solver_rates_shifted(solver *sv, const double *vshift, const double *ashift)
+{
+    const solver_plan *sp = sv->p;
+    sv->generation++;
+    if (sp->ns == 0)
+        return;
+    const tape *t = &sp->tp;
+    double *reg = sv->reg;
+    solver_velocity_rhs(sv, sv->ft);  /* -f_q for qdot = 1 */
+    for (int i = 0; vshift && i < sp->nr; i++)
+        sv->ft[i] += vshift[i];
+    linear_solve(sv, sv->ft, sv->xq);
+    for (int i = 0; i < sp->ns; i++)
+        if (sp->xdreg[i] >= 0)
+            reg[sp->xdreg[i]] = sv->xq[i];
+    tape_set_var(t, reg, SYS_VAR_QDDOT(sp->n), 0.0);
+    tape_run(t, reg, PHASE_ACCELERATION);
+    for (int i = 0; i < sp->nr; i++)
+        sv->ft[i] = reg[sp->areg[i]] + (ashift ? ashift[i] : 0.0);
+    linear_solve(sv, sv->ft, sv->xqq);
+}
+
+void solver_accel_shifted(solver *sv, const double *ashift)
+{
+    const solver_plan *sp = sv->p;
+    sv->generation++;
+    if (sp->ns == 0)
+        return;
+    /* the acceleration phase's registers still hold this position's terms */
+    for (int i = 0; i < sp->nr; i++)
+        sv->ft[i] = sv->reg[sp->areg[i]] + (ashift ? ashift[i] : 0.0);
     linear_solve(sv, sv->ft, sv->xqq);
 }
 

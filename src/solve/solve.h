@@ -353,6 +353,18 @@ step_status solver_newton(solver *sv, double q);
 /* dx/dq and d2x/dq2 at the converged position (both always: the predictor
  * uses them). */
 void solver_rates(solver *sv);
+/* Free coordinates (mech simulate, docs/dynamics.md): Newton for
+ * f(x, q) = shift[0..nr-1] (the solved rows; a driver's row x_k - p_k(q)
+ * shifted by X_k - p_k(q) holds x_k at X_k), from sv->x. */
+step_status solver_newton_shifted(solver *sv, double q, const double *shift);
+/* After solver_newton_shifted, for the time as sweep variable (qdot 1,
+ * qddot 0): sv->xq := x' from J x' = -f_q + vshift, sv->xqq := x'' from
+ * J x'' = (the acceleration right-hand side at x') + ashift (NULL: 0);
+ * solver_publish(sv, t, 1, 0) then publishes them. */
+void solver_rates_shifted(solver *sv, const double *vshift, const double *ashift);
+/* x'' again for another ashift at the same position and velocities (after
+ * solver_rates_shifted; one solve). */
+void solver_accel_shifted(solver *sv, const double *ashift);
 /* Scatter x, and the rates for driver speed qd and acceleration qdd, into
  * pos, vel, acc and update the link frames. */
 void solver_publish(solver *sv, double q, double qd, double qdd);  /* again: no work */
@@ -539,6 +551,10 @@ typedef struct start_failure {
 
 /* Row 0 could not be found at q: why, reported; the kind reported. */
 mech_fail_kind diagnose_start(cont *c, double q, const start_failure *f);
+/* The two moving links pinned together most nearly in line at the published
+ * position, when the cosine of their angle is above cos_min: "arm1 and arm2
+ * extended in line" (or "folded"); "" when none is. */
+void diagnose_links_in_line(solver *sv, double cos_min, char *buf, size_t size);
 /* The owners of the rows that depend at the current (nearly singular)
  * factors, e.g. "loop 1 (A-B-C-D-A), gear pair 'g'"; "" when unknown (a
  * large system). */

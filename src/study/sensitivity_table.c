@@ -87,9 +87,10 @@ static int plan_columns(sens_plan *sp, const mech_table *t, sens_col *cols, int 
 }
 
 /* Every unknown's position and rates, per row: the same sweep with every
- * moving link and slider as outputs and no forces. */
-static int solve_states(const mech_model *m, const mech_solve_options *o, mech_table *x,
-                        mech_diag *d)
+ * moving link and slider as outputs and no forces (at the driver positions
+ * q[0..nq-1] when q is not NULL, else the options'). */
+static int solve_states(const mech_model *m, const mech_solve_options *o, const double *q,
+                        int nq, mech_table *x, mech_diag *d)
 {
     mech_outputs all = {0};
     all.links = xcalloc((size_t)m->nlinks + 1, sizeof *all.links);
@@ -112,7 +113,16 @@ static int solve_states(const mech_model *m, const mech_solve_options *o, mech_t
     o2.log = NULL;
     mech_diag quiet;
     mech_diag_init(&quiet);
-    int rc = mech_solve(m, &o2, x, NULL, &quiet);
+    int rc;
+    if (q) {
+        mech_analysis *a = NULL;
+        rc = mech_analysis_new(m, &o2, &a, &quiet);
+        if (rc == MECH_OK)
+            rc = mech_analysis_solve(a, q, nq, x, NULL, &quiet);
+        mech_analysis_free(&a);
+    } else {
+        rc = mech_solve(m, &o2, x, NULL, &quiet);
+    }
     mech_diag_free(&quiet);
     free(all.links);
     free(all.sliders);
@@ -274,9 +284,9 @@ static int find_params(const mech_model *m, const char *const *names, int nnames
 
 /* The sensitivities of t's kinematic columns by the parameters which[]:
  * *vals[(row * nnames + k) * nc + c] for column cols[c]. */
-static int sensitivities(const mech_model *m, const mech_solve_options *o, const int *which,
-                         int nnames, const mech_table *table, sens_col *cols, int *nc,
-                         double **vals, mech_diag *d)
+static int sensitivities(const mech_model *m, const mech_solve_options *o, const double *q,
+                         int nq, const int *which, int nnames, const mech_table *table,
+                         sens_col *cols, int *nc, double **vals, mech_diag *d)
 {
     sens_plan sp;
     mech_table x = {0};
@@ -289,7 +299,7 @@ static int sensitivities(const mech_model *m, const mech_solve_options *o, const
     if (rc == MECH_OK)
         rc = sens_plan_compile(&sp, d);
     if (rc == MECH_OK)
-        rc = solve_states(m, o, &x, d);
+        rc = solve_states(m, o, q, nq, &x, d);
     if (rc == MECH_OK &&
         !(*vals = xcalloc((size_t)table->nrows * nnames * *nc + 1, sizeof **vals)))
         rc = diag_nomem(d, m->file, (mech_mark){0, 0});
@@ -305,8 +315,9 @@ static int sensitivities(const mech_model *m, const mech_solve_options *o, const
 }
 
 static int sensitivity_columns(const mech_model *m, const mech_override *ov, int nov,
-                               const mech_solve_options *o, const char *const *names,
-                               int nnames, mech_table *table, mech_diag *d)
+                               const mech_solve_options *o, const double *q, int nq,
+                               const char *const *names, int nnames, mech_table *table,
+                               mech_diag *d)
 {
     int nc = 0, *which = xcalloc((size_t)nnames + 1, sizeof *which);
     sens_col *cols = xcalloc((size_t)table->ncolumns + 1, sizeof *cols);
@@ -315,7 +326,7 @@ static int sensitivity_columns(const mech_model *m, const mech_override *ov, int
     int rc = which && cols ? find_params(m, names, nnames, which, d)
                            : diag_nomem(d, m->file, (mech_mark){0, 0});
     if (rc == MECH_OK)
-        rc = sensitivities(m, o, which, nnames, table, cols, &nc, &vals, d);
+        rc = sensitivities(m, o, q, nq, which, nnames, table, cols, &nc, &vals, d);
     if (rc == MECH_OK && widen(table, m, which, nnames, cols, nc, vals) < 0)
         rc = diag_nomem(d, m->file, (mech_mark){0, 0});
     free(vals);
@@ -379,7 +390,7 @@ static int tolerance_columns(const mech_model *m, const mech_override *ov, int n
                              "tolerance (write one as r: {value: 40 mm, tolerance: 0.05 mm})");
     (void)ov, (void)nov;  /* the model holds its replacements' expressions already */
     if (rc == MECH_OK)
-        rc = sensitivities(m, o, which, np, table, cols, &nc, &vals, d);
+        rc = sensitivities(m, o, NULL, 0, which, np, table, cols, &nc, &vals, d);
     if (rc == MECH_OK && add_stackup(table, m, which, np, cols, nc, vals) < 0)
         rc = diag_nomem(d, m->file, (mech_mark){0, 0});
     free(vals);
@@ -417,7 +428,7 @@ int mech_sensitivity(const mech_model *m, const mech_override *ov, int nov,
     mech_diag own, *dd = api_diag(d, &own);
     int rc = check_arguments("mech_sensitivity", m, ov, nov, o, &full, names, nnames, table, dd);
     if (rc == MECH_OK)
-        rc = sensitivity_columns(m, ov, nov, &full, names, nnames, table, dd);
+        rc = sensitivity_columns(m, ov, nov, &full, NULL, 0, names, nnames, table, dd);
     api_diag_end(d, &own);
     return rc;
 }
@@ -432,4 +443,17 @@ int mech_tolerances(const mech_model *m, const mech_override *ov, int nov,
         rc = tolerance_columns(m, ov, nov, &full, table, dd);
     api_diag_end(d, &own);
     return rc;
+}
+
+int sens_table_at(const mech_model *m, const mech_solve_options *o, const double *q, int nq,
+                  const char *const *names, int nnames, mech_table *table, mech_diag *d)
+{
+    mech_analysis *a = NULL;
+    int rc = mech_analysis_new(m, o, &a, d);
+    if (rc == MECH_OK)
+        rc = mech_analysis_solve(a, q, nq, table, NULL, d);
+    mech_analysis_free(&a);
+    if (rc != MECH_OK)
+        return rc;
+    return sensitivity_columns(m, NULL, 0, o, q, nq, names, nnames, table, d);
 }

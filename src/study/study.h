@@ -222,6 +222,64 @@ int sens_plan_compile(sens_plan *sp, mech_diag *d);
  * the outputs' derivatives by parameter `param` (index into the plan's).
  * 0, or -1 when J is singular there. */
 int sens_row(sens_plan *sp, const double *state, int param, double *out);
+/* sensitivity_table.c: the table of m at the driver positions q[0..nq-1]
+ * (in order; mech_analysis_solve) with the columns d(COL)/d(NAME) of
+ * mech_sensitivity for the parameters names[0..nnames-1] (mech fit).
+ * MECH_OK; MECH_ESOLVE when a row is missing (the table holds the rows
+ * solved, without derivatives); or an error in d. */
+int sens_table_at(const mech_model *m, const mech_solve_options *o, const double *q, int nq,
+                  const char *const *names, int nnames, mech_table *table, mech_diag *d);
+
+/* ==== fit ==== */
+/* fit.c: the least-squares problem of mech fit (docs/synthesis.md):
+ * residuals r[i ncols + j] = weight[j] (y_j(p; q_i) - target[i][j]) of the
+ * solved position columns cols[] at the driver positions q[] (an angle's
+ * difference taken in (-pi, pi]; a NaN target contributes 0), the free
+ * parameters p = the file's parameters names[], and the exact Jacobian
+ * from the sensitivities. Each evaluation loads the file with the
+ * parameters replaced (mech_load_file_with) and solves the targets' rows
+ * in order (continuation from one to the next). */
+typedef struct fit_problem {
+    const char *path;          /* the mechanism file, borrowed */
+    int nfree;
+    const char **names;        /* [nfree] free parameters, borrowed */
+    char (*unit)[32];          /* [nfree] their SI units (fit_prepare) */
+    mech_mark *mark;           /* [nfree] their keys in the file (fit_prepare) */
+    int nq;                    /* target rows */
+    const double *q;           /* [nq] driver positions, SI, in sweep order */
+    int ncols;
+    const char **cols;         /* [ncols] target columns ("P.x"), borrowed */
+    char (*col_unit)[16];      /* [ncols] their SI units (fit_prepare) */
+    char qunit[16];            /* the driver's SI unit (fit_prepare) */
+    const double *target;      /* [nq * ncols] SI, row-major; NaN: none */
+    const double *weight;      /* [ncols] or NULL (all 1) */
+    char *outputs;             /* the objects the columns need, "P,rocker"; owned */
+    long nsolves;              /* evaluations so far */
+    int free_timing;           /* 1: the driver positions are unknowns too, p[nfree + i]
+                                  (q is then only the start); dr/dq from the rates */
+} fit_problem;
+
+/* The unknowns of the problem: the free parameters, and with free timing
+ * one driver position per target row. */
+static inline int fit_nvars(const fit_problem *fp)
+{
+    return fp->nfree + (fp->free_timing ? fp->nq : 0);
+}
+
+/* Load and check the file, find the free parameters (their values into
+ * p0[nfree], units and marks into fp) and the columns (their units):
+ * MECH_OK, or an error in d naming the unknown parameter or column. */
+int fit_prepare(fit_problem *fp, double *p0, mech_diag *d);
+/* r[nq ncols] at p[fit_nvars] and, when jac is not NULL, dr/dp into
+ * jac[k * nq ncols + row] (column-major, MINPACK's layout). MECH_OK;
+ * MECH_ESOLVE (nothing in d) when the mechanism does not assemble at
+ * every target; MECH_ENOMEM. */
+int fit_eval(fit_problem *fp, const double *p, double *r, double *jac, mech_diag *d);
+/* The constraint whole-range: MECH_OK when the mechanism at p assembles at
+ * every row of the file's own driver range (a crank from 0 to 360 deg: it
+ * turns fully), else MECH_ESOLVE (nothing in d); one solve. */
+int fit_check_range(fit_problem *fp, const double *p, mech_diag *d);
+void fit_problem_free(fit_problem *fp);
 
 /* ==== flywheel ==== */
 /* flywheel.c: flywheel sizing from the driver torque over one cycle

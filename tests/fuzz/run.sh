@@ -7,7 +7,9 @@
 #
 # Environment: FUZZ_BUILD (default build/fuzz) holds the binary, the corpus
 # and any crash-* / leak-* / timeout-* / oom-* artifacts; FUZZ_SECONDS;
-# FUZZ_JOBS (parallel fuzzing processes, default 1); CC_FUZZ (default clang).
+# FUZZ_JOBS (parallel fuzzing processes, default 1); CC_FUZZ (default clang);
+# FUZZ_LIBS, libraries the library sources need beyond libyaml and KLU (the
+# Makefile passes SUNDIALS's, for src/study/simulate.c).
 # Exits non-zero when the target crashes, leaks, times out or runs out of
 # memory on some input (libFuzzer writes it to FUZZ_BUILD/artifacts/).
 # Run from the repository root; needs clang with libFuzzer (Debian: clang).
@@ -31,7 +33,7 @@ $cc -g -O1 -std=c11 -D_POSIX_C_SOURCE=200809L -pthread \
     -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all \
     -Iinclude $src_inc -I/usr/include/suitesparse \
     $lib_src "$out/rt_text.c" tests/fuzz/fuzz_load.c -o "$bin" \
-    -lyaml -lklu -lbtf -lamd -lcolamd -lsuitesparseconfig -lm -pthread
+    -lyaml -lklu -lbtf -lamd -lcolamd -lsuitesparseconfig ${FUZZ_LIBS:-} -lm -pthread
 
 # -rss_limit_mb: a file must not make the loader use gigabytes; -timeout: nor
 # take seconds (the target solves only small mechanisms).
@@ -51,7 +53,7 @@ fi
 
 # Seed corpus: the examples, the malformed corpus, the solver cases, the
 # drawn-form files and every input that once crashed.
-for f in mechanisms/*.yaml tests/bad/*.yaml tests/solve/*.yaml tests/drawn/*.yaml $regressions; do
+for f in mechanisms/*.yaml tests/bad/*.yaml tests/solve/*.yaml tests/drawn/*.yaml tests/dynamics/*.yaml tests/fit/*.yaml $regressions; do
     [ -f "$f" ] && cp "$f" "$out/corpus/seed-$(basename "$f")"
 done
 # -fork=N runs N fuzzing processes; the first crash still stops the run.

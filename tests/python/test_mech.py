@@ -314,3 +314,30 @@ def test_gears_and_laws_of_time_in_the_model():
     assert r.columns[0] == 't'
     # the driven angle follows its law (rad, t in s)
     assert r['crank1.angle'] == pytest.approx(math.radians(90) + 2 * math.pi * r['t'], abs=1e-12)
+
+
+def test_simulate_equals_the_cli_and_keeps_energy():
+    """mech.simulate (docs/dynamics.md): the same doubles as `mech simulate`'s
+    CSV; the pendulum's energy kept; a file without a free driver refused."""
+    path = 'tests/dynamics/pendulum.yaml'
+    r = mech.simulate(path, to=1.0, step=0.01, rtol=1e-10, atol=1e-12)
+    out = subprocess.run([MECH, 'simulate', path, '--to', '1', '--step', '0.01', '--rtol',
+                          '1e-10', '--atol', '1e-12'], check=True, capture_output=True,
+                         text=True).stdout.splitlines()
+    names = [h[:h.index(' [')] for h in out[0].split(',')]
+    assert r.columns == names
+    assert r.nrows == 101 == len(out) - 1
+    data = np.array([[float(x) for x in l.split(',')] for l in out[1:]])
+    for i, n in enumerate(names):
+        assert_bits_equal(r[n], data[:, i], n)
+    assert np.max(np.abs(r['energy.balance'])) < 1e-8 * np.max(np.abs(r['energy.gravity']))
+    assert r.stats['steps'] > 0 and r.stats['stop_time'] == 1.0
+    with pytest.raises(mech.MechError):
+        mech.simulate('mechanisms/fourbar.yaml')
+    with pytest.raises(ValueError):
+        mech.simulate(path, method='rk4')
+    # the events: at rest half a period after release, at the vertical a quarter
+    h = mech.simulate(path, stop_at_rest=True, rtol=1e-10, atol=1e-12)
+    q = mech.simulate(path, stop_when='bar.angle=-90', rtol=1e-10, atol=1e-12)
+    assert abs(h['t'][-1] - 2 * q['t'][-1]) < 1e-7
+    assert abs(q['bar.angle'][-1] + math.pi / 2) < 1e-9

@@ -1,0 +1,157 @@
+/* tests/unit/test_fit.c: mech fit's problem (src/study/fit.c) and its local
+ * solver (src/cli/cmd_fit_lm.c) against independent truths, on
+ * tests/fit/fourbar.yaml. (1) The Jacobian fit_eval gives (from the
+ * sensitivities) against central differences of the residuals themselves
+ * (each a whole solve with the parameter replaced), relative step 1e-5:
+ * the difference's truncation error is about h^2 |y'''| and its rounding
+ * Newton's 1e-12 of 70 mm over 2 h, both below 1e-6 of the column's
+ * scale; agreement asked to 1e-5 of the largest derivative of the column.
+ * (2) Recovery: targets solved at known parameters, the fit from 10 %
+ * off (bounded and unbounded) must give them back to 1e-9 relative. */
+#include <criterion/criterion.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "helpers.h"
+#include "base.h"
+#include "study.h"
+#include "cli.h"
+
+#define NQ 8
+#define NC 3
+#define NF 4
+
+static const char *const names[NF] = {"r", "l", "b", "phi"};
+static const char *const cols[NC] = {"P.x", "P.y", "rocker.angle"};
+static char units[NF][32];
+static mech_mark marks[NF];
+static char col_units[NC][16];
+static double qs[NQ], targets[NQ * NC];
+
+/* The problem on the fixture, targets 0 (the residuals are then the solved
+ * values themselves), p0 the file's values. */
+static fit_problem problem(double *p0, int timing)
+{
+    fit_problem fp = {0};
+    fp.free_timing = timing;
+    fp.path = "tests/fit/fourbar.yaml";
+    fp.nfree = NF;
+    fp.names = (const char **)names;
+    fp.unit = units;
+    fp.mark = marks;
+    fp.nq = NQ;
+    for (int i = 0; i < NQ; i++)
+        qs[i] = i * 45.0 * 3.14159265358979323846 / 180.0;
+    fp.q = qs;
+    fp.ncols = NC;
+    fp.cols = (const char **)cols;
+    fp.col_unit = col_units;
+    memset(targets, 0, sizeof targets);
+    fp.target = targets;
+    mech_diag d;
+    mech_diag_init(&d);
+    int rc = fit_prepare(&fp, p0, &d);
+    mech_diag_print(&d, stderr);
+    mech_diag_free(&d);
+    cr_assert_eq(rc, MECH_OK, "fit_prepare");
+    return fp;
+}
+
+Test(fit, jacobian_against_central_differences)
+{
+    double p0[NF], r[NQ * NC], jac[NQ * NC * NF], rp[NQ * NC], rm[NQ * NC];
+    fit_problem fp = problem(p0, 0);
+    mech_diag d;
+    mech_diag_init(&d);
+    cr_assert_eq(fit_eval(&fp, p0, r, jac, &d), MECH_OK);
+    for (int k = 0; k < NF; k++) {
+        double p[NF];
+        memcpy(p, p0, sizeof p);
+        double h = 1e-5 * fabs(p0[k]);
+        p[k] = p0[k] + h;
+        cr_assert_eq(fit_eval(&fp, p, rp, NULL, &d), MECH_OK);
+        p[k] = p0[k] - h;
+        cr_assert_eq(fit_eval(&fp, p, rm, NULL, &d), MECH_OK);
+        for (int j = 0; j < NC; j++) {
+            double scale = 0.0;
+            for (int i = 0; i < NQ; i++)
+                scale = fmax(scale, fabs(jac[k * NQ * NC + i * NC + j]));
+            for (int i = 0; i < NQ; i++) {
+                double exact = jac[k * NQ * NC + i * NC + j];
+                double fd = (rp[i * NC + j] - rm[i * NC + j]) / (2.0 * h);
+                cr_expect(fabs(exact - fd) <= 1e-5 * scale + 1e-12,
+                          "d(%s)/d(%s) at q = %g deg: exact %.12g, central difference %.12g",
+                          cols[j], names[k], qs[i] * 180 / 3.14159265358979323846, exact, fd);
+            }
+        }
+    }
+    cr_expect_eq(fp.nsolves, 1 + 2 * NF);
+    mech_diag_free(&d);
+    fit_problem_free(&fp);
+}
+
+static void recover(int bounded)
+{
+    double p0[NF], truth[NF], r[NQ * NC];
+    fit_problem fp = problem(p0, 0);
+    mech_diag d;
+    mech_diag_init(&d);
+    memcpy(truth, p0, sizeof truth);
+    cr_assert_eq(fit_eval(&fp, truth, targets, NULL, &d), MECH_OK);  /* y(truth) */
+    double lo[NF], hi[NF], p[NF];
+    for (int k = 0; k < NF; k++) {
+        lo[k] = bounded ? 0.7 * truth[k] : -INFINITY;
+        hi[k] = bounded ? 1.2 * truth[k] : INFINITY;
+        p[k] = truth[k] * (k % 2 ? 0.9 : 1.1);
+    }
+    double obj = -1.0;
+    int info = 0;
+    cr_assert_eq(fit_lm(&fp, lo, hi, p, r, &obj, &info), MECH_OK);
+    for (int k = 0; k < NF; k++)
+        cr_expect(fabs(p[k] - truth[k]) <= 1e-9 * fabs(truth[k]), "%s: %.15g, expected %.15g",
+                  names[k], p[k], truth[k]);
+    cr_expect(obj >= 0.0 && obj < 1e-24, "objective %g", obj);
+    cr_expect(info >= 1 && info <= 4, "lmder's info %d: converged", info);
+    mech_diag_free(&d);
+    fit_problem_free(&fp);
+}
+
+Test(fit, recovery_unbounded) { recover(0); }
+Test(fit, recovery_bounded) { recover(1); }
+
+/* Free timing: dr/dq_i (from the rates: dy/dq = (dy/dt) / (dq/dt)) against
+ * central differences, relative step 1e-6 of a radian, on each row; the
+ * other rows' residuals do not move (checked: 0 in the Jacobian). */
+Test(fit, timing_jacobian_against_central_differences)
+{
+    enum { NV = NF + NQ };
+    double p[NV], r[NQ * NC], jac[NQ * NC * NV], rp[NQ * NC], rm[NQ * NC];
+    fit_problem fp = problem(p, 1);
+    cr_assert_eq(fit_nvars(&fp), NV);
+    for (int i = 0; i < NQ; i++)
+        p[NF + i] = qs[i] + 0.1;  /* off the file's rows */
+    mech_diag d;
+    mech_diag_init(&d);
+    cr_assert_eq(fit_eval(&fp, p, r, jac, &d), MECH_OK);
+    for (int i = 0; i < NQ; i++) {
+        double pp[NV], h = 1e-6;
+        memcpy(pp, p, sizeof pp);
+        pp[NF + i] = p[NF + i] + h;
+        cr_assert_eq(fit_eval(&fp, pp, rp, NULL, &d), MECH_OK);
+        pp[NF + i] = p[NF + i] - h;
+        cr_assert_eq(fit_eval(&fp, pp, rm, NULL, &d), MECH_OK);
+        for (int row = 0; row < NQ * NC; row++) {
+            double exact = jac[(NF + i) * NQ * NC + row];
+            double fd = (rp[row] - rm[row]) / (2.0 * h);
+            cr_expect(fabs(exact - fd) <= 1e-6 * (fabs(exact) + 0.01),
+                      "d(row %d)/d(q_%d): exact %.12g, central difference %.12g", row, i, exact,
+                      fd);
+            if (row / NC != i)
+                cr_expect_eq(exact, 0.0);
+        }
+    }
+    mech_diag_free(&d);
+    fit_problem_free(&fp);
+}
