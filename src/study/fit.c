@@ -148,19 +148,18 @@ static double difference(const char *unit, double y, double t)
     return strcmp(unit, "rad") == 0 ? remainder(e, 6.283185307179586476925) : e;
 }
 
-int fit_eval(fit_problem *fp, const double *p, double *r, double *jac, mech_diag *d)
+/* The file loaded and checked with the free parameters at p (as overrides
+ * of their values, in their file units); counts a solve. */
+static int load_at(fit_problem *fp, const double *p, mech_model **m, mech_diag *quiet,
+                   mech_diag *d)
 {
-    int n = fp->nfree, mrows = fp->nq * fp->ncols, rc;
+    int n = fp->nfree, rc;
     mech_override *ov = xcalloc((size_t)n + 1, sizeof *ov);
     char (*text)[64] = xcalloc((size_t)n + 1, sizeof *text);
-    mech_model *m = NULL;
-    mech_outputs outs = {0};
-    mech_table t = {0};
-    mech_diag quiet;
-    mech_diag_init(&quiet);
     if (!ov || !text) {
-        rc = diag_nomem(d, fp->path, (mech_mark){0, 0});
-        goto done;
+        free(ov);
+        free(text);
+        return diag_nomem(d, fp->path, (mech_mark){0, 0});
     }
     for (int k = 0; k < n; k++) {
         snprintf(text[k], sizeof text[k], "%.17g%s%s", p[k], fp->unit[k][0] ? " " : "",
@@ -168,10 +167,24 @@ int fit_eval(fit_problem *fp, const double *p, double *r, double *jac, mech_diag
         ov[k] = (mech_override){fp->names[k], text[k]};
     }
     fp->nsolves++;
-    rc = mech_load_file_with(fp->path, ov, n, &m, &quiet);
+    rc = mech_load_file_with(fp->path, ov, n, m, quiet);
     mech_summary s;
     if (rc == MECH_OK)
-        rc = mech_check(m, &s, &quiet);
+        rc = mech_check(*m, &s, quiet);
+    free(ov);
+    free(text);
+    return rc;
+}
+
+int fit_eval(fit_problem *fp, const double *p, double *r, double *jac, mech_diag *d)
+{
+    int n = fp->nfree, mrows = fp->nq * fp->ncols;
+    mech_model *m = NULL;
+    mech_outputs outs = {0};
+    mech_table t = {0};
+    mech_diag quiet;
+    mech_diag_init(&quiet);
+    int rc = load_at(fp, p, &m, &quiet, d);
     mech_solve_options o;
     if (rc == MECH_OK)
         rc = eval_options(fp, m, &outs, &o, &quiet);
@@ -224,48 +237,28 @@ done:
     mech_table_free(&t);
     mech_outputs_free(&outs);
     mech_model_free(&m);
-    free(ov);
-    free(text);
     return rc;
 }
 
 int fit_check_range(fit_problem *fp, const double *p, mech_diag *d)
 {
-    int n = fp->nfree, rc;
-    mech_override *ov = xcalloc((size_t)n + 1, sizeof *ov);
-    char (*text)[64] = xcalloc((size_t)n + 1, sizeof *text);
     mech_model *m = NULL;
     mech_table t = {0};
     mech_diag quiet;
     mech_diag_init(&quiet);
-    if (!ov || !text) {
-        rc = diag_nomem(d, fp->path, (mech_mark){0, 0});
-        goto done;
-    }
-    for (int k = 0; k < n; k++) {
-        snprintf(text[k], sizeof text[k], "%.17g%s%s", p[k], fp->unit[k][0] ? " " : "",
-                 fp->unit[k]);
-        ov[k] = (mech_override){fp->names[k], text[k]};
-    }
-    fp->nsolves++;
-    mech_summary s;
-    mech_solve_options o;
-    mech_solve_options_default(&o);
-    o.want = MECH_WANT_POSITION;
-    o.forces = -1;
-    rc = mech_load_file_with(fp->path, ov, n, &m, &quiet);
-    if (rc == MECH_OK)
-        rc = mech_check(m, &s, &quiet);
-    if (rc == MECH_OK)
+    int rc = load_at(fp, p, &m, &quiet, d);
+    if (rc == MECH_OK) {
+        mech_solve_options o;
+        mech_solve_options_default(&o);
+        o.want = MECH_WANT_POSITION;
+        o.forces = -1;
         rc = mech_solve(m, &o, &t, NULL, &quiet);
+    }
     if (rc != MECH_OK)
         rc = rc == MECH_ENOMEM ? diag_nomem(d, fp->path, (mech_mark){0, 0}) : MECH_ESOLVE;
-done:
     mech_diag_free(&quiet);
     mech_table_free(&t);
     mech_model_free(&m);
-    free(ov);
-    free(text);
     return rc;
 }
 
