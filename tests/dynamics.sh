@@ -16,7 +16,9 @@
 #      close it too;
 #   4. a free crank under a stiff speed controller (a load of its own
 #      omega) reproduces the torque `mech solve --forces` gives the same
-#      crank at that constant speed;
+#      crank at that constant speed; and that torque (checked against its
+#      closed form), fed back as a load of time, holds the crank at the
+#      constant speed to the integration's tolerance;
 #   5. the shaper run up from rest by a motor law with the flywheel `mech
 #      solve --speed-fluctuation 0.02` sizes: the simulated steady speed
 #      fluctuation against that 0.02 (the sizing is an estimate: 10 %);
@@ -175,6 +177,37 @@ if run "speed controller: simulate" 0 "$MECH" simulate "$tmp/ctl.yaml" --to 0.3s
     # against the torque that holds 20 rad/s, to 1e-3 of the largest
     within "speed controller: torque" "$(paste -d, "$tmp/ctl.csv" "$tmp/law.csv" | awk -F, -v w="$w" -v t="$((n + tq))" 'NR > 2 { d = -1000 * ($w - 20) - $t; if (d < 0) d = -d; if (d > e) e = d; a = $t < 0 ? -$t : $t; if (a > m) m = a } END { print e / m }')" 1e-3
 fi
+
+# ---- 4b. mech solve's torque fed back as a load of time keeps the speed -----
+
+# constant-speed.yaml: the crank's load is the torque m w^2 x'(q) x''(q) at
+# q = q0 + w t. First the truth of that torque: mech solve --forces with the
+# crank's law q0 + w t gives it to rounding; then, fed back, it holds the free
+# crank at w from q0 (the dynamics about that motion are not damped: errors
+# of the integration stay, they are not forgotten) - BDF and Adams, at the
+# default tolerances, at rtol 1e-10 and with atol 1e-14 (where CVODE's own
+# difference-quotient Jacobian let BDF drift 1e-3).
+sed -e 's/^    free: true$/    angle: "q0 + w * t"/' -e '/^    initial: {value: q0/d' -e '/^    # mp (w/,/^outputs:/{/^outputs:/!d;}' \
+    $D/constant-speed.yaml >"$tmp/cslaw.yaml"
+if run "constant speed: mech solve" 0 "$MECH" solve "$tmp/cslaw.yaml" --forces -o "$tmp/cslaw.csv"; then
+    within "constant speed: mech solve's torque against m w^2 x' x''" "$(awk -F, -v c="$(col "$tmp/cslaw.csv" crank.torque)" 'NR > 1 {
+            q = 0.523598775598298873 + 20 * $1; r = 0.04; l = 0.14; s = sin(q); k = cos(q)
+            D = sqrt(l * l - r * r * s * s)
+            xp = -r * s - r * r * s * k / D
+            xpp = -r * k - r * r * (k * k - s * s) / D - r ^ 4 * s * s * k * k / D ^ 3
+            T = 0.5 * 400 * xp * xpp; d = T - $c; if (d < 0) d = -d; if (d > e) e = d
+            a = T < 0 ? -T : T; if (a > m) m = a }
+        END { printf "%.3g\n", (NR > 50 && m > 0.1) ? e / m : 1 }' "$tmp/cslaw.csv")" 1e-13
+fi
+for opts in "--method bdf" "--method adams" "--method bdf --rtol 1e-10" "--method bdf --rtol 1e-8 --atol 1e-14" "--method adams --rtol 1e-10 --atol 1e-12"; do
+    if run "constant speed: simulate $opts" 0 "$MECH" simulate $D/constant-speed.yaml $opts -o "$tmp/cs.csv"; then
+        r=$(echo "$opts" | sed -n 's/.*--rtol \([^ ]*\).*/\1/p')
+        within "constant speed ($opts): crank.omega against 20 rad/s" "$(awk -F, -v w="$(col "$tmp/cs.csv" crank.omega)" -v a="$(col "$tmp/cs.csv" crank.angle)" 'NR > 1 {
+                d = ($w - 20) / 20; if (d < 0) d = -d; if (d > e) e = d
+                d = $a - (0.523598775598298873 + 20 * $1); if (d < 0) d = -d; if (d > e) e = d }
+            END { printf "%.3g\n", NR == 102 ? e : 1 }' "$tmp/cs.csv")" "$(awk -v r="${r:-1e-8}" 'BEGIN { print 100 * r }')"
+    fi
+done
 
 # ---- 5. the shaper run up by a motor, with the flywheel sized for Cs = 0.02 --
 

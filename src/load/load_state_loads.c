@@ -32,10 +32,12 @@ static const dim NONE = {{0, 0, 0, 0}};
 
 /* With laws of time (`sweep: {time}`, MECH_DRIVE_TIME) a load may read the
  * time as `t`, as the drivers' laws do: the word `t` is then the time, never
- * the tonne. Where the first standalone word `t` starts in s, or NULL. */
+ * the tonne. Where the first standalone word `t` starts in s, or NULL.
+ * The sweep's kind is set before the drivers are read (has_driver only
+ * after), so a free driver's `load:` sees `t` too. */
 static const char *time_word(const loader *ld, const char *s)
 {
-    if (!ld->m->has_driver || ld->m->driver.kind != MECH_DRIVE_TIME)
+    if (ld->m->driver.kind != MECH_DRIVE_TIME)
         return NULL;
     for (const char *c = s; *c; c++) {
         int before = c > s && (isalnum((unsigned char)c[-1]) || c[-1] == '_' || c[-1] == '.');

@@ -13,6 +13,7 @@
  * tau0. SUNDIALS CVODE integrates [X, W] and the work of the loads, the
  * prescribed drivers and the dampers. Every workspace is allocated once
  * before the integration. */
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -241,6 +242,40 @@ static int rhs(sunrealtype t, N_Vector y, N_Vector ydot, void *user)
     D[2 * s->nf] = s->p_loads;
     D[2 * s->nf + 1] = s->p_drivers;
     D[2 * s->nf + 2] = s->p_dampers;
+    return 0;
+}
+
+/* The Jacobian of rhs by forward differences, for CVODE's Newton. Not
+ * CVODE's own difference quotients: those step a component by about
+ * atol x h x |f| where it is 0 (the works at the start), far below the
+ * rounding of a right-hand side that a Newton solve computes, so its
+ * columns were noise times 1e20 and BDF accepted wrong steps (a crank held
+ * at constant speed drifted 1e-3 at rtol 1e-8, atol 1e-14). Here a free
+ * coordinate or rate steps by sqrt(eps) of its size (at least 1 SI unit:
+ * the Newton solve's rounding is far below), and the works' columns are 0
+ * exactly: no right-hand side reads them. */
+static int jacobian(sunrealtype t, N_Vector y, N_Vector fy, SUNMatrix J, void *user,
+                    N_Vector tmp1, N_Vector tmp2, N_Vector tmp3)
+{
+    (void)tmp3;
+    sim *s = user;
+    int n = (int)N_VGetLength(y), nx = 2 * s->nf;
+    const double *F = N_VGetArrayPointer(fy);
+    double *Yp = N_VGetArrayPointer(tmp1), *Fp = N_VGetArrayPointer(tmp2);
+    memcpy(Yp, N_VGetArrayPointer(y), (size_t)n * sizeof *Yp);
+    SUNMatZero(J);
+    for (int j = 0; j < nx; j++) {
+        double keep = Yp[j], inc = sqrt(DBL_EPSILON) * fmax(fabs(keep), 1.0);
+        Yp[j] = keep + inc;
+        inc = Yp[j] - keep;  /* the step the rounding made */
+        int rc = rhs(t, tmp1, tmp2, user);
+        Yp[j] = keep;
+        if (rc != 0)
+            return rc;
+        double *col = SUNDenseMatrix_Column(J, j);
+        for (int i = 0; i < n; i++)
+            col[i] = (Fp[i] - F[i]) / inc;
+    }
     return 0;
 }
 
@@ -553,7 +588,8 @@ static int integrate(sim *s, const mech_simulate_options *o, double t0, double t
     out->values[(size_t)(out->ncolumns) - 1] = 0.0;
     s->det_sign = solver_det_sign(&s->sv);
     if (CVodeInit(cv, rhs, t0, y) != CV_SUCCESS || CVodeSStolerances(cv, o->rtol, o->atol) ||
-        CVodeSetLinearSolver(cv, LS, J) || CVodeSetUserData(cv, s) ||
+        CVodeSetLinearSolver(cv, LS, J) || CVodeSetJacFn(cv, jacobian) ||
+        CVodeSetUserData(cv, s) ||
         CVodeSetMaxNumSteps(cv, o->max_steps) || CVodeSetStopTime(cv, t1)) {
         rc = diag_error(s->d, m->file, m->driver.mark, "CVODE could not be set up");
         goto done;
