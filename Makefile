@@ -349,6 +349,11 @@ golden: all
 	    echo "$(BUILD)/mech solve $$f -o tests/golden/$$n.csv"; \
 	    $(BUILD)/mech solve $$f -o tests/golden/$$n.csv || exit 1; \
 	done
+	@for f in mechanisms/dynamics/*.yaml; do \
+	    n=$$(basename $$f .yaml); \
+	    echo "$(BUILD)/mech simulate $$f --rtol 1e-12 --atol 1e-14 -o tests/golden/dynamics/$$n.csv"; \
+	    $(BUILD)/mech simulate $$f --rtol 1e-12 --atol 1e-14 -o tests/golden/dynamics/$$n.csv || exit 1; \
+	done
 
 install: all $(if $(filter 1,$(WITH_PYTHON)),python)
 	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib/pkgconfig \

@@ -35,4 +35,4 @@ one() {  # FILE COLUMN TO: the table of one example
     echo "  one evaluation $per us (positions, rates, mass matrix, forces); one kinematic row with forces of mech solve $kin us"
 }
 one tests/dynamics/pendulum.yaml bar.angle 5
-one tests/dynamics/fourbar-gravity.yaml crank.angle 2
+one mechanisms/dynamics/pendulum-fourbar.yaml crank.angle 2

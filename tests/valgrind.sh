@@ -49,7 +49,7 @@ check "mech draw (a guessed pose)" draw mechanisms/fourbar.yaml --frame 30 -o "$
 check "mech check --draw" check mechanisms/offset-slider-crank.yaml --draw "$tmp/d.svg"
 check "mech draw, no assembly" draw tests/hard/non-grashof-crank.yaml --at 180 -o "$tmp/d.svg"
 check "mech simulate (BDF)" simulate tests/dynamics/pendulum.yaml --to 1 --step 0.05 -o "$tmp/sim.csv"
-check "mech simulate (two free cranks, Adams)" simulate tests/dynamics/five-bar-free.yaml --to 0.5 --method adams -o "$tmp/sim.csv"
+check "mech simulate (two free cranks, Adams)" simulate mechanisms/dynamics/five-bar-free.yaml --to 0.5 --method adams -o "$tmp/sim.csv"
 check "mech simulate --stop-at-rest" simulate tests/dynamics/pendulum.yaml --stop-at-rest -o "$tmp/sim.csv"
 "$MECH" solve tests/fit/fourbar.yaml --from 0 --to 330 --steps 11 --outputs P --level positions \
     --units file -o "$tmp/all.csv" && cut -d, -f1-3 "$tmp/all.csv" >"$tmp/path.csv"
