@@ -20,6 +20,7 @@
 
 #include <cvode/cvode.h>
 #include <nvector/nvector_serial.h>
+#include <sundials/sundials_dense.h>
 #include <sunlinsol/sunlinsol_dense.h>
 #include <sunmatrix/sunmatrix_dense.h>
 
@@ -46,7 +47,8 @@ typedef struct sim {
     int *fdrv, *frow;      /* [nf] their driver and its solved row */
     double *shift, *vshift, *ashift; /* [nr] */
     double *M, *tau0, *A;  /* [nf nf], [nf], [nf] */
-    int *piv;
+    double **Mcol;         /* [nf] M's columns, for SUNDIALS' dense LU */
+    sunindextype *piv;
     double p_loads, p_drivers, p_dampers; /* powers at the last evaluation */
     double kinetic, gravity, springs;
     double worst_load;     /* largest |free driver load| at the output rows, N*m or N */
@@ -91,44 +93,22 @@ static int free_loads(sim *s, double *tau)
     return 0;
 }
 
-/* Solve M A = b in place (b := A), Gaussian elimination with partial
- * pivoting on a copy kept in s->M's storage; -1 when singular. */
+/* Solve M A = b in place (b := A) by SUNDIALS' dense LU with partial
+ * pivoting (M column-major, factored in its own storage); -1 when a pivot
+ * is below 1e-13 of M's largest entry: the mass matrix is singular there
+ * (a dead point of the free coordinates). */
 static int solve_small(sim *s, double *b)
 {
     int n = s->nf;
-    double *a = s->M, big = 0.0;
+    double big = 0.0;
     for (int i = 0; i < n * n; i++)
-        big = fmax(big, fabs(a[i]));
-    for (int c = 0; c < n; c++) {
-        int p = c;
-        for (int r = c + 1; r < n; r++)
-            if (fabs(a[r * n + c]) > fabs(a[p * n + c]))
-                p = r;
-        if (!(fabs(a[p * n + c]) > 1e-13 * big))
+        big = fmax(big, fabs(s->M[i]));
+    if (SUNDlsMat_denseGETRF(s->Mcol, n, n, s->piv) != 0)
+        return -1;
+    for (int k = 0; k < n; k++)
+        if (!(fabs(s->Mcol[k][k]) > 1e-13 * big))
             return -1;
-        if (p != c) {
-            for (int j = 0; j < n; j++) {
-                double w = a[c * n + j];
-                a[c * n + j] = a[p * n + j];
-                a[p * n + j] = w;
-            }
-            double w = b[c];
-            b[c] = b[p];
-            b[p] = w;
-        }
-        for (int r = c + 1; r < n; r++) {
-            double f = a[r * n + c] / a[c * n + c];
-            for (int j = c; j < n; j++)
-                a[r * n + j] -= f * a[c * n + j];
-            b[r] -= f * b[c];
-        }
-    }
-    for (int c = n - 1; c >= 0; c--) {
-        double v = b[c];
-        for (int j = c + 1; j < n; j++)
-            v -= a[c * n + j] * b[j];
-        b[c] = v / a[c * n + c];
-    }
+    SUNDlsMat_denseGETRS(s->Mcol, n, s->piv, b);
     return 0;
 }
 
@@ -208,7 +188,7 @@ static int evaluate_state(sim *s, double t, const double *X, const double *W)
         if (free_loads(s, col) != 0)
             return -1;
         for (int i = 0; i < s->nf; i++)
-            s->M[i * s->nf + j] = col[i] - s->tau0[i];
+            s->M[j * s->nf + i] = col[i] - s->tau0[i];  /* column-major */
         s->ashift[r] -= 1.0;
     }
     for (int i = 0; i < s->nf; i++)
@@ -319,7 +299,7 @@ static void sim_free(sim *s)
     if (s->have_sp)
         solver_plan_free(&s->sp);
     void *blocks[] = {s->fdrv, s->frow, s->shift, s->vshift, s->ashift, s->M, s->tau0, s->A,
-                      s->piv};
+                      s->piv, s->Mcol};
     for (size_t i = 0; i < sizeof blocks / sizeof *blocks; i++)
         free(blocks[i]);
 }
@@ -360,11 +340,14 @@ static int sim_setup(sim *s, const mech_model *m, mech_diag *d)
     s->fdrv = xcalloc((size_t)nf, sizeof *s->fdrv);
     s->frow = xcalloc((size_t)nf, sizeof *s->frow);
     s->piv = xcalloc((size_t)nf, sizeof *s->piv);
+    s->Mcol = xcalloc((size_t)nf, sizeof *s->Mcol);
     double **arrays[] = {&s->shift, &s->vshift, &s->ashift, &s->M, &s->tau0, &s->A};
     size_t sizes[] = {(size_t)nr + 1, (size_t)nr + 1, (size_t)nr + 1, (size_t)(nf * nf),
                       (size_t)nf, (size_t)nf};
-    if (!s->fdrv || !s->frow || !s->piv || xcalloc_doubles(arrays, sizes, 0, 6) < 0)
+    if (!s->fdrv || !s->frow || !s->piv || !s->Mcol || xcalloc_doubles(arrays, sizes, 0, 6) < 0)
         return diag_nomem(d, m->file, m->driver.mark);
+    for (int j = 0; j < nf; j++)
+        s->Mcol[j] = s->M + (size_t)j * (size_t)nf;
     const mech_system *sys = s->sp.sys;
     for (int k = 0; k < nf; k++) {
         s->fdrv[k] = m->free_drivers->d[k].driver;
