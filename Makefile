@@ -34,6 +34,10 @@ CRIT_LIBS   := $(shell pkg-config --libs criterion 2>/dev/null || echo -lcriteri
 # no static libcminpack.a for a `pkg-config --static` link of the library.
 MINPACK_CFLAGS := $(shell pkg-config --cflags cminpack 2>/dev/null || echo -I/usr/include/cminpack-1)
 MINPACK_LIBS   := $(shell pkg-config --libs cminpack 2>/dev/null || echo -lcminpack)
+# NLopt (libnlopt-dev): the gradient-free minimisers `make bench` compares mech
+# fit with (bench/bench_fit.c), in that benchmark only.
+NLOPT_CFLAGS := $(shell pkg-config --cflags nlopt 2>/dev/null)
+NLOPT_LIBS   := $(shell pkg-config --libs nlopt 2>/dev/null || echo -lnlopt)
 # The Python the module is built for: Debian's python3 (python3-dev,
 # python3-numpy), not a python3 earlier in PATH, unless PYTHON names another
 # (a pyenv or venv python with its own numpy). python/buildinfo.py asks that
@@ -303,7 +307,7 @@ test-browser: $(BUILD)/mech
 bench:
 	@$(MAKE) --no-print-directory BUILD=build/bench OPT="-O2 -DNDEBUG" build/bench/bench-eval \
 	    build/bench/bench-solve build/bench/bench-hand build/bench/bench-accuracy build/bench/bench-scale \
-	    build/bench/mech build/bench/bench-alloc build/bench/bench-sweep
+	    build/bench/mech build/bench/bench-alloc build/bench/bench-sweep build/bench/bench-fit
 	{ build/bench/bench-eval mechanisms/*.yaml && \
 	  build/bench/bench-solve mechanisms/*.yaml bench/files/*.yaml && \
 	  build/bench/bench-hand mechanisms && \
@@ -314,6 +318,7 @@ bench:
 	  MECH=build/bench/mech sh bench/bench_batch.sh && \
 	  MECH=build/bench/mech sh bench/bench_simulate.sh && \
 	  build/bench/bench-sweep mechanisms/conveyor.yaml l1 55 65 && \
+	  build/bench/bench-fit tests/fit/fourbar.yaml && \
 	  build/bench/bench-alloc mechanisms/*.yaml; } 2>&1 | tee build/bench/report.txt
 	sh bench/report.sh build/bench/report.txt
 
@@ -325,6 +330,11 @@ $(BUILD)/bench-solve: bench/bench_solve.c bench/bench_util.h $(BUILD)/libmech.a 
 
 $(BUILD)/bench-sweep: bench/bench_sweep.c $(BUILD)/libmech.a $(HEADERS)
 	$(CC) $(CFLAGS) -o $@ $< $(BUILD)/libmech.a $(LDLIBS)
+
+# mech fit's lmder (cmd_fit_lm.o, MINPACK) against NLopt's gradient-free methods
+$(BUILD)/bench-fit: bench/bench_fit.c $(BUILD)/obj/cmd_fit_lm.o $(BUILD)/libmech.a $(HEADERS)
+	$(CC) $(CFLAGS) $(NLOPT_CFLAGS) -o $@ $< $(BUILD)/obj/cmd_fit_lm.o $(BUILD)/libmech.a \
+	    $(MINPACK_LIBS) $(NLOPT_LIBS) $(LDLIBS)
 
 $(BUILD)/bench-alloc: bench/bench_alloc.c $(BUILD)/libmech.a $(HEADERS)
 	$(CC) $(CFLAGS) -o $@ $< $(BUILD)/libmech.a $(LDLIBS)

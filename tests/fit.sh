@@ -224,6 +224,73 @@ case $? in
 *) fail "whole range: exit status $?" ;;
 esac
 
+# --plot: the targets as points, the fitted curve and the start's over the
+# file's range, one SVG. check_plot SVG CSV COLS: well-formed XML, one
+# marker of class "dot" per target and each where the target is on the
+# page (data-mech-transform: a path, x and y in mm; data-mech-axes: a
+# column against the driver in deg), two curves (fitted, start dashed)
+check_plot() {
+    python3 - "$@" <<'EOF'
+import csv, math, sys
+import xml.dom.minidom
+svg, targets, ncols = sys.argv[1], sys.argv[2], int(sys.argv[3])
+try:
+    doc = xml.dom.minidom.parse(svg)
+except Exception as e:
+    print(f"FAIL: {svg}: not well-formed XML: {e}")
+    sys.exit(1)
+root = doc.documentElement
+rows = [[float(v) for v in r] for r in list(csv.reader(open(targets)))[1:]]
+dots = [u for u in doc.getElementsByTagName("use") if u.getAttribute("class") == "dot"]
+page = [(float(u.getAttribute("x")), float(u.getAttribute("y"))) for u in dots]
+if ncols == 2:  # a path: x, y in mm; the transform is for metres
+    s, ox, oy = (float(v) for v in root.getAttribute("data-mech-transform").split())
+    want = [(ox + s * r[1] / 1e3, oy - s * r[2] / 1e3) for r in rows]
+else:  # against the driver: deg and the column's display unit
+    sx, ox, sy, oy = (float(v) for v in root.getAttribute("data-mech-axes").split())
+    want = [(ox + sx * r[0], oy - sy * r[1]) for r in rows]
+bad = []
+if len(page) != len(rows):
+    bad.append(f"{len(page)} target markers for {len(rows)} targets")
+worst = max((math.hypot(a[0] - b[0], a[1] - b[1]) for a, b in zip(page, want)), default=0)
+if worst > 0.01:
+    bad.append(f"a target marker {worst:.3f} px from its target")
+curves = [p for p in doc.getElementsByTagName("path") if p.getAttribute("stroke")
+          and p.getAttribute("d").startswith("M") and p.parentNode.getAttribute("clip-path")]
+if len(curves) != 2 or not curves[1].getAttribute("stroke-dasharray"):
+    bad.append(f"{len(curves)} curves, expected the fitted one and the start's dashed")
+title = doc.getElementsByTagName("title")[0].firstChild.data
+if f"{len(rows)} targets" not in title:
+    bad.append(f"title '{title}' does not count the targets")
+for b in bad:
+    print(f"FAIL: {svg}: {b}")
+sys.exit(1 if bad else 0)
+EOF
+}
+if run "plot: path" 0 "$MECH" fit "$tmp/moved.yaml" --free r,l,b --target "$tmp/path.csv" --plot "$tmp/fit.svg"; then
+    has_line "$tmp/out" "^plotted      $tmp/fit.svg\$" "plot: path: said"
+    check_plot "$tmp/fit.svg" "$tmp/path.csv" 2 && pass || fail "plot: path: the figure"
+fi
+if run "plot: function" 0 "$MECH" fit "$tmp/moved.yaml" --free r,l,b --target "$tmp/function.csv" \
+    --plot "$tmp/fn.svg" -o "$tmp/fn2.yaml"; then
+    check_plot "$tmp/fn.svg" "$tmp/function.csv" 1 && pass || fail "plot: function: the figure"
+    [ -s "$tmp/fn2.yaml" ] && pass || fail "plot: function: -o not written with --plot"
+fi
+cp "$tmp/moved.yaml" "$tmp/keep.yaml"
+run "plot over the input" 2 "$MECH" fit "$tmp/moved.yaml" --free r --target "$tmp/path.csv" --plot "$tmp/moved.yaml" &&
+    has_line "$tmp/err" "is the input file" "plot over the input: message"
+run "plot over the targets" 2 "$MECH" fit "$tmp/moved.yaml" --free r --target "$tmp/path.csv" --plot "$tmp/path.csv" &&
+    has_line "$tmp/err" "is the input file" "plot over the targets: message"
+cmp -s "$tmp/moved.yaml" "$tmp/keep.yaml" && pass || fail "plot: the input changed"
+run "plot and -o the same" 2 "$MECH" fit "$tmp/moved.yaml" --free r --target "$tmp/path.csv" --plot "$tmp/same" -o "$tmp/same" &&
+    has_line "$tmp/err" "name the same file" "plot and -o the same: message"
+[ ! -e "$tmp/same" ] && pass || fail "plot and -o the same: a file was written"
+run "plot: no such folder" 3 "$MECH" fit "$tmp/moved.yaml" --free r,l,b --target "$tmp/path.csv" --plot "$tmp/no/fit.svg" &&
+    has_line "$tmp/err" "$tmp/no/fit.svg" "plot: no such folder: message"
+[ ! -e "$tmp/no" ] && pass || fail "plot: no such folder: something written"
+run "plot: no solution" 1 "$MECH" fit "$tmp/far.yaml" --free r=45:60 --target "$tmp/path.csv" --starts 2 \
+    --plot "$tmp/none.svg" && { [ ! -e "$tmp/none.svg" ] && pass || fail "plot: no solution: a plot was written"; }
+
 # bad input: each a precise message, exit 2, no file written
 sed '1s/P.x/Q.x/' "$tmp/path.csv" >"$tmp/unknown.csv"
 run "unknown column" 2 "$MECH" fit "$tmp/moved.yaml" --free r --target "$tmp/unknown.csv" -o "$tmp/x.yaml" &&

@@ -162,6 +162,9 @@ typedef struct plot_figure {
     int ycol[PLOT_MAX_SERIES];        /* [nseries] PLOT_PATH: the y column of series s */
     char note[2][48];                 /* legend heading lines, e.g. "B: force on rocker",
                                          "from coupler" (empty: none) */
+    unsigned char dots[PLOT_MAX_SERIES]; /* 1: series s is points (mech fit's targets): its
+                                         marker at every finite row, class "dot", no
+                                         line, arrows or start marker */
 } plot_figure;
 
 /* The figures a table calls for, in order: points (positions, velocities,

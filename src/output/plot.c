@@ -474,11 +474,14 @@ static void fig_markers(FILE *f, const fig_ctx *c, const plot_axis *ax, const pl
     char b1[32], b2[32];
     plot_style(s, &colour, &dash, &shape, &filled);
     fprintf(f, "<g stroke=\"%s\" fill=\"%s\">", colour, filled ? colour : "#fff");
-    for (int r = (s * every) / (fg->nseries > 0 ? fg->nseries : 1); r < t->nrows; r += every) {
+    int dots = fg->dots[s];  /* points: every row, each marked */
+    for (int r = dots ? 0 : (s * every) / (fg->nseries > 0 ? fg->nseries : 1); r < t->nrows;
+         r += dots ? 1 : every) {
         double x = xval(c, r), y = mech_table_get(t, r, fg->col[s]) * fg->yscale;
         if (isfinite(x) && isfinite(y))
-            fprintf(f, "<use xlink:href=\"#m%d\" x=\"%s\" y=\"%s\"/>", shape,
-                    plot_fmt(b1, px_of(ax, x), 2), plot_fmt(b2, py_of(ay, y), 2));
+            fprintf(f, "<use xlink:href=\"#m%d\"%s x=\"%s\" y=\"%s\"/>", shape,
+                    dots ? " class=\"dot\"" : "", plot_fmt(b1, px_of(ax, x), 2),
+                    plot_fmt(b2, py_of(ay, y), 2));
     }
     fputs("</g>\n", f);
 }
@@ -494,7 +497,8 @@ static void fig_series(FILE *f, const fig_ctx *c, const plot_axis *ax, const plo
         const char *colour, *dash;
         int shape, filled;
         plot_style(s, &colour, &dash, &shape, &filled);
-        fig_curve(f, c, ax, ay, s, colour, dash);
+        if (!fg->dots[s])
+            fig_curve(f, c, ax, ay, s, colour, dash);
         fig_markers(f, c, ax, ay, s, every);
     }
     fputs("</g>\n", f);
@@ -524,8 +528,10 @@ static void fig_legend(FILE *f, const fig_ctx *c)
         int shape, filled;
         plot_style(s, &colour, &dash, &shape, &filled);
         int y = ly + 17 + 22 * s;
-        fprintf(f, "<path d=\"M%d,%dh36\" fill=\"none\" stroke=\"%s\" stroke-width=\"1.6\"%s%s%s/>",
-                lx + 8, y, colour, *dash ? " stroke-dasharray=\"" : "", dash, *dash ? "\"" : "");
+        if (!fg->dots[s])
+            fprintf(f, "<path d=\"M%d,%dh36\" fill=\"none\" stroke=\"%s\" stroke-width=\"1.6\"%s%s%s/>",
+                    lx + 8, y, colour, *dash ? " stroke-dasharray=\"" : "", dash,
+                    *dash ? "\"" : "");
         fprintf(f, "<use xlink:href=\"#m%d\" x=\"%d\" y=\"%d\" stroke=\"%s\" fill=\"%s\"/>", shape,
                 lx + 26, y, colour, filled ? colour : "#fff");
         fprintf(f, "<text x=\"%d\" y=\"%d\">", lx + 50, y + 4);

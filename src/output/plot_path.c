@@ -201,6 +201,21 @@ static void path_curve(FILE *f, const path_ctx *c, int s, const char *colour, co
 static void path_marks(FILE *f, const path_ctx *c, int s, const char *colour, int shape)
 {
     int n = c->t->nrows;
+    if (c->f->dots[s]) {  /* points: the marker at every finite row */
+        int filled;
+        const char *col, *dash;
+        plot_style(s, &col, &dash, &shape, &filled);
+        fprintf(f, "<g stroke=\"%s\" fill=\"%s\">", colour, filled ? colour : "#fff");
+        for (int r = 0; r < n; r++) {
+            double px, py;
+            char b1[32], b2[32];
+            if (to_page(c, s, r, &px, &py))
+                fprintf(f, "<use xlink:href=\"#m%d\" class=\"dot\" x=\"%s\" y=\"%s\"/>",
+                        shape, plot_fmt(b1, px, 2), plot_fmt(b2, py, 2));
+        }
+        fputs("</g>\n", f);
+        return;
+    }
     double len = 0, px, py, qx, qy, lx = 0, ly = 0;
     int have = 0, first = -1;
     for (int r = 0; r < n; r++)
@@ -255,10 +270,14 @@ static void path_legend(FILE *f, const path_ctx *c)
         const char *colour, *dash;
         int shape, filled, y = ly + 17 + 22 * s;
         plot_style(s, &colour, &dash, &shape, &filled);
-        fprintf(f, "<path d=\"M%d,%dh36\" fill=\"none\" stroke=\"%s\" stroke-width=\"1.6\"%s%s%s/>",
-                lx + 8, y, colour, *dash ? " stroke-dasharray=\"" : "", dash, *dash ? "\"" : "");
-        fprintf(f, "<use xlink:href=\"#m%d\" x=\"%d\" y=\"%d\" fill=\"%s\" stroke=\"#fff\"/>",
-                shape, lx + 14, y, colour);
+        if (fg->dots[s])
+            fprintf(f, "<use xlink:href=\"#m%d\" x=\"%d\" y=\"%d\" stroke=\"%s\" fill=\"%s\"/>",
+                    shape, lx + 26, y, colour, filled ? colour : "#fff");
+        else
+            fprintf(f, "<path d=\"M%d,%dh36\" fill=\"none\" stroke=\"%s\" stroke-width=\"1.6\"%s%s%s/>"
+                       "<use xlink:href=\"#m%d\" x=\"%d\" y=\"%d\" fill=\"%s\" stroke=\"#fff\"/>",
+                    lx + 8, y, colour, *dash ? " stroke-dasharray=\"" : "", dash,
+                    *dash ? "\"" : "", shape, lx + 14, y, colour);
         fprintf(f, "<text x=\"%d\" y=\"%d\">", lx + 50, y + 4);
         plot_put_text(f, fg->label[s]);
         fputs("</text>\n", f);
@@ -291,7 +310,8 @@ int plot_path_svg(FILE *f, const mech_model *m, const mech_table *t, const plot_
         const char *colour, *dash;
         int shape, filled;
         plot_style(s, &colour, &dash, &shape, &filled);
-        path_curve(f, &c, s, colour, dash);
+        if (!fg->dots[s])
+            path_curve(f, &c, s, colour, dash);
     }
     for (int s = 0; s < fg->nseries; s++) {  /* marks above every curve */
         const char *colour, *dash;

@@ -149,9 +149,9 @@ static double difference(const char *unit, double y, double t)
 }
 
 /* The file loaded and checked with the free parameters at p (as overrides
- * of their values, in their file units); counts a solve. */
-static int load_at(fit_problem *fp, const double *p, mech_model **m, mech_diag *quiet,
-                   mech_diag *d)
+ * of their values, in their file units). */
+static int load_values(const fit_problem *fp, const double *p, mech_model **m, mech_diag *quiet,
+                       mech_diag *d)
 {
     int n = fp->nfree, rc;
     mech_override *ov = xcalloc((size_t)n + 1, sizeof *ov);
@@ -166,7 +166,6 @@ static int load_at(fit_problem *fp, const double *p, mech_model **m, mech_diag *
                  fp->unit[k]);
         ov[k] = (mech_override){fp->names[k], text[k]};
     }
-    fp->nsolves++;
     rc = mech_load_file_with(fp->path, ov, n, m, quiet);
     mech_summary s;
     if (rc == MECH_OK)
@@ -174,6 +173,14 @@ static int load_at(fit_problem *fp, const double *p, mech_model **m, mech_diag *
     free(ov);
     free(text);
     return rc;
+}
+
+/* load_values, counted as a solve. */
+static int load_at(fit_problem *fp, const double *p, mech_model **m, mech_diag *quiet,
+                   mech_diag *d)
+{
+    fp->nsolves++;
+    return load_values(fp, p, m, quiet, d);
 }
 
 int fit_eval(fit_problem *fp, const double *p, double *r, double *jac, mech_diag *d)
@@ -232,6 +239,12 @@ int fit_eval(fit_problem *fp, const double *p, double *r, double *jac, mech_diag
             }
         }
     }
+    if (fp->observe) {
+        double f = 0.0;
+        for (int i = 0; i < mrows; i++)
+            f += r[i] * r[i];
+        fp->observe(fp->observe_ctx, fp->nsolves, f);
+    }
 done:
     mech_diag_free(&quiet);
     mech_table_free(&t);
@@ -258,6 +271,38 @@ int fit_check_range(fit_problem *fp, const double *p, mech_diag *d)
         rc = rc == MECH_ENOMEM ? diag_nomem(d, fp->path, (mech_mark){0, 0}) : MECH_ESOLVE;
     mech_diag_free(&quiet);
     mech_table_free(&t);
+    mech_model_free(&m);
+    return rc;
+}
+
+int fit_objective(fit_problem *fp, const double *p, double *r, double *objective, mech_diag *d)
+{
+    int rc = fit_eval(fp, p, r, NULL, d);
+    double f = 0.0;
+    for (int i = 0; rc == MECH_OK && i < fp->nq * fp->ncols; i++)
+        f += r[i] * r[i];
+    *objective = rc == MECH_OK ? f : INFINITY;
+    return rc;
+}
+
+int fit_sweep(const fit_problem *fp, const double *p, mech_table *t, mech_diag *d)
+{
+    mech_model *m = NULL;
+    mech_outputs outs = {0};
+    int rc = load_values(fp, p, &m, d, d);
+    mech_solve_options o;
+    if (rc == MECH_OK)
+        rc = eval_options(fp, m, &outs, &o, d);
+    if (rc == MECH_OK) {
+        o.want = MECH_WANT_POSITION;
+        mech_diag quiet;  /* the gaps are in t->gaps */
+        mech_diag_init(&quiet);
+        rc = mech_solve(m, &o, t, NULL, &quiet);
+        if (rc != MECH_OK && rc != MECH_ESOLVE)
+            mech_diag_print(&quiet, stderr);
+        mech_diag_free(&quiet);
+    }
+    mech_outputs_free(&outs);
     mech_model_free(&m);
     return rc;
 }

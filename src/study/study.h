@@ -257,6 +257,11 @@ typedef struct fit_problem {
     long nsolves;              /* evaluations so far */
     int free_timing;           /* 1: the driver positions are unknowns too, p[nfree + i]
                                   (q is then only the start); dr/dq from the rates */
+    /* called by fit_eval after each evaluation that assembles, with the
+     * count of solves so far and the objective sum r^2 there (bench/bench_fit.c
+     * traces the objective against the solves); NULL: none */
+    void (*observe)(void *ctx, long nsolves, double objective);
+    void *observe_ctx;
 } fit_problem;
 
 /* The unknowns of the problem: the free parameters, and with free timing
@@ -279,6 +284,17 @@ int fit_eval(fit_problem *fp, const double *p, double *r, double *jac, mech_diag
  * every row of the file's own driver range (a crank from 0 to 360 deg: it
  * turns fully), else MECH_ESOLVE (nothing in d); one solve. */
 int fit_check_range(fit_problem *fp, const double *p, mech_diag *d);
+/* The file at p solved over its own driver range (positions of the
+ * target columns' objects, fp->outputs) into *t: the traced curve of `mech
+ * fit --plot`. MECH_OK; MECH_ESOLVE with the rows solved in *t (t->gaps
+ * lists the missing ones) when it does not assemble everywhere; an error
+ * in d (nothing in *t) when the file does not load. Not a counted solve. */
+int fit_sweep(const fit_problem *fp, const double *p, mech_table *t, mech_diag *d);
+/* The objective F(p) = sum r^2 of the residuals fit_eval computes (r[nq
+ * ncols] the workspace): MECH_OK, MECH_ESOLVE when the mechanism does not
+ * assemble at every target, MECH_ENOMEM. For minimisers without gradients
+ * (bench/bench_fit.c, NLopt): the same evaluation as the fit's. */
+int fit_objective(fit_problem *fp, const double *p, double *r, double *objective, mech_diag *d);
 void fit_problem_free(fit_problem *fp);
 
 /* ==== flywheel ==== */

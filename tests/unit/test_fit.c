@@ -7,7 +7,10 @@
  * Newton's 1e-12 of 70 mm over 2 h, both below 1e-6 of the column's
  * scale; agreement asked to 1e-5 of the largest derivative of the column.
  * (2) Recovery: targets solved at known parameters, the fit from 10 %
- * off (bounded and unbounded) must give them back to 1e-9 relative. */
+ * off (bounded and unbounded) must give them back to 1e-9 relative.
+ * (3) fit_objective and the observer (bench/bench_fit.c's objective and
+ * trace) against fit_eval's residuals; fit_sweep (mech fit --plot) over
+ * the file's range, whole and with gaps. */
 #include <criterion/criterion.h>
 #include <math.h>
 #include <stdio.h>
@@ -152,6 +155,81 @@ Test(fit, timing_jacobian_against_central_differences)
                 cr_expect_eq(exact, 0.0);
         }
     }
+    mech_diag_free(&d);
+    fit_problem_free(&fp);
+}
+
+/* The observer sees every evaluation that assembles, with the count of
+ * solves and the objective fit_objective returns (the one bench/bench_fit.c
+ * gives NLopt): the same number as the sum of the squares of fit_eval's
+ * residuals. */
+typedef struct seen {
+    long n, last_solve;
+    double last;
+} seen;
+
+static void observe(void *ctx, long nsolves, double f)
+{
+    seen *s = ctx;
+    s->n++;
+    s->last_solve = nsolves;
+    s->last = f;
+}
+
+Test(fit, objective_and_observer)
+{
+    double p0[NF], r[NQ * NC], f = -1.0;
+    fit_problem fp = problem(p0, 0);
+    seen s = {0, 0, 0.0};
+    fp.observe = observe;
+    fp.observe_ctx = &s;
+    mech_diag d;
+    mech_diag_init(&d);
+    cr_assert_eq(fit_objective(&fp, p0, r, &f, &d), MECH_OK);
+    double sum = 0.0;
+    for (int i = 0; i < NQ * NC; i++)
+        sum += r[i] * r[i];
+    cr_expect(sum > 0.0 && f == sum, "objective %.17g, sum of squares %.17g", f, sum);
+    cr_expect_eq(s.n, 1);
+    cr_expect_eq(s.last_solve, fp.nsolves);
+    cr_expect(s.last == f);
+    /* a point where the mechanism does not assemble: ESOLVE, infinite,
+     * counted as a solve, not observed */
+    double far[NF];
+    memcpy(far, p0, sizeof far);
+    far[0] = 0.2;  /* a crank of 200 mm on a 70 mm ground */
+    long before = fp.nsolves;
+    cr_expect_eq(fit_objective(&fp, far, r, &f, &d), MECH_ESOLVE);
+    cr_expect(isinf(f));
+    cr_expect_eq(fp.nsolves, before + 1);
+    cr_expect_eq(s.n, 1);
+    mech_diag_free(&d);
+    fit_problem_free(&fp);
+}
+
+/* fit_sweep: the file's own range (0 to 360 deg in 36 steps) at p, with
+ * the target columns; not a counted solve; a crank that cannot turn fully
+ * gives ESOLVE with the rows solved and the gaps. */
+Test(fit, sweep_over_the_file_range)
+{
+    double p0[NF];
+    fit_problem fp = problem(p0, 0);
+    mech_table t = {0};
+    mech_diag d;
+    mech_diag_init(&d);
+    long before = fp.nsolves;
+    cr_assert_eq(fit_sweep(&fp, p0, &t, &d), MECH_OK);
+    cr_expect_eq(fp.nsolves, before);
+    cr_expect_eq(t.nrows, 37);
+    for (int j = 0; j < NC; j++)
+        cr_expect(mech_table_column(&t, cols[j]) > 0, "column %s", cols[j]);
+    mech_table_free(&t);
+    double p[NF];
+    memcpy(p, p0, sizeof p);
+    p[0] = 0.045;  /* r 45 mm: s + l = 45 + 70 > 60 + 50, not a Grashof crank */
+    cr_expect_eq(fit_sweep(&fp, p, &t, &d), MECH_ESOLVE);
+    cr_expect(t.nrows > 0 && t.nrows < 37 && t.ngaps > 0, "%d rows, %d gaps", t.nrows, t.ngaps);
+    mech_table_free(&t);
     mech_diag_free(&d);
     fit_problem_free(&fp);
 }
