@@ -143,7 +143,7 @@ static inline int cmd_exit_status(int rc)
            : rc == MECH_EIO || rc == MECH_ENOMEM ? MECH_EXIT_IO : MECH_EXIT_INPUT;
 }
 
-/* cmd_common.c: a command's table to `out` (NULL or "-": standard output):
+/* cmd_manifest.c: a command's table to `out` (NULL or "-": standard output):
  * HDF5 when the name ends in .h5 or .hdf5 (output_h5.c, with the manifest
  * as attributes: mech's version, the command, the input file and its
  * digest), else CSV. MECH_OK or a failure in d. */

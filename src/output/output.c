@@ -349,3 +349,34 @@ int mech_table_write_csv(const mech_table *t, const char *path, mech_diag *d)
     api_diag_end(d, &own);
     return rc;
 }
+
+int mech_table_read(const char *path, mech_table *out, mech_diag *d)
+{
+    mech_diag own, *dd = api_diag(d, &own);
+    int rc;
+    if (!path || !out) {
+        rc = api_null(dd, "mech_table_read", out ? "path" : "out");
+        api_diag_end(d, &own);
+        return rc;
+    }
+    memset(out, 0, sizeof *out);
+    compare_table ct;
+    rc = compare_read_csv(path, &ct, dd);
+    if (rc == MECH_OK && (ct.ncols > INT_MAX || ct.nrows > (size_t)INT_MAX / (ct.ncols + 1)))
+        rc = diag_fail(dd, MECH_FAIL_INPUT, path, (mech_mark){0, 0}, "the table is too large");
+    if (rc == MECH_OK && !(out->columns = calloc(ct.ncols + 1, sizeof *out->columns)))
+        rc = diag_nomem(dd, path, (mech_mark){0, 0});
+    if (rc == MECH_OK) {  /* the names, units and values change owner */
+        for (size_t c = 0; c < ct.ncols; c++) {
+            out->columns[c] = (mech_column){ct.names[c], ct.units[c]};
+            ct.names[c] = ct.units[c] = NULL;
+        }
+        out->ncolumns = (int)ct.ncols;
+        out->nrows = out->nrequested = (int)ct.nrows;
+        out->values = ct.values;
+        ct.values = NULL;
+    }
+    compare_table_free(&ct);
+    api_diag_end(d, &own);
+    return rc;
+}
