@@ -740,6 +740,12 @@ void mech_outputs_free(mech_outputs *o);
  * same directory renamed over `path` when complete; "-" writes to stdout.
  * Returns MECH_OK or MECH_EIO (with a message in d). */
 int mech_table_write_csv(const mech_table *t, const char *path, mech_diag *d);
+/* Read a table that mech_table_write_csv, `mech solve` or `mech simulate`
+ * wrote: a CSV, or HDF5 (`-o OUT.h5`, docs/cli.md), told apart by the
+ * file's content. *out is overwritten (free it with mech_table_free).
+ * Returns MECH_OK, MECH_EINPUT (a malformed file, FILE:LINE:COLUMN in d),
+ * MECH_EIO or MECH_ENOMEM; then *out is empty. */
+int mech_table_read(const char *path, mech_table *out, mech_diag *d);
 
 /* ---- Sweeps: many variants of one mechanism file ----------------------
  * `mech sweep` as a call (src/study/sweep_run.c, docs/batch.md, docs/api.md):
@@ -923,6 +929,7 @@ enum {
 /*   mech_table_column(t, name)               t, name (-1)                */
 /*   mech_table_get(t, row, col)              none (inline, unchecked)    */
 /*   mech_table_write_csv(t, path, d)         d                           */
+/*   mech_table_read(path, out, d)            d                           */
 /*   mech_parse_value(text, is_angle, si,     si (the text is checked),   */
 /*                    err, errsize)           err (no message)            */
 /*   mech_outputs_parse(m, list, out, err,    out (the list is checked),  */

@@ -910,6 +910,29 @@ static PyObject *py_sweep(PyObject *self, PyObject *args, PyObject *kw)
     return result;
 }
 
+/* _mech.read(path) -> (names, units, arrays, {}, messages): a table that
+ * mech solve or simulate wrote, CSV or HDF5 (mech_table_read) */
+static PyObject *py_read(PyObject *self, PyObject *args, PyObject *kw)
+{
+    (void)self;
+    static char *kwlist[] = {"path", NULL};
+    const char *path;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "s", kwlist, &path))
+        return NULL;
+    mech_diag d;
+    mech_diag_init(&d);
+    mech_table t;
+    int rc;
+    Py_BEGIN_ALLOW_THREADS
+    rc = mech_table_read(path, &t, &d);
+    Py_END_ALLOW_THREADS
+    PyObject *out = rc == MECH_OK ? table_tuple_with(&t, PyDict_New(), &d)
+                                  : raise_mech(rc, &d, "cannot read the table", NULL);
+    mech_table_free(&t);
+    mech_diag_free(&d);
+    return out;
+}
+
 static PyMethodDef methods[] = {
     {"sweep", (PyCFunction)(void (*)(void))py_sweep, METH_VARARGS | METH_KEYWORDS,
      "sweep(path, grid, metrics, random=0, seed=1, forces=False, shard=(0, 1), "
@@ -922,6 +945,9 @@ static PyMethodDef methods[] = {
      "solve(path, set=None, from_=None, to=None, steps=None, outputs=None, forces=None, "
      "tol=None, level=None, friction=None, diagnostics=False, all=False) -> "
      "(names, units, arrays, stats, messages)"},
+    {"read", (PyCFunction)(void (*)(void))py_read, METH_VARARGS | METH_KEYWORDS,
+     "read(path) -> (names, units, arrays, {}, messages): a CSV or HDF5 table that mech "
+     "solve or simulate wrote"},
     {"simulate", (PyCFunction)(void (*)(void))py_simulate, METH_VARARGS | METH_KEYWORDS,
      "simulate(path, to=None, step=None, rtol=None, atol=None, method=None, "
      "stop_at_rest=False, stop_when=None) -> "

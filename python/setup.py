@@ -91,6 +91,9 @@ klu_cflags = pkg_config('--cflags', 'klu', ['-I/usr/include/suitesparse'])
 klu_libs = pkg_config('--libs', 'klu', ['-lklu', '-lbtf', '-lamd', '-lcolamd',
                                          '-lsuitesparseconfig'])
 yaml_libs = pkg_config('--libs', 'yaml-0.1', ['-lyaml'])
+# HDF5's serial flavour, as the Makefile's HDF5_CFLAGS and HDF5_LIBS
+hdf5_cflags = pkg_config('--cflags', 'hdf5-serial', ['-I/usr/include/hdf5/serial'])
+hdf5_libs = pkg_config('--libs', 'hdf5-serial', ['-lhdf5_serial'])
 
 
 def sundials_libs():
@@ -110,8 +113,8 @@ extension = Extension(
     depends=[os.path.relpath(h, HERE) for h in [os.path.join(ROOT, 'include', 'mech.h')] +
              sorted(glob.glob(os.path.join(ROOT, 'src', '*', '*.h')))],
     define_macros=buildinfo.define_macros(),
-    extra_compile_args=['-std=c11', '-D_POSIX_C_SOURCE=200809L'] + klu_cflags,
-    extra_link_args=yaml_libs + klu_libs + sundials_libs() + ['-lm', '-pthread'],
+    extra_compile_args=['-std=c11', '-D_POSIX_C_SOURCE=200809L'] + klu_cflags + hdf5_cflags,
+    extra_link_args=yaml_libs + klu_libs + sundials_libs() + hdf5_libs + ['-lm', '-pthread'],
 )
 
 setup(

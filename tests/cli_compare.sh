@@ -186,4 +186,40 @@ if "$MECH" solve --help >/dev/null 2>&1 && [ -f mechanisms/fourbar.yaml ]; then
     fi
 fi
 
+
+# ---- HDF5 outputs (docs/cli.md, HDF5 output) ---------------------------------
+# the same numbers as the CSV, read by mech compare on either side with a zero
+# tolerance; written whole; a symbolic link's target; a FIFO; never an input;
+# an HDF5 file that is not mech's, and one cut short, are errors
+if run "solve -o run.h5" 0 "$MECH" solve mechanisms/fourbar.yaml --forces -o "$tmp/run.h5" &&
+   run "solve -o run.csv" 0 "$MECH" solve mechanisms/fourbar.yaml --forces -o "$tmp/run.csv"; then
+    run "HDF5 against the CSV, exactly" 0 "$MECH" compare --rtol 0 --atol 0 "$tmp/run.h5" "$tmp/run.csv" && pass
+    run "the CSV against HDF5, exactly" 0 "$MECH" compare --rtol 0 --atol 0 "$tmp/run.csv" "$tmp/run.h5" && pass
+    has_line "$tmp/out" "^compare: 42 columns, 361 rows: all within" "HDF5: every column and row read"
+    [ "$(head -c 4 "$tmp/run.h5" | od -An -c | tr -d ' ')" = "211HDF" ] && pass || fail "run.h5 has no HDF5 signature"
+    ls "$tmp"/run.h5.tmp* >/dev/null 2>&1 && fail "a temporary file was left beside run.h5" || pass
+    cp "$tmp/run.h5" "$tmp/target.h5"
+    ln -s "$tmp/target.h5" "$tmp/link.h5"
+    if run "solve -o LINK.h5" 0 "$MECH" solve mechanisms/slider-crank.yaml -o "$tmp/link.h5"; then
+        [ -L "$tmp/link.h5" ] && pass || fail "the symbolic link was replaced"
+        "$MECH" solve mechanisms/slider-crank.yaml -o "$tmp/sc.csv" 2>/dev/null
+        run "the link's target holds the new run" 0 "$MECH" compare --rtol 0 --atol 0 "$tmp/target.h5" "$tmp/sc.csv" && pass
+    fi
+    if mkfifo "$tmp/pipe.h5" 2>/dev/null; then
+        cat "$tmp/pipe.h5" >"$tmp/from-pipe.h5" &
+        run "solve -o FIFO.h5" 0 "$MECH" solve mechanisms/fourbar.yaml --forces -o "$tmp/pipe.h5"
+        wait
+        run "what came through the FIFO" 0 "$MECH" compare --rtol 0 --atol 0 "$tmp/from-pipe.h5" "$tmp/run.csv" && pass
+    fi
+    run "simulate -o run.h5" 0 "$MECH" simulate tests/dynamics/pendulum.yaml --to 0.2 -o "$tmp/sim.h5" &&
+        run "simulate: HDF5 against CSV" 0 "$MECH" simulate tests/dynamics/pendulum.yaml --to 0.2 -o "$tmp/sim.csv" &&
+        run "simulate: the same numbers" 0 "$MECH" compare --rtol 0 --atol 0 "$tmp/sim.h5" "$tmp/sim.csv" && pass
+    head -c 2000 "$tmp/run.h5" >"$tmp/cut.h5"
+    run "an HDF5 file cut short" 3 "$MECH" compare "$tmp/cut.h5" "$tmp/run.csv" &&
+        has_line "$tmp/err" "cut.h5: error: cannot open the HDF5 file" "the cut file is named"
+    cp mechanisms/fourbar.yaml "$tmp/in.h5"
+    run "the output is the input" 2 "$MECH" solve "$tmp/in.h5" -o "$tmp/in.h5" &&
+        cmp -s "$tmp/in.h5" mechanisms/fourbar.yaml && pass
+fi
+
 summary

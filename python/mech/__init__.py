@@ -46,6 +46,7 @@ except ModuleNotFoundError as e:
 from . import _mech
 
 __all__ = ['MechError', 'Result', 'SweepResult', 'load', 'check', 'solve', 'simulate', 'sweep',
+           'read',
            'VERSION',
            'EINPUT', 'ENOMEM', 'EIO', 'ESOLVE', 'FAIL_KINDS', 'VARIANT_STATUS']
 __version__ = VERSION
@@ -158,6 +159,16 @@ def solve(path, set=None, from_=None, to=None, steps=None, outputs=None, forces=
         if isinstance(getattr(e, 'partial', None), tuple):
             e.partial = Result(*e.partial)
         raise
+    return Result(names, units, arrays, stats, messages)
+
+
+def read(path):
+    """Read a table that `mech solve` or `mech simulate` wrote: a CSV, or
+    the HDF5 of `-o OUT.h5` (docs/cli.md, HDF5 output), told apart by the
+    file's content. Returns a Result (its stats empty) with the file's
+    columns, units and numbers as they are in the file. Raises MechError for
+    a malformed or unreadable file."""
+    names, units, arrays, stats, messages = _mech.read(path)
     return Result(names, units, arrays, stats, messages)
 
 

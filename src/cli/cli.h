@@ -143,6 +143,12 @@ static inline int cmd_exit_status(int rc)
            : rc == MECH_EIO || rc == MECH_ENOMEM ? MECH_EXIT_IO : MECH_EXIT_INPUT;
 }
 
+/* cmd_manifest.c: a command's table to `out` (NULL or "-": standard output):
+ * HDF5 when the name ends in .h5 or .hdf5 (output_h5.c, with the manifest
+ * as attributes: mech's version, the command, the input file and its
+ * digest), else CSV. MECH_OK or a failure in d. */
+int cmd_write_table(const mech_table *t, const char *out, const char *command,
+                    const char *input, mech_diag *d);
 /* cmd_common.c: "mech COMMAND: MESSAGE (see 'mech COMMAND --help')" on
  * stderr; returns MECH_EXIT_INPUT. fmt has one %s for arg. */
 int cmd_usage_error(const char *command, const char *fmt, const char *arg);

@@ -154,3 +154,17 @@ int digest_parse(const char *line, const char *prefix, long *rows, uint64_t *h)
         return -1;
     return 0;
 }
+
+int cmd_write_table(const mech_table *t, const char *out, const char *command,
+                    const char *input, mech_diag *d)
+{
+    if (!out || !output_is_h5_name(out))
+        return mech_table_write_csv(t, out ? out : "-", d);
+    uint64_t h = 0;
+    char digest[24] = "-";
+    if (input && manifest_hash_file(&h, input) == 0)
+        snprintf(digest, sizeof digest, "%016llx", (unsigned long long)h);
+    const char *keys[] = {"mech_version", "command", "input", "input_digest"};
+    const char *values[] = {mech_version(), command, input ? input : "-", digest};
+    return output_write_h5(t, out, keys, values, 4, d);
+}

@@ -141,7 +141,7 @@ static int run(simulate_args *a, const mech_model *m)
                     st.evaluations ? st.seconds / st.evaluations * 1e6 : 0.0);
         mech_diag w;
         mech_diag_init(&w);
-        if (mech_table_write_csv(&t, a->out ? a->out : "-", &w) != MECH_OK)
+        if (cmd_write_table(&t, a->out, "simulate", a->file, &w) != MECH_OK)
             code = MECH_EXIT_IO;
         mech_diag_print(&w, stderr);
         mech_diag_free(&w);

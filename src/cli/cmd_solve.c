@@ -312,7 +312,7 @@ static int write_rows(const solve_args *a, const mech_table *t)
     mech_diag d;
     mech_diag_init(&d);
     int code = MECH_EXIT_OK;
-    if (mech_table_write_csv(t, a->out ? a->out : "-", &d) != MECH_OK)
+    if (cmd_write_table(t, a->out, "solve", a->file, &d) != MECH_OK)
         code = MECH_EXIT_IO;
     mech_diag_print(&d, stderr);
     mech_diag_free(&d);

@@ -364,6 +364,8 @@ void compare_table_free(compare_table *t)
 
 int compare_read_csv(const char *path, compare_table *t, mech_diag *d)
 {
+    if (output_file_is_h5(path))  /* mech's HDF5 output (output_h5.c) */
+        return compare_read_h5(path, t, d);
     memset(t, 0, sizeof *t);
     csv_reader r = {.path = path, .d = d};
     r.f = fopen(path, "rb");

@@ -235,6 +235,42 @@ static int write_replacing(const char *path, const char *target,
     return e ? io_error(d, path, "cannot write the output file", e) : MECH_OK;
 }
 
+/* The same for a writer that needs a file name (a library that opens the
+ * file itself, as HDF5 does): `emit_path` writes the temporary file by its
+ * name; it is then synced and renamed over `target`. */
+static int write_replacing_by_name(const char *path, const char *target,
+                                   int (*emit_path)(const char *, const void *),
+                                   const void *ctx, mech_diag *d)
+{
+    size_t n = strlen(target) + sizeof ".tmpXXXXXX";
+    char *tmp = malloc(n);
+    if (!tmp)
+        return diag_nomem(d, path, (mech_mark){0, 0});
+    snprintf(tmp, n, "%s.tmpXXXXXX", target);
+    pthread_once(&mask_once, read_umask);
+    int slot = -1;
+    int fd = create_registered(tmp, &slot);
+    if (fd < 0) {
+        int e = errno;
+        free(tmp);
+        return io_error(d, path, "cannot create the output file", e);
+    }
+    int e = fchmod(fd, 0666 & ~file_mask) != 0 ? errno : 0;
+    if (!e && emit_path(tmp, ctx) != 0)
+        e = errno ? errno : EIO;
+    if (!e && fsync(fd) != 0)  /* the same file: the writer reopened it by name */
+        e = errno;
+    if (close(fd) != 0 && !e)
+        e = errno;
+    if (!e && rename(tmp, target) != 0)
+        e = errno;
+    if (e)
+        unlink(tmp);
+    live_remove(slot);
+    free(tmp);
+    return e ? io_error(d, path, "cannot write the output file", e) : MECH_OK;
+}
+
 static atomic_int stdout_reported;  /* a failed write of "-" was reported */
 
 int output_stdout_reported(void)
@@ -287,6 +323,22 @@ int write_file_whole(const char *path, int (*emit)(FILE *, const void *), const 
     return rc;
 }
 
+int write_file_whole_by_name(const char *path, int (*emit_path)(const char *, const void *),
+                             int (*emit)(FILE *, const void *), const void *ctx, mech_diag *d)
+{
+    if (strcmp(path, "-") == 0)
+        return write_file_whole(path, emit, ctx, d);
+    struct stat st;
+    if (lstat(path, &st) != 0) {
+        if (errno != ENOENT)
+            return io_error(d, path, "cannot write the output", errno);
+        return write_replacing_by_name(path, path, emit_path, ctx, d);  /* a new file */
+    }
+    if (!S_ISREG(st.st_mode))  /* a symbolic link, a FIFO, a device: through emit */
+        return write_file_whole(path, emit, ctx, d);
+    return write_replacing_by_name(path, path, emit_path, ctx, d);
+}
+
 static int emit_csv(FILE *f, const void *t) { return write_rows(t, f); }
 
 int mech_table_write_csv(const mech_table *t, const char *path, mech_diag *d)
@@ -294,6 +346,37 @@ int mech_table_write_csv(const mech_table *t, const char *path, mech_diag *d)
     mech_diag own, *dd = api_diag(d, &own);
     int rc = t && path ? write_file_whole(path, emit_csv, t, dd)
                        : api_null(dd, "mech_table_write_csv", t ? "path" : "t");
+    api_diag_end(d, &own);
+    return rc;
+}
+
+int mech_table_read(const char *path, mech_table *out, mech_diag *d)
+{
+    mech_diag own, *dd = api_diag(d, &own);
+    int rc;
+    if (!path || !out) {
+        rc = api_null(dd, "mech_table_read", out ? "path" : "out");
+        api_diag_end(d, &own);
+        return rc;
+    }
+    memset(out, 0, sizeof *out);
+    compare_table ct;
+    rc = compare_read_csv(path, &ct, dd);
+    if (rc == MECH_OK && (ct.ncols > INT_MAX || ct.nrows > (size_t)INT_MAX / (ct.ncols + 1)))
+        rc = diag_fail(dd, MECH_FAIL_INPUT, path, (mech_mark){0, 0}, "the table is too large");
+    if (rc == MECH_OK && !(out->columns = calloc(ct.ncols + 1, sizeof *out->columns)))
+        rc = diag_nomem(dd, path, (mech_mark){0, 0});
+    if (rc == MECH_OK) {  /* the names, units and values change owner */
+        for (size_t c = 0; c < ct.ncols; c++) {
+            out->columns[c] = (mech_column){ct.names[c], ct.units[c]};
+            ct.names[c] = ct.units[c] = NULL;
+        }
+        out->ncolumns = (int)ct.ncols;
+        out->nrows = out->nrequested = (int)ct.nrows;
+        out->values = ct.values;
+        ct.values = NULL;
+    }
+    compare_table_free(&ct);
     api_diag_end(d, &own);
     return rc;
 }

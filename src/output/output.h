@@ -26,6 +26,12 @@
  * Thread-safe. */
 int write_file_whole(const char *path, int (*emit)(FILE *, const void *), const void *ctx,
                      mech_diag *d);
+/* The same for a writer that opens the file by name (HDF5): a new or
+ * regular file is written by emit_path(temporary name, ctx) and renamed
+ * over `path`; standard output ("-"), a symbolic link, a FIFO or a device
+ * go through write_file_whole with emit. */
+int write_file_whole_by_name(const char *path, int (*emit_path)(const char *, const void *),
+                             int (*emit)(FILE *, const void *), const void *ctx, mech_diag *d);
 
 /* 1 when write_file_whole has reported a failed write to standard output
  * (so src/cli/main.c does not report it again). */
@@ -46,6 +52,19 @@ double output_in_file_units(const mech_model *m, const char *unit, double v, cha
 /* Every column of t in the file's units, its header unit with it:
  * MECH_OK, or MECH_ENOMEM. */
 int output_file_units(const mech_model *m, mech_table *t);
+
+/* ==== output_h5 ==== */
+/* output_h5.c: a table as HDF5 (docs/cli.md, "Output files"): one float64
+ * dataset per column with its "unit", the root attributes "columns",
+ * "units", "rows" and the caller's nattrs strings keys[i] = values[i] (the
+ * manifest: version, command, input); written whole or not at all, like a
+ * CSV (write_file_whole). MECH_OK, MECH_EIO or MECH_ENOMEM with d. */
+int output_write_h5(const mech_table *t, const char *path, const char *const *keys,
+                    const char *const *values, int nattrs, mech_diag *d);
+/* 1 when the output name asks for HDF5: it ends in .h5 or .hdf5 */
+int output_is_h5_name(const char *path);
+/* 1 when `path` is a regular file that starts with HDF5's signature */
+int output_file_is_h5(const char *path);
 
 /* ==== compare ==== */
 /* compare.c: compare a solver output CSV with a golden CSV (`mech compare`).
@@ -98,6 +117,9 @@ typedef struct compare_table {
  * MECH_EINPUT with every malformed line in d (FILE:LINE:COLUMN), MECH_EIO
  * (cannot open or read) or MECH_ENOMEM, and then *t is empty. */
 int compare_read_csv(const char *path, compare_table *t, mech_diag *d);
+/* The same for mech's HDF5 output (output_h5.c); compare_read_csv calls it
+ * for a file with HDF5's signature. */
+int compare_read_h5(const char *path, compare_table *t, mech_diag *d);
 void compare_table_free(compare_table *t);  /* accepts an empty table */
 
 /* 1 when `out` passes against `golden`: both NaN; equal infinities; or both

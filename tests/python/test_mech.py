@@ -341,3 +341,22 @@ def test_simulate_equals_the_cli_and_keeps_energy():
     q = mech.simulate(path, stop_when='bar.angle=-90', rtol=1e-10, atol=1e-12)
     assert abs(h['t'][-1] - 2 * q['t'][-1]) < 1e-7
     assert abs(q['bar.angle'][-1] + math.pi / 2) < 1e-9
+
+
+def test_read_gives_back_the_hdf5_and_the_csv_of_the_cli(tmp_path):
+    """mech.read (docs/cli.md, HDF5 output): the HDF5 that `mech solve -o
+    OUT.h5` writes and the CSV of the same run read back as the doubles
+    mech.solve returns, bit for bit; a file that is not a table is refused."""
+    path = 'mechanisms/fourbar.yaml'
+    r = mech.solve(path, forces=True)
+    h5, csv = str(tmp_path / 'run.h5'), str(tmp_path / 'run.csv')
+    for out in (h5, csv):
+        subprocess.run([MECH, 'solve', path, '--forces', '-o', out], check=True)
+    for out in (h5, csv):
+        t = mech.read(out)
+        assert t.columns == r.columns and t.nrows == r.nrows
+        for n in r.columns:
+            assert_bits_equal(t[n], r[n], n)
+        assert t.units == r.units
+    with pytest.raises(mech.MechError):
+        mech.read(path)
