@@ -491,7 +491,7 @@ static void run_start(void *ctx, long i)
     fit_start *st = &runs->st[i];
     fit_problem fp = s->fp;  /* this thread's: its own count of solves */
     fp.nsolves = 0;
-    double *r = xcalloc((size_t)fp.nq * (size_t)fp.ncols, sizeof *r);
+    double *r = xcalloc((size_t)fit_nres(&fp), sizeof *r);
     start_point(s, i, st->p);
     st->objective = INFINITY;
     st->rc = r ? fit_lm(&fp, s->lo, s->hi, st->p, r, &st->objective, &st->info) : MECH_ENOMEM;
@@ -549,7 +549,7 @@ static void print_params(const fit_setup *s, const mech_model *m, const double *
 /* The worst target error (in the file's units) of the solution p. */
 static void print_errors(fit_setup *s, const mech_model *m, const double *p, FILE *out)
 {
-    int nr = s->fp.nq * s->fp.ncols;
+    int nr = fit_nres(&s->fp);
     double *r = xcalloc((size_t)nr, sizeof *r);
     mech_diag d;
     mech_diag_init(&d);
@@ -576,6 +576,48 @@ static void print_errors(fit_setup *s, const mech_model *m, const double *p, FIL
             double qat = output_in_file_units(m, s->fp.qunit, qw, bq, sizeof bq);
             fprintf(out, "  %-12s worst error %.3g %s (at %s = %.6g %s), rms %.3g %s\n",
                     s->cols[j], we, bu, s->csv.names[0], qat, bq, rms, bu);
+        }
+    }
+    mech_diag_free(&d);
+    free(r);
+}
+
+/* The margin of each constraint of the file's fit: section at p (>= 0:
+ * met), in the file's units. */
+static void print_margins(fit_setup *s, const mech_model *m, const double *p, FILE *out)
+{
+    const model_fit *mf = m->fit;
+    if (!mf || !fit_ncons(&s->fp))
+        return;
+    double *r = xcalloc((size_t)fit_nres(&s->fp), sizeof *r);
+    mech_diag d;
+    mech_diag_init(&d);
+    if (r && fit_eval(&s->fp, p, r, NULL, &d) == MECH_OK) {
+        int base = s->fp.nq * s->fp.ncols;
+        fprintf(out, "constraint margins (>= 0: met):\n");
+        for (int c = 0; c < s->fp.ncons; c++) {
+            char bu[32];
+            double v = output_in_file_units(m, mf->cons[c].unit, -r[base + c], bu, sizeof bu);
+            fprintf(out, "  %-24s margin %.6g%s%s%s\n", mf->cons[c].text, v, bu[0] ? " " : "",
+                    bu, -r[base + c] <= fit_con_tolerance(&s->fp, c) ? "   (active: on the "
+                    "boundary)" : "");
+        }
+        if (s->fp.trans) {
+            double worst = INFINITY;
+            int at = 0;
+            for (int i = 0; i < s->fp.nq; i++)
+                if (-r[base + s->fp.ncons + i] < worst) {
+                    worst = -r[base + s->fp.ncons + i];
+                    at = i;
+                }
+            char bu[32], bq[32], lab[128];
+            double mn = output_in_file_units(m, "rad", mf->trans_min + worst, bu, sizeof bu);
+            double v = output_in_file_units(m, "rad", worst, bu, sizeof bu);
+            double qw = s->fp.free_timing ? p[s->fp.nfree + at] : s->q[at];
+            double qat = output_in_file_units(m, s->fp.qunit, qw, bq, sizeof bq);
+            snprintf(lab, sizeof lab, "transmission %s/%s", mf->trans_a, mf->trans_b);
+            fprintf(out, "  %-24s margin %.6g %s (least %.6g %s, at %s = %.6g %s)\n", lab, v, bu,
+                    mn, bu, s->csv.names[0], qat, bq);
         }
     }
     mech_diag_free(&d);
@@ -757,10 +799,11 @@ static int report(fit_setup *s, const fit_args *a, const mech_model *m, fit_star
                   double seconds)
 {
     long solves = 0;
-    int ok = 0;
+    int ok = 0, violated = 0;
     for (int i = 0; i < n; i++) {
         solves += st[i].solves;
         ok += st[i].rc == MECH_OK;
+        violated += st[i].rc == MECH_ESOLVE && st[i].info == -2;
     }
     for (int i = 0; i < n; i++)
         if (st[i].rc != MECH_OK && st[i].rc != MECH_ESOLVE) {
@@ -772,16 +815,21 @@ static int report(fit_setup *s, const fit_args *a, const mech_model *m, fit_star
     fprintf(out, "mech fit: %s, %d free parameter%s, %d target row%s x %d column%s\n", a->file,
             s->fp.nfree, s->fp.nfree == 1 ? "" : "s", s->fp.nq, s->fp.nq == 1 ? "" : "s",
             s->fp.ncols, s->fp.ncols == 1 ? "" : "s");
-    fprintf(out, "starts       %d (%d assembled at every target%s, %d rejected)\n", n, ok,
-            s->whole_range ? " and over the whole range" : "", n - ok);
+    char viol[64] = "";
+    if (fit_ncons(&s->fp))
+        snprintf(viol, sizeof viol, ", %d of them violating a constraint", violated);
+    fprintf(out, "starts       %d (%d assembled at every target%s%s, %d rejected%s)\n", n, ok,
+            s->whole_range ? " and over the whole range" : "",
+            fit_ncons(&s->fp) ? " within the constraints" : "", n - ok, viol);
     fprintf(out, "solves       %ld (each the file loaded and the targets' rows solved)\n",
             solves);
     fprintf(out, "time         %.3g s\n", seconds);
     if (!ok) {
-        fprintf(stderr, "mech fit: no start assembles at every target%s: no solution (the "
+        fprintf(stderr, "mech fit: no start assembles at every target%s%s: no solution (the "
                 "bounds too narrow, a target past a limit position for every value tried, or "
-                "the constraint excludes the fits found)%s\n",
+                "the constraints exclude the fits found)%s\n",
                 s->whole_range ? " and over the whole range" : "",
+                fit_ncons(&s->fp) ? " within the constraints" : "",
                 a->out ? ", no file written" : "");
         return MECH_EXIT_SOLVE;
     }
@@ -811,6 +859,7 @@ static int report(fit_setup *s, const fit_args *a, const mech_model *m, fit_star
     }
     fprintf(out, "target errors:\n");
     print_errors(s, m, st[0].p, out);
+    print_margins(s, m, st[0].p, out);
     if (!a->quiet && ok > 1) {
         fprintf(out, "distinct solutions (best first):\n");
         int shown = 0;

@@ -19,7 +19,10 @@ typedef struct lm_ctx {
     double *p;              /* [n] the parameters at the point asked for */
     double *r, *jac;        /* [m], [m n] workspace of the Jacobian's call */
     double penalty;         /* each residual where the mechanism does not assemble */
+    double worst;           /* the largest sum of squares evaluated (the penalty stays above) */
     int error;              /* MECH_ENOMEM met */
+    int nt, nc;             /* target residuals, constraint values */
+    double *shift, *wcon;   /* [nc] the constraints' shifts and weights */
 } lm_ctx;
 
 static int bounded(const lm_ctx *c, int k)
@@ -53,6 +56,14 @@ static void to_free(const lm_ctx *c, int n, const double *p, double *u)
     }
 }
 
+static double sum_squares(const double *r, int m)
+{
+    double s = 0.0;
+    for (int i = 0; i < m; i++)
+        s += r[i] * r[i];
+    return s;
+}
+
 /* MINPACK's callback: iflag 1 the residuals, 2 the Jacobian (by u). A
  * trial point where the mechanism does not assemble gets residuals so large
  * that lmder rejects the step and shortens it. */
@@ -65,18 +76,34 @@ static int lm_fcn(void *vp, int m, int n, const double *u, double *fvec, double 
     to_params(c, n, u, c->p);
     int rc = MECH_OK;
     if (iflag == 1) {
-        rc = fit_eval(c->fp, c->p, fvec, NULL, &d);
+        rc = fit_eval(c->fp, c->p, c->r, NULL, &d);
         if (rc == MECH_ESOLVE) {
+            /* above every sum of squares seen: the constraints' penalties
+             * may have raised it past the start's */
+            double e = sqrt(10.0 * c->worst / m);
             for (int i = 0; i < m; i++)
-                fvec[i] = c->penalty;
+                fvec[i] = c->penalty > e ? c->penalty : e;
             rc = MECH_OK;
+        } else if (rc == MECH_OK) {
+            memcpy(fvec, c->r, (size_t)c->nt * sizeof *fvec);
+            for (int j = 0; j < c->nc; j++) {  /* w max(0, g + shift) */
+                double g = c->r[c->nt + j] + c->shift[j];
+                fvec[c->nt + j] = g > 0.0 ? c->wcon[j] * g : 0.0;
+            }
+            double ss = sum_squares(fvec, m);
+            if (ss > c->worst)
+                c->worst = ss;
         }
     } else if (iflag == 2) {
         rc = fit_eval(c->fp, c->p, c->r, c->jac, &d);
         for (int k = 0; rc == MECH_OK && k < n; k++) {
             double s = slope(c, k, u[k]);
-            for (int i = 0; i < m; i++)
-                fjac[(size_t)k * (size_t)ldfjac + (size_t)i] = c->jac[(size_t)k * m + i] * s;
+            for (int i = 0; i < m; i++) {
+                double x = c->jac[(size_t)k * m + i] * s;
+                if (i >= c->nt)  /* a constraint's row: the penalty's derivative */
+                    x = c->r[i] + c->shift[i - c->nt] > 0.0 ? c->wcon[i - c->nt] * x : 0.0;
+                fjac[(size_t)k * (size_t)ldfjac + (size_t)i] = x;
+            }
         }
     }
     mech_diag_free(&d);
@@ -85,28 +112,23 @@ static int lm_fcn(void *vp, int m, int n, const double *u, double *fvec, double 
     return rc == MECH_OK ? 0 : -1;
 }
 
-static double sum_squares(const double *r, int m)
-{
-    double s = 0.0;
-    for (int i = 0; i < m; i++)
-        s += r[i] * r[i];
-    return s;
-}
 
 int fit_lm(fit_problem *fp, const double *lo, const double *hi, double *p, double *r,
            double *objective, int *info)
 {
-    int n = fit_nvars(fp), m = fp->nq * fp->ncols;
+    int n = fit_nvars(fp), m = fit_nres(fp), nt = fp->nq * fp->ncols, nc = fit_ncons(fp);
     size_t nn = (size_t)n, mm = (size_t)m;
     double *u = xcalloc(nn, sizeof *u), *fvec = xcalloc(mm, sizeof *fvec);
     double *fjac = xcalloc(mm * nn, sizeof *fjac), *diag = xcalloc(nn, sizeof *diag);
     double *qtf = xcalloc(nn, sizeof *qtf), *wa = xcalloc(3 * nn + mm, sizeof *wa);
     double *pw = xcalloc(nn, sizeof *pw), *jac = xcalloc(mm * nn, sizeof *jac);
     int *ipvt = xcalloc(nn, sizeof *ipvt);
+    double *shift = xcalloc((size_t)nc + 1, sizeof *shift);
+    double *wcon = xcalloc((size_t)nc + 1, sizeof *wcon);
     int rc = MECH_OK, nfev = 0, njev = 0;
     mech_diag d;
     mech_diag_init(&d);
-    if (!u || !fvec || !fjac || !diag || !qtf || !wa || !pw || !jac || !ipvt) {
+    if (!u || !fvec || !fjac || !diag || !qtf || !wa || !pw || !jac || !ipvt || !shift || !wcon) {
         rc = MECH_ENOMEM;
         goto done;
     }
@@ -114,25 +136,67 @@ int fit_lm(fit_problem *fp, const double *lo, const double *hi, double *p, doubl
     rc = fit_eval(fp, p, r, NULL, &d);
     if (rc != MECH_OK)
         goto done;
-    lm_ctx c = {fp, lo, hi, pw, r, jac, 0.0, MECH_OK};
-    double rms = sqrt(sum_squares(r, m) / m);
+    lm_ctx c = {fp, lo, hi, pw, r, jac, 0.0, 0.0, MECH_OK, nt, nc, shift, wcon};
+    double rms = sqrt(sum_squares(r, nt) / (nt ? nt : 1));
     c.penalty = 1e3 * (rms > 1e-3 ? rms : 1e-3);
+    /* the constraints steer: each g <= 0 adds the residual w max(0, g + s),
+     * a shifted quadratic penalty (the method of multipliers, Nocedal and
+     * Wright, "Numerical Optimization", 2nd ed., 17.4): after each lmder
+     * run the shift becomes max(0, s + g), which moves the minimum onto
+     * the boundary g = 0 of an active constraint without the weight
+     * growing. w: a violation of 1e-3 of the constraint's size weighs as
+     * much as the start's residuals. */
+    double f0 = sqrt(sum_squares(r, nt));
+    for (int j = 0; j < nc; j++) {
+        double size = j < fp->ncons && fp->con_scale[j] > 1e-300 ? fp->con_scale[j] : 1.0;
+        wcon[j] = (f0 > 1e-6 ? f0 : 1e-6) / (1e-3 * size);
+    }
     to_free(&c, n, p, u);
-    /* tolerances: relative reduction of the sum of squares 1e-15, relative
-     * step 1e-12 (lengths to about 1e-14 m on a 0.1 m mechanism); gtol 0:
-     * the orthogonality test is left out (a zero-residual problem ends by
-     * ftol or xtol). mode 1: MINPACK scales by the Jacobian's columns. */
-    *info = lmder(lm_fcn, &c, m, n, u, fvec, fjac, m, 1e-15, 1e-12, 0.0, 200 * (n + 1), diag, 1,
-                  100.0, 0, &nfev, &njev, ipvt, qtf, wa, wa + nn, wa + 2 * nn, wa + 3 * nn);
-    if (c.error != MECH_OK) {
-        rc = c.error;
-        goto done;
+    for (int round = 0; round < (nc ? 30 : 1); round++) {
+        /* tolerances: relative reduction of the sum of squares 1e-15,
+         * relative step 1e-12 (lengths to about 1e-14 m on a 0.1 m
+         * mechanism); gtol 0: the orthogonality test is left out (a
+         * zero-residual problem ends by ftol or xtol). mode 1: MINPACK
+         * scales by the Jacobian's columns. */
+        *info = lmder(lm_fcn, &c, m, n, u, fvec, fjac, m, 1e-15, 1e-12, 0.0, 200 * (n + 1), diag,
+                      1, 100.0, 0, &nfev, &njev, ipvt, qtf, wa, wa + nn, wa + 2 * nn,
+                      wa + 3 * nn);
+        if (c.error != MECH_OK) {
+            rc = c.error;
+            goto done;
+        }
+        if (!nc)
+            break;
+        to_params(&c, n, u, p);
+        if (fit_eval(fp, p, r, NULL, &d) != MECH_OK)
+            break;
+        /* on: until each constraint holds to 1/100 of the tolerance the
+         * result is accepted at */
+        int inside = 1;
+        for (int j = 0; j < nc; j++)
+            inside &= r[nt + j] <= 1e-2 * fit_con_tolerance(fp, j);
+        if (inside)
+            break;
+        int moved = 0;
+        for (int j = 0; j < nc; j++) {
+            double s = shift[j] + r[nt + j];
+            s = s > 0.0 ? s : 0.0;
+            moved |= s != shift[j];
+            shift[j] = s;
+        }
+        if (!moved)
+            break;
     }
     to_params(&c, n, u, p);
-    /* the result checked again: it assembles at every target, in bounds */
+    /* the result checked again: it assembles at every target, in bounds,
+     * and meets every constraint (else it is rejected: info -2) */
     rc = fit_eval(fp, p, r, NULL, &d);
+    if (rc == MECH_OK && fit_feasible(fp, r) != MECH_OK) {
+        rc = MECH_ESOLVE;
+        *info = -2;
+    }
     if (rc == MECH_OK)
-        *objective = sum_squares(r, m);
+        *objective = sum_squares(r, nt);
 done:
     mech_diag_free(&d);
     free(u);
@@ -144,5 +208,7 @@ done:
     free(pw);
     free(jac);
     free(ipvt);
+    free(shift);
+    free(wcon);
     return rc;
 }

@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "base.h"
+#include "load.h"
 #include "study.h"
 
 /* Which of the solve's columns a fit may target: positions only. */
@@ -48,6 +49,40 @@ static int outputs_list(fit_problem *fp, mech_diag *d)
         memcpy(o, c, n);
         o += n;
         *o = '\0';
+    }
+    return MECH_OK;
+}
+
+/* The constraints of the file's fit: section: their count and sizes; a
+ * transmission's two links added to the outputs (their angles solved). */
+static int constraints_of(fit_problem *fp, const mech_model *m, mech_diag *d)
+{
+    const model_fit *mf = m->fit;
+    fp->ncons = mf->ncons;
+    fp->trans = mf->trans_a != NULL;
+    free(fp->con_scale);
+    fp->con_scale = xcalloc((size_t)mf->ncons + 1, sizeof *fp->con_scale);
+    if (!fp->con_scale)
+        return diag_nomem(d, fp->path, (mech_mark){0, 0});
+    for (int c = 0; c < mf->ncons; c++)
+        fp->con_scale[c] = mf->cons[c].scale;
+    if (!fp->trans)
+        return MECH_OK;
+    for (int w = 0; w < 2; w++) {  /* each once */
+        const char *name = w ? mf->trans_b : mf->trans_a;
+        size_t n = strlen(name);
+        int seen = 0;
+        for (const char *x = fp->outputs; *x && !seen; x += strcspn(x, ","), x += *x == ',')
+            seen = strcspn(x, ",") == n && strncmp(x, name, n) == 0;
+        if (seen)
+            continue;
+        size_t len = strlen(fp->outputs) + n + 2;
+        char *o = xcalloc(len, 1);
+        if (!o)
+            return diag_nomem(d, fp->path, (mech_mark){0, 0});
+        snprintf(o, len, "%s%s%s", fp->outputs, fp->outputs[0] ? "," : "", name);
+        free(fp->outputs);
+        fp->outputs = o;
     }
     return MECH_OK;
 }
@@ -101,6 +136,8 @@ int fit_prepare(fit_problem *fp, double *p0, mech_diag *d)
     }
     if (rc == MECH_OK)
         rc = outputs_list(fp, d);
+    if (rc == MECH_OK && m->fit)
+        rc = constraints_of(fp, m, d);
     if (rc == MECH_OK && fp->free_timing &&
         (m->driver.kind == MECH_DRIVE_TIME || m->ndrivers != 1 || !(m->driver.speed != 0.0)))
         rc = diag_error(d, m->file, (mech_mark){0, 0}, "free timing needs one driver "
@@ -176,9 +213,92 @@ static int load_at(fit_problem *fp, const double *p, mech_model **m, mech_diag *
     return rc;
 }
 
+/* The constraint values after the target residuals (fit_ncons of them)
+ * and their rows of the Jacobian: an expression's g and dg/dp from its
+ * recorded tree (exact, param_expr.c); a transmission's g_i = min -
+ * asin|sin(a_i - b_i)| from the two links' solved angles and their
+ * sensitivities (and rates, with free timing). */
+static int eval_constraints(fit_problem *fp, const mech_model *m, const mech_table *t,
+                            const double *p, double *r, double *jac)
+{
+    int n = fp->nfree, mrows = fit_nres(fp), base = fp->nq * fp->ncols;
+    const model_fit *mf = m->fit;
+    for (int c = 0; c < fp->ncons; c++)
+        r[base + c] = mf->cons[c].g;
+    if (jac && fp->ncons) {
+        const param_exprs *pe = m->pexpr;
+        double *dv = xcalloc((size_t)(pe ? pe->n : 0) + 1, sizeof *dv);
+        if (!dv)
+            return MECH_ENOMEM;
+        for (int k = 0; k < fit_nvars(fp); k++) {
+            int pi = -1;
+            for (int i = 0; k < n && i < m->nparams; i++)
+                if (strcmp(m->params[i].name, fp->names[k]) == 0)
+                    pi = i;
+            if (pe && pi >= 0)
+                pexpr_derivatives(pe, pi, dv);
+            for (int c = 0; c < fp->ncons; c++)
+                jac[(size_t)k * mrows + base + c] =
+                    pe && pi >= 0 ? pexpr_deriv_of(dv, mf->cons[c].h) : 0.0;
+        }
+        free(dv);
+    }
+    if (!fp->trans)
+        return MECH_OK;
+    char name[300];
+    int ca, cb, base2 = base + fp->ncons;
+    snprintf(name, sizeof name, "%s.angle", mf->trans_a);
+    ca = mech_table_column(t, name);
+    snprintf(name, sizeof name, "%s.angle", mf->trans_b);
+    cb = mech_table_column(t, name);
+    if (ca < 0 || cb < 0)
+        return MECH_ESOLVE;
+    for (int i = 0; i < fp->nq; i++) {
+        double da = mech_table_get(t, i, ca) - mech_table_get(t, i, cb);
+        double s = sin(da), c = cos(da);
+        r[base2 + i] = mf->trans_min - asin(fabs(s) < 1.0 ? fabs(s) : 1.0);
+        if (!jac)
+            continue;
+        double f = -((s < 0) ? -1.0 : 1.0) * ((c < 0) ? -1.0 : 1.0);  /* dg/d(da) */
+        for (int k = 0; k < fit_nvars(fp); k++) {
+            double dd = 0.0;
+            if (k < n) {
+                int x[2];
+                for (int w = 0; w < 2; w++) {
+                    snprintf(name, sizeof name, "d(%s.angle)/d(%s)", w ? mf->trans_b : mf->trans_a,
+                             fp->names[k]);
+                    x[w] = mech_table_column(t, name);
+                }
+                dd = (x[0] < 0 ? 0.0 : mech_table_get(t, i, x[0])) -
+                     (x[1] < 0 ? 0.0 : mech_table_get(t, i, x[1]));
+            } else if (k - n == i) {  /* free timing: d(da)/dq_i from the rates */
+                int x[2];
+                for (int w = 0; w < 2; w++) {
+                    snprintf(name, sizeof name, "%s.omega", w ? mf->trans_b : mf->trans_a);
+                    x[w] = mech_table_column(t, name);
+                }
+                dd = ((x[0] < 0 ? 0.0 : mech_table_get(t, i, x[0])) -
+                      (x[1] < 0 ? 0.0 : mech_table_get(t, i, x[1]))) / m->driver.speed;
+            }
+            jac[(size_t)k * mrows + base2 + i] = f * dd;
+        }
+    }
+    (void)p;
+    return MECH_OK;
+}
+
+int fit_feasible(const fit_problem *fp, const double *r)
+{
+    int base = fp->nq * fp->ncols;
+    for (int c = 0; c < fit_ncons(fp); c++)
+        if (!(r[base + c] <= fit_con_tolerance(fp, c)))
+            return MECH_ESOLVE;
+    return MECH_OK;
+}
+
 int fit_eval(fit_problem *fp, const double *p, double *r, double *jac, mech_diag *d)
 {
-    int n = fp->nfree, mrows = fp->nq * fp->ncols;
+    int n = fp->nfree, mrows = fit_nres(fp);
     mech_model *m = NULL;
     mech_outputs outs = {0};
     mech_table t = {0};
@@ -232,6 +352,9 @@ int fit_eval(fit_problem *fp, const double *p, double *r, double *jac, mech_diag
             }
         }
     }
+    rc = eval_constraints(fp, m, &t, p, r, jac);
+    if (rc == MECH_ENOMEM)
+        rc = diag_nomem(d, fp->path, (mech_mark){0, 0});
 done:
     mech_diag_free(&quiet);
     mech_table_free(&t);
@@ -266,4 +389,6 @@ void fit_problem_free(fit_problem *fp)
 {
     free(fp->outputs);
     fp->outputs = NULL;
+    free(fp->con_scale);
+    fp->con_scale = NULL;
 }

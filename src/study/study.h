@@ -257,7 +257,32 @@ typedef struct fit_problem {
     long nsolves;              /* evaluations so far */
     int free_timing;           /* 1: the driver positions are unknowns too, p[nfree + i]
                                   (q is then only the start); dr/dq from the rates */
+    /* the constraints of the file's fit: section (fit_prepare), as values
+     * g <= 0 after the target residuals: the ncons expressions, then with
+     * a transmission one per target row, g_i = min - asin|sin(a_i - b_i)| */
+    int ncons;                 /* expression constraints */
+    int trans;                 /* 1: a transmission constraint (its links' angles solved) */
+    double *con_scale;         /* [ncons] the size each tolerance is relative to; owned */
 } fit_problem;
+
+/* The constraint values after the nq ncols target residuals. */
+static inline int fit_ncons(const fit_problem *fp)
+{
+    return fp->ncons + (fp->trans ? fp->nq : 0);
+}
+static inline int fit_nres(const fit_problem *fp)
+{
+    return fp->nq * fp->ncols + fit_ncons(fp);
+}
+/* A constraint value g counts as violated above this (docs/synthesis.md 4). */
+static inline double fit_con_tolerance(const fit_problem *fp, int c)
+{
+    double s = c < fp->ncons ? fp->con_scale[c] : 1.0;  /* the transmission's: 1 rad */
+    return 1e-9 * (s > 1e-300 ? s : 1.0);
+}
+/* MECH_OK when every constraint value of r[fit_nres] (fit_eval's) holds to
+ * its tolerance, else MECH_ESOLVE. */
+int fit_feasible(const fit_problem *fp, const double *r);
 
 /* The unknowns of the problem: the free parameters, and with free timing
  * one driver position per target row. */
@@ -270,8 +295,9 @@ static inline int fit_nvars(const fit_problem *fp)
  * p0[nfree], units and marks into fp) and the columns (their units):
  * MECH_OK, or an error in d naming the unknown parameter or column. */
 int fit_prepare(fit_problem *fp, double *p0, mech_diag *d);
-/* r[nq ncols] at p[fit_nvars] and, when jac is not NULL, dr/dp into
- * jac[k * nq ncols + row] (column-major, MINPACK's layout). MECH_OK;
+/* r[fit_nres] at p[fit_nvars] (the target residuals, then the constraint
+ * values g) and, when jac is not NULL, dr/dp into jac[k * fit_nres + row]
+ * (column-major, MINPACK's layout). MECH_OK;
  * MECH_ESOLVE (nothing in d) when the mechanism does not assemble at
  * every target; MECH_ENOMEM. */
 int fit_eval(fit_problem *fp, const double *p, double *r, double *jac, mech_diag *d);
