@@ -2,8 +2,7 @@
  * the residuals r = w (y(p) - y*) of solved output columns against targets
  * at given driver positions, and their exact Jacobian dr/dp from the
  * sensitivities (sens_table_at: the implicit-function theorem). The
- * minimiser itself (MINPACK lmder) is the command's (src/cli/cmd_fit_lm.c):
- * libmech does not link MINPACK. */
+ * minimiser itself (MINPACK lmder) is fit_lm.c's. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

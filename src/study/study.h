@@ -307,6 +307,32 @@ int fit_eval(fit_problem *fp, const double *p, double *r, double *jac, mech_diag
 int fit_check_range(fit_problem *fp, const double *p, mech_diag *d);
 void fit_problem_free(fit_problem *fp);
 
+/* fit_lm.c: one local fit of fp from p[fit_nvars] (in: the start, in the
+ * bounds lo[k] < hi[k], or both infinite: none; out: the solution) by
+ * MINPACK's lmder with the bounds as a change of variable and the
+ * constraints as a shifted penalty; r[fit_nres]: the solution's residuals
+ * and constraint values, *objective the targets' sum of squares, *info
+ * lmder's (-2: rejected, a constraint violated). MECH_OK; MECH_ESOLVE when
+ * the start does not assemble at every target, or the solution does not
+ * or violates a constraint; MECH_ENOMEM. */
+int fit_lm(fit_problem *fp, const double *lo, const double *hi, double *p, double *r,
+           double *objective, int *info);
+
+enum { FIT_MAX_FREE = 32, FIT_MAX_TIMED = 512, FIT_MAX_VARS = FIT_MAX_FREE + FIT_MAX_TIMED };
+typedef struct fit_start {
+    double p[FIT_MAX_VARS];  /* the parameters, then (free timing) the driver positions */
+    double objective;        /* the targets' sum of squares; INFINITY: rejected */
+    int rc, info;            /* fit_lm's (then whole-range's) status, lmder's info */
+    long solves;
+} fit_start;
+/* n local fits on jobs threads (0: the default): start 0 at p0, start i at
+ * the Halton point i of the bounds (a parameter without bounds at p0); with
+ * whole_range each solution must assemble over the file's range
+ * (fit_check_range). st[n] sorted by objective (the rejected last).
+ * MECH_OK, or MECH_ENOMEM (MECH_EINPUT: too many unknowns). */
+int fit_run_starts(const fit_problem *fp, const double *lo, const double *hi, const double *p0,
+                   int whole_range, int n, int jobs, fit_start *st);
+
 /* ==== flywheel ==== */
 /* flywheel.c: flywheel sizing from the driver torque over one cycle
  * (docs/forces.md section 8): the mean torque, the largest fluctuation of

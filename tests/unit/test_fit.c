@@ -1,5 +1,5 @@
 /* tests/unit/test_fit.c: mech fit's problem (src/study/fit.c) and its local
- * solver (src/cli/cmd_fit_lm.c) against independent truths, on
+ * solver (src/study/fit_lm.c) against independent truths, on
  * tests/fit/fourbar.yaml. (1) The Jacobian fit_eval gives (from the
  * sensitivities) against central differences of the residuals themselves
  * (each a whole solve with the parameter replaced), relative step 1e-5:
@@ -21,7 +21,6 @@
 #include "helpers.h"
 #include "base.h"
 #include "study.h"
-#include "cli.h"
 
 #define NQ 8
 #define NC 3

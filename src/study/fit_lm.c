@@ -1,15 +1,16 @@
-/* src/cli/cmd_fit_lm.c: one local least-squares fit of mech fit: MINPACK's
- * lmder (Levenberg-Marquardt, Debian libcminpack) on the problem fit.c
- * defines, with the exact Jacobian and the bounds by a change of variable
- * (docs/synthesis.md, "Bounds"). Linked into the mech binary and the unit
- * tests only: libmech does not depend on MINPACK. */
+/* src/study/fit_lm.c: the local least-squares fits of mech fit and
+ * mech_fit: MINPACK's lmder (Levenberg-Marquardt, Debian libcminpack) on
+ * the problem fit.c defines, with the exact Jacobian, the bounds by a
+ * change of variable and the constraints by a shifted penalty
+ * (docs/synthesis.md sections 3 and 4); and the starts, run on worker
+ * threads. libmech.so links MINPACK (shared); a static link pulls this
+ * object, and needs -lcminpack, only when it calls mech_fit. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include <cminpack.h>
 
-#include "cli.h"
 #include "base.h"
 #include "study.h"
 
@@ -211,4 +212,87 @@ done:
     free(shift);
     free(wcon);
     return rc;
+}
+
+/* ---- the starts ------------------------------------------------------ */
+
+/* The radical inverse of i in base b: the Halton sequence's coordinate. */
+static double halton(long i, int b)
+{
+    double f = 1.0, r = 0.0;
+    for (; i > 0; i /= b) {
+        f /= b;
+        r += f * (double)(i % b);
+    }
+    return r;
+}
+
+static const int primes[FIT_MAX_FREE] = {2,  3,  5,  7,  11, 13, 17, 19, 23, 29, 31,
+                                         37, 41, 43, 47, 53, 59, 61, 67, 71, 73, 79,
+                                         83, 89, 97, 101, 103, 107, 109, 113, 127, 131};
+
+typedef struct fit_runs {
+    const fit_problem *fp;
+    const double *lo, *hi, *p0;
+    int whole_range;
+    fit_start *st;
+} fit_runs;
+
+/* Start i: the file's values (i = 0), else the Halton point i of the
+ * bounds (an unbounded parameter keeps the file's value); with free timing
+ * the targets' driver positions. */
+static void start_point(const fit_runs *runs, long i, double *p)
+{
+    const fit_problem *fp = runs->fp;
+    for (int k = 0; k < fp->nfree; k++) {
+        int b = isfinite(runs->lo[k]) && isfinite(runs->hi[k]);
+        p[k] = i == 0 || !b ? runs->p0[k]
+                            : runs->lo[k] + (runs->hi[k] - runs->lo[k]) * halton(i, primes[k]);
+    }
+    for (int j = 0; fp->free_timing && j < fp->nq; j++)
+        p[fp->nfree + j] = fp->q[j];
+}
+
+static void run_start(void *ctx, long i)
+{
+    fit_runs *runs = ctx;
+    fit_start *st = &runs->st[i];
+    fit_problem fp = *runs->fp;  /* this thread's: its own count of solves */
+    fp.nsolves = 0;
+    double *r = xcalloc((size_t)fit_nres(&fp), sizeof *r);
+    start_point(runs, i, st->p);
+    st->objective = INFINITY;
+    st->info = 0;
+    st->rc = r ? fit_lm(&fp, runs->lo, runs->hi, st->p, r, &st->objective, &st->info)
+               : MECH_ENOMEM;
+    if (st->rc == MECH_OK && runs->whole_range) {
+        mech_diag d;
+        mech_diag_init(&d);
+        st->rc = fit_check_range(&fp, st->p, &d);  /* a violated constraint: rejected */
+        mech_diag_free(&d);
+    }
+    if (st->rc != MECH_OK)
+        st->objective = INFINITY;
+    st->solves = fp.nsolves;
+    free(r);
+}
+
+static int by_objective(const void *a, const void *b)
+{
+    const fit_start *x = a, *y = b;
+    return (x->objective > y->objective) - (x->objective < y->objective);
+}
+
+int fit_run_starts(const fit_problem *fp, const double *lo, const double *hi, const double *p0,
+                   int whole_range, int n, int jobs, fit_start *st)
+{
+    if (fit_nvars(fp) > FIT_MAX_VARS || fp->nfree > FIT_MAX_FREE)
+        return MECH_EINPUT;
+    fit_runs runs = {fp, lo, hi, p0, whole_range, st};
+    parallel_run(n, jobs > 0 ? jobs : parallel_default_jobs(), run_start, &runs);
+    for (int i = 0; i < n; i++)
+        if (st[i].rc != MECH_OK && st[i].rc != MECH_ESOLVE)
+            return st[i].rc;
+    qsort(st, (size_t)n, sizeof *st, by_objective);
+    return MECH_OK;
 }
