@@ -254,6 +254,14 @@ if run "transmission, inactive" 0 "$MECH" fit "$tmp/trans10.yaml" --free r,l,b -
     near "$(value r "$tmp/trans10-best.yaml")" 20 1e-6 && pass || fail "transmission, inactive: r"
     has_line "$tmp/out" '^  transmission coupler/rocker margin 43.130[0-9]* deg (least 53.130[0-9]* deg, at q = 0 deg)$' "transmission, inactive: margin"
 fi
+# both kinds at once, with free timing: the ratio and the transmission
+# (least 55 deg) end on their boundaries, each margin within its tolerance
+cp "$tmp/moved.yaml" "$tmp/both.yaml"
+printf 'fit:\n  constraints: ["l / r >= 3.1"]\n  transmission: {links: [coupler, rocker], min: 55 deg}\n' >>"$tmp/both.yaml"
+if run "constraints, free timing" 0 "$MECH" fit "$tmp/both.yaml" --free r,l,b --target "$tmp/path.csv" --free-timing; then
+    has_line "$tmp/out" '^  l / r >= 3.1  *margin -\{0,1\}[0-9.]*e-1[0-9]   (active: on the boundary)$' "free timing: the ratio on its boundary"
+    has_line "$tmp/out" '^  transmission coupler/rocker margin -\{0,1\}[0-9.]*e-1[0-9] deg (least 55 deg' "free timing: the transmission on its boundary"
+fi
 # a constraint no mechanism within the bounds meets: every start rejected
 # (never reported as a solution), exit 1, no file
 cp "$tmp/moved.yaml" "$tmp/never.yaml"

@@ -102,12 +102,15 @@ const cmd_spec cmd_fit_spec = {
              "sensitivities (docs/sensitivity.md); bounds by a change of variable; many\n"
              "starts. A start or a solution where the mechanism does not assemble at\n"
              "every target is rejected (docs/synthesis.md). The file's 'fit:' section\n"
-             "(docs/format.md) states the same problem; the options replace its parts.\n",
+             "(docs/format.md) states the same problem; the options replace its parts.\n"
+             "Its 'constraints:' (\"l / r >= 1.5\", \"r + d <= l + b\") and 'transmission:'\n"
+             "(a least angle between two links) steer the fit and are checked after it: a\n"
+             "result that violates one is never reported; their margins are printed.\n",
     .opts = options,
     .column = 22,
     .exits = "exit status: 0 a solution found (the summary says how close it is), 1 no\n"
-             "start assembles at every target, 2 invalid file, targets or usage, 3 a\n"
-             "file cannot be read or written\n",
+             "start assembles at every target within the constraints, 2 invalid file,\n"
+             "targets or usage, 3 a file cannot be read or written\n",
     .max_files = 1,
     .file_at = AT(file),
     .min_files = 1,
