@@ -680,6 +680,7 @@ typedef struct mech_fit_options {
                                       parameter, else 1 */
     int jobs;                      /* worker threads; 0: the default */
     int whole_range, free_timing;  /* 1: on (as the flags; the section may turn them on) */
+    const char *transmission;      /* "A,B,MIN" as --transmission; NULL: the section's */
 } mech_fit_options;
 
 typedef struct mech_fit_result {

@@ -766,16 +766,16 @@ static int str_list(PyObject *list, const char *what, const char **out, int max,
 static PyObject *py_fit(PyObject *self, PyObject *args, PyObject *kw)
 {
     static char *kwlist[] = {"path", "free", "target", "columns", "weights", "starts", "jobs",
-                             "whole_range", "free_timing", NULL};
+                             "whole_range", "free_timing", "transmission", NULL};
     PyObject *path, *columns = Py_None, *weights = Py_None, *bytes = NULL, *tbytes = NULL;
     PyObject *target = Py_None;
     const char *free_text = NULL;
     mech_fit_options o;
     mech_fit_options_default(&o);
     (void)self;
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "O|zOOOiipp", kwlist, &path, &free_text, &target,
-                                     &columns, &weights, &o.starts, &o.jobs, &o.whole_range,
-                                     &o.free_timing))
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "O|zOOOiippz", kwlist, &path, &free_text,
+                                     &target, &columns, &weights, &o.starts, &o.jobs,
+                                     &o.whole_range, &o.free_timing, &o.transmission))
         return NULL;
     if (o.starts < 0 || o.starts > 100000 || o.jobs < 0)
         return PyErr_Format(PyExc_ValueError, "starts must be 1 to 100000 (0: the default), "
@@ -1051,7 +1051,7 @@ static PyMethodDef methods[] = {
      "(names, units, arrays, stats, messages): mech_simulate"},
     {"fit", (PyCFunction)(void (*)(void))py_fit, METH_VARARGS | METH_KEYWORDS,
      "fit(path, free=None, target=None, columns=None, weights=None, starts=0, jobs=0, "
-     "whole_range=False, free_timing=False) -> dict: mech_fit (synthesis)"},
+     "whole_range=False, free_timing=False, transmission=None) -> dict: mech_fit (synthesis)"},
     {NULL, NULL, 0, NULL}};
 
 static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "mech._mech",

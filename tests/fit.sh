@@ -248,6 +248,23 @@ if run "transmission" 0 "$MECH" fit "$tmp/trans.yaml" --free r=15:25,l=50:70,b=4
     obj=$(sed -n 's/^objective *\([^ ]*\).*/\1/p' "$tmp/out")
     near "$obj" 0 1e-8 && fail "transmission: objective $obj, expected a residual" || pass
 fi
+# --transmission states the same on the command line: the same answer
+if run "--transmission" 0 "$MECH" fit "$tmp/moved.yaml" --free r=15:25,l=50:70,b=40:60 --starts 4 \
+    --target "$tmp/path.csv" --transmission coupler,rocker,60deg -o "$tmp/trans-opt.yaml"; then
+    for n in r l b; do
+        near "$(value $n "$tmp/trans-opt.yaml")" "$(value $n "$tmp/trans-best.yaml")" 1e-9 && pass ||
+            fail "--transmission: $n = $(value $n "$tmp/trans-opt.yaml"), the section's $(value $n "$tmp/trans-best.yaml")"
+    done
+fi
+run "--transmission, not a link" 2 "$MECH" fit "$tmp/moved.yaml" --free r,l,b --target "$tmp/path.csv" \
+    --transmission coupler,crankk,60 -o "$tmp/x.yaml" &&
+    has_line "$tmp/err" "error: transmission: 'crankk' is not a moving link of the file" "--transmission, not a link: message"
+run "--transmission, 95 deg" 2 "$MECH" fit "$tmp/moved.yaml" --free r,l,b --target "$tmp/path.csv" \
+    --transmission coupler,rocker,95deg -o "$tmp/x.yaml" &&
+    has_line "$tmp/err" "the least angle must lie between 0 and 90 deg, not '95deg'" "--transmission, 95 deg: message"
+run "--transmission, no angle" 2 "$MECH" fit "$tmp/moved.yaml" --free r,l,b --target "$tmp/path.csv" \
+    --transmission coupler,rocker -o "$tmp/x.yaml" &&
+    has_line "$tmp/err" "transmission needs LINK,LINK,MIN" "--transmission, no angle: message"
 sed 's/min: 60 deg/min: 10 deg/' "$tmp/trans.yaml" >"$tmp/trans10.yaml"
 if run "transmission, inactive" 0 "$MECH" fit "$tmp/trans10.yaml" --free r,l,b --target "$tmp/path.csv" \
     -o "$tmp/trans10-best.yaml"; then

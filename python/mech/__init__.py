@@ -194,7 +194,7 @@ def simulate(path, to=None, step=None, rtol=None, atol=None, method=None, stop_a
 
 
 def fit(path, free=None, target=None, starts=None, jobs=None, columns=None, weights=None,
-        whole_range=False, free_timing=False):
+        whole_range=False, free_timing=False, transmission=None):
     """Dimensional synthesis, as `mech fit` (docs/synthesis.md): the values of
     the file's free parameters that make the solved outputs meet the targets,
     by least squares (MINPACK lmder, exact Jacobian, several starts), within
@@ -210,6 +210,9 @@ def fit(path, free=None, target=None, starts=None, jobs=None, columns=None, weig
     columns     the CSV's columns to fit (default: every one after the first)
     weights     {column: weight} (default 1)
     whole_range, free_timing   as the command's flags
+    transmission  (link_a, link_b, min) or 'coupler,rocker,40deg': the least
+                angle between two links at every target (default: the
+                section's); min a str with its unit or a number of degrees
 
     Returns a dict: 'params' {name: value in SI}, 'objective' (sum of
     squared weighted residuals, SI), 'worst_error' {column: SI},
@@ -224,10 +227,14 @@ def fit(path, free=None, target=None, starts=None, jobs=None, columns=None, weig
         weights = ['%s=%r' % (k, float(v)) for k, v in dict(weights).items()]
     if columns is not None:
         columns = list(columns)
+    if transmission is not None and not isinstance(transmission, str):
+        a, b, least = transmission
+        transmission = '%s,%s,%s' % (a, b, least if isinstance(least, str) else '%rdeg' % float(least))
     return _mech.fit(os.fspath(path), free=free,
                      target=None if target is None else os.fspath(target),
                      columns=columns, weights=weights, starts=starts or 0, jobs=jobs or 0,
-                     whole_range=bool(whole_range), free_timing=bool(free_timing))
+                     whole_range=bool(whole_range), free_timing=bool(free_timing),
+                     transmission=transmission)
 
 
 # mech_variant_status, in its order: the status column of `mech sweep`

@@ -21,7 +21,7 @@ typedef struct fit_list {
 } fit_list;
 
 typedef struct fit_args {
-    const char *file, *out, *target, *free;
+    const char *file, *out, *target, *free, *transmission;
     fit_list columns;            /* --column NAME (repeatable) */
     fit_list weights;            /* --weight NAME=W (repeatable) */
     int starts, jobs, quiet;
@@ -71,6 +71,11 @@ static const cmd_opt options[] = {
              "whole driver range (a crank from 0 to 360 deg turns\n"
              "fully: a Grashof crank); a solution that does not is\n"
              "rejected"},
+    {.names = "--transmission", .kind = CMD_OPT_TEXT, .at = AT(transmission),
+     .label = "--transmission A,B,M",
+     .help = "a constraint that steers: the angle between links A and\n"
+             "B stays within [M, 180 deg - M] at every target (e.g.\n"
+             "coupler,rocker,40deg; replaces the fit: section's)"},
     {.names = "--free-timing", .kind = CMD_OPT_FLAG, .at = AT(free_timing), .flag = 1,
      .label = "--free-timing",
      .help = "each target's driver position is an unknown too (the\n"
@@ -91,8 +96,8 @@ const cmd_spec cmd_fit_spec = {
     .summary = "fit parameters so that outputs meet targets (synthesis)",
     .usage = "usage: mech fit FILE --free NAME[=LO:HI],... --target TARGETS.csv\n"
              "                [--column NAME]... [--weight NAME=W]... [--starts N]\n"
-             "                [--whole-range] [--free-timing] [-j N] [-o BEST.yaml]\n"
-             "                [--quiet]\n"
+             "                [--whole-range] [--free-timing] [--transmission A,B,MIN]\n"
+             "                [-j N] [-o BEST.yaml] [--quiet]\n"
              "       mech fit FILE [-o BEST.yaml]   (the file's fit: section)\n",
     .about = "Dimensional synthesis: find the values of the file's free parameters that\n"
              "make the solved outputs meet the targets at the targets' driver positions:\n"
@@ -125,7 +130,7 @@ static int setup(fit_setup *s, const fit_args *a, mech_model **m)
     if (code != MECH_EXIT_OK)
         return code;
     fit_request rq = {a->file, a->free, a->target, a->columns.v, a->columns.n, a->weights.v,
-                      a->weights.n, a->whole_range, a->free_timing};
+                      a->weights.n, a->whole_range, a->free_timing, a->transmission};
     mech_diag d;
     mech_diag_init(&d);
     int rc = fit_setup_read(s, &rq, *m, &d);
@@ -210,8 +215,8 @@ static void print_errors(fit_setup *s, const mech_model *m, const double *p, FIL
  * met), in the file's units. */
 static void print_margins(fit_setup *s, const mech_model *m, const double *p, FILE *out)
 {
-    const model_fit *mf = m->fit;
-    if (!mf || !fit_ncons(&s->fp))
+    const model_fit *mf = m->fit;  /* the expressions' texts (ncons > 0: there is one) */
+    if (!fit_ncons(&s->fp))
         return;
     double *r = xcalloc((size_t)fit_nres(&s->fp), sizeof *r);
     mech_diag d;
@@ -234,12 +239,12 @@ static void print_margins(fit_setup *s, const mech_model *m, const double *p, FI
                     worst = -r[base + s->fp.ncons + i];
                     at = i;
                 }
-            char bu[32], bq[32], lab[128];
-            double mn = output_in_file_units(m, "rad", mf->trans_min + worst, bu, sizeof bu);
+            char bu[32], bq[32], lab[160];
+            double mn = output_in_file_units(m, "rad", s->fp.trans_min + worst, bu, sizeof bu);
             double v = output_in_file_units(m, "rad", worst, bu, sizeof bu);
             double qw = s->fp.free_timing ? p[s->fp.nfree + at] : s->q[at];
             double qat = output_in_file_units(m, s->fp.qunit, qw, bq, sizeof bq);
-            snprintf(lab, sizeof lab, "transmission %s/%s", mf->trans_a, mf->trans_b);
+            snprintf(lab, sizeof lab, "transmission %s/%s", s->fp.trans_a, s->fp.trans_b);
             fprintf(out, "  %-24s margin %.6g %s (least %.6g %s, at %s = %.6g %s)\n", lab, v, bu,
                     mn, bu, s->csv.names[0], qat, bq);
         }

@@ -260,6 +260,27 @@ static int target_path(fit_setup *s, const fit_request *rq, const model_fit *mf,
     return MECH_OK;
 }
 
+/* --transmission A,B,MIN: the links (fit_prepare checks them) and the least
+ * angle (a bare number in the file's angle unit), 0 < MIN < 90 deg. */
+static int transmission(fit_setup *s, const mech_model *m, const char *text, mech_diag *d)
+{
+    const char *c1 = strchr(text, ','), *c2 = c1 ? strchr(c1 + 1, ',') : NULL;
+    double v = NAN;
+    if (!c1 || !c2 || strchr(c2 + 1, ',') || c1 == text || c2 == c1 + 1 ||
+        c1 - text >= (long)sizeof s->fp.trans_a || c2 - c1 - 1 >= (long)sizeof s->fp.trans_b ||
+        parse_quantity(m, c2 + 1, "rad", &v) < 0)
+        return diag_error(d, m->file, (mech_mark){0, 0}, "--transmission needs LINK,LINK,MIN "
+                          "(two moving links and the least angle, e.g. coupler,rocker,30deg), "
+                          "not '%s'", text);
+    if (!(v > 0.0 && v < 1.5707963267948966))
+        return diag_error(d, m->file, (mech_mark){0, 0}, "--transmission: the least angle "
+                          "must lie between 0 and 90 deg, not '%s'", c2 + 1);
+    snprintf(s->fp.trans_a, sizeof s->fp.trans_a, "%.*s", (int)(c1 - text), text);
+    snprintf(s->fp.trans_b, sizeof s->fp.trans_b, "%.*s", (int)(c2 - c1 - 1), c1 + 1);
+    s->fp.trans_min = v;
+    return MECH_OK;
+}
+
 int fit_setup_read(fit_setup *s, const fit_request *rq, const mech_model *m, mech_diag *d)
 {
     const model_fit *mf = m->fit;
@@ -274,6 +295,8 @@ int fit_setup_read(fit_setup *s, const fit_request *rq, const mech_model *m, mec
     if (rc == MECH_OK)
         rc = choose_columns(s, rq, mf, d);
     if (rc != MECH_OK)
+        return rc;
+    if (rq->transmission && (rc = transmission(s, m, rq->transmission, d)) != MECH_OK)
         return rc;
     s->fp.path = rq->file;
     s->fp.names = s->names;
@@ -387,8 +410,7 @@ static int fill_result(fit_setup *s, const mech_model *m, const fit_start *best,
             snprintf(label, sizeof label, "%s", m->fit->cons[c].text);
             margin = -res[base + c];
         } else {
-            snprintf(label, sizeof label, "transmission %s/%s", m->fit->trans_a,
-                     m->fit->trans_b);
+            snprintf(label, sizeof label, "transmission %s/%s", s->fp.trans_a, s->fp.trans_b);
             margin = INFINITY;
             for (int i = 0; i < s->fp.nq; i++)
                 margin = fmin(margin, -res[base + s->fp.ncons + i]);
@@ -422,7 +444,7 @@ int mech_fit(const char *path, const mech_fit_options *o, mech_fit_result *r, me
     if (rc == MECH_OK)
         rc = mech_check(m, &sm, d);
     fit_request rq = {path, o->free, o->target, o->columns, o->ncolumns, o->weights,
-                      o->nweights, o->whole_range, o->free_timing};
+                      o->nweights, o->whole_range, o->free_timing, o->transmission};
     if (rc == MECH_OK)
         rc = fit_setup_read(s, &rq, m, d);
     int n = 1;

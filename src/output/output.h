@@ -482,6 +482,8 @@ typedef struct fit_request {
     const char *const *weights;       /* "COLUMN=W" */
     int nweights;
     int whole_range, free_timing;     /* 1: on */
+    const char *transmission;         /* "A,B,MIN" (links and least angle), or NULL: the
+                                         fit: section's */
 } fit_request;
 
 typedef struct fit_setup {

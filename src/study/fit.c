@@ -52,23 +52,38 @@ static int outputs_list(fit_problem *fp, mech_diag *d)
     return MECH_OK;
 }
 
-/* The constraints of the file's fit: section: their count and sizes; a
- * transmission's two links added to the outputs (their angles solved). */
+/* The constraints of the file's fit: section: their count and sizes; the
+ * transmission, the caller's or else the file's, its two links added to
+ * the outputs (their angles solved). */
 static int constraints_of(fit_problem *fp, const mech_model *m, mech_diag *d)
 {
     const model_fit *mf = m->fit;
-    fp->ncons = mf->ncons;
-    fp->trans = mf->trans_a != NULL;
+    fp->ncons = mf ? mf->ncons : 0;
+    if (!fp->trans_a[0] && mf && mf->trans_a) {
+        snprintf(fp->trans_a, sizeof fp->trans_a, "%s", mf->trans_a);
+        snprintf(fp->trans_b, sizeof fp->trans_b, "%s", mf->trans_b);
+        fp->trans_min = mf->trans_min;
+    }
+    fp->trans = fp->trans_a[0] != '\0';
     free(fp->con_scale);
-    fp->con_scale = xcalloc((size_t)mf->ncons + 1, sizeof *fp->con_scale);
+    fp->con_scale = xcalloc((size_t)fp->ncons + 1, sizeof *fp->con_scale);
     if (!fp->con_scale)
         return diag_nomem(d, fp->path, (mech_mark){0, 0});
-    for (int c = 0; c < mf->ncons; c++)
+    for (int c = 0; c < fp->ncons; c++)
         fp->con_scale[c] = mf->cons[c].scale;
     if (!fp->trans)
         return MECH_OK;
+    for (int w = 0; w < 2; w++) {
+        const char *name = w ? fp->trans_b : fp->trans_a;
+        int found = 0;
+        for (int i = 1; i < m->nlinks; i++)
+            found |= strcmp(m->links[i].name, name) == 0;
+        if (!found)
+            return diag_error(d, m->file, (mech_mark){0, 0}, "transmission: '%s' is not a "
+                              "moving link of the file", name);
+    }
     for (int w = 0; w < 2; w++) {  /* each once */
-        const char *name = w ? mf->trans_b : mf->trans_a;
+        const char *name = w ? fp->trans_b : fp->trans_a;
         size_t n = strlen(name);
         int seen = 0;
         for (const char *x = fp->outputs; *x && !seen; x += strcspn(x, ","), x += *x == ',')
@@ -135,7 +150,7 @@ int fit_prepare(fit_problem *fp, double *p0, mech_diag *d)
     }
     if (rc == MECH_OK)
         rc = outputs_list(fp, d);
-    if (rc == MECH_OK && m->fit)
+    if (rc == MECH_OK)
         rc = constraints_of(fp, m, d);
     if (rc == MECH_OK && fp->free_timing &&
         (m->driver.kind == MECH_DRIVE_TIME || m->ndrivers != 1 || !(m->driver.speed != 0.0)))
@@ -218,7 +233,7 @@ static int load_at(fit_problem *fp, const double *p, mech_model **m, mech_diag *
  * asin|sin(a_i - b_i)| from the two links' solved angles and their
  * sensitivities (and rates, with free timing). */
 static int eval_constraints(fit_problem *fp, const mech_model *m, const mech_table *t,
-                            const double *p, double *r, double *jac)
+                            double *r, double *jac)
 {
     int n = fp->nfree, mrows = fit_nres(fp), base = fp->nq * fp->ncols;
     const model_fit *mf = m->fit;
@@ -246,16 +261,16 @@ static int eval_constraints(fit_problem *fp, const mech_model *m, const mech_tab
         return MECH_OK;
     char name[300];
     int ca, cb, base2 = base + fp->ncons;
-    snprintf(name, sizeof name, "%s.angle", mf->trans_a);
+    snprintf(name, sizeof name, "%s.angle", fp->trans_a);
     ca = mech_table_column(t, name);
-    snprintf(name, sizeof name, "%s.angle", mf->trans_b);
+    snprintf(name, sizeof name, "%s.angle", fp->trans_b);
     cb = mech_table_column(t, name);
     if (ca < 0 || cb < 0)
         return MECH_ESOLVE;
     for (int i = 0; i < fp->nq; i++) {
         double da = mech_table_get(t, i, ca) - mech_table_get(t, i, cb);
         double s = sin(da), c = cos(da);
-        r[base2 + i] = mf->trans_min - asin(fabs(s) < 1.0 ? fabs(s) : 1.0);
+        r[base2 + i] = fp->trans_min - asin(fabs(s) < 1.0 ? fabs(s) : 1.0);
         if (!jac)
             continue;
         double f = -((s < 0) ? -1.0 : 1.0) * ((c < 0) ? -1.0 : 1.0);  /* dg/d(da) */
@@ -264,7 +279,7 @@ static int eval_constraints(fit_problem *fp, const mech_model *m, const mech_tab
             if (k < n) {
                 int x[2];
                 for (int w = 0; w < 2; w++) {
-                    snprintf(name, sizeof name, "d(%s.angle)/d(%s)", w ? mf->trans_b : mf->trans_a,
+                    snprintf(name, sizeof name, "d(%s.angle)/d(%s)", w ? fp->trans_b : fp->trans_a,
                              fp->names[k]);
                     x[w] = mech_table_column(t, name);
                 }
@@ -273,7 +288,7 @@ static int eval_constraints(fit_problem *fp, const mech_model *m, const mech_tab
             } else if (k - n == i) {  /* free timing: d(da)/dq_i from the rates */
                 int x[2];
                 for (int w = 0; w < 2; w++) {
-                    snprintf(name, sizeof name, "%s.omega", w ? mf->trans_b : mf->trans_a);
+                    snprintf(name, sizeof name, "%s.omega", w ? fp->trans_b : fp->trans_a);
                     x[w] = mech_table_column(t, name);
                 }
                 dd = ((x[0] < 0 ? 0.0 : mech_table_get(t, i, x[0])) -
@@ -282,7 +297,6 @@ static int eval_constraints(fit_problem *fp, const mech_model *m, const mech_tab
             jac[(size_t)k * mrows + base2 + i] = f * dd;
         }
     }
-    (void)p;
     return MECH_OK;
 }
 
@@ -351,7 +365,7 @@ int fit_eval(fit_problem *fp, const double *p, double *r, double *jac, mech_diag
             }
         }
     }
-    rc = eval_constraints(fp, m, &t, p, r, jac);
+    rc = eval_constraints(fp, m, &t, r, jac);
     if (rc == MECH_ENOMEM)
         rc = diag_nomem(d, fp->path, (mech_mark){0, 0});
 done:

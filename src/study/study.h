@@ -262,6 +262,9 @@ typedef struct fit_problem {
      * a transmission one per target row, g_i = min - asin|sin(a_i - b_i)| */
     int ncons;                 /* expression constraints */
     int trans;                 /* 1: a transmission constraint (its links' angles solved) */
+    char trans_a[64], trans_b[64];  /* its links: set before fit_prepare (--transmission),
+                                  else fit_prepare takes the file's */
+    double trans_min;          /* its least angle, rad */
     double *con_scale;         /* [ncons] the size each tolerance is relative to; owned */
 } fit_problem;
 

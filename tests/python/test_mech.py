@@ -405,6 +405,12 @@ def test_fit_keeps_the_constraints(tmp_path):
         mech.fit(bad, free=['r', 'l', 'b'], target=path)
     assert "bad.yaml:42:20: error: fit: constraint 'l <= 3 kg': cannot subtract" in str(e.value)
     assert e.value.status == mech.EINPUT
+    # the least transmission angle (53.13 deg for the answer) held at 60 deg
+    plain = tmp_path / 'moved.yaml'
+    plain.write_text(moved)
+    t = mech.fit(plain, free=['r=15mm:25mm', 'l=50mm:70mm', 'b=40mm:60mm'], target=path,
+                 starts=2, transmission=('coupler', 'rocker', 60))
+    assert abs(t['margins']['transmission coupler/rocker']) < 1e-9
     never = tmp_path / 'never.yaml'
     never.write_text(moved + 'fit:\n  constraints: ["r >= 30 mm"]\n')
     with pytest.raises(mech.MechError) as e:
