@@ -29,9 +29,10 @@ KLU_LIBS   := $(shell pkg-config --libs klu 2>/dev/null || echo -lklu -lbtf -lam
 YAML_CFLAGS := $(shell pkg-config --cflags yaml-0.1 2>/dev/null)
 YAML_LIBS   := $(shell pkg-config --libs yaml-0.1 2>/dev/null || echo -lyaml)
 CRIT_LIBS   := $(shell pkg-config --libs criterion 2>/dev/null || echo -lcriterion)
-# MINPACK (libcminpack-dev): mech fit's least squares, in the mech binary and
-# the unit tests only (src/cli/cmd_fit_lm.c), never in libmech: Debian ships
-# no static libcminpack.a for a `pkg-config --static` link of the library.
+# MINPACK (libcminpack-dev): mech fit's least squares (src/study/fit_lm.c),
+# linked into libmech.so (shared). Debian ships no static libcminpack.a, so
+# mech.pc's Libs.private leaves it out: a static link pulls fit_lm.o (and
+# needs -lcminpack) only when it calls mech_fit, which api_example does not.
 MINPACK_CFLAGS := $(shell pkg-config --cflags cminpack 2>/dev/null || echo -I/usr/include/cminpack-1)
 MINPACK_LIBS   := $(shell pkg-config --libs cminpack 2>/dev/null || echo -lcminpack)
 # NLopt (libnlopt-dev): the gradient-free minimisers `make bench` compares mech
@@ -73,7 +74,7 @@ HDF5_LIBS   := $(shell pkg-config --libs hdf5-serial 2>/dev/null || echo -lhdf5_
 # SUNDIALS CVODE (mech simulate, docs/dynamics.md): Debian's libsundials-dev
 SUNDIALS_LIBS = -lsundials_cvode -lsundials_sunlinsoldense -lsundials_sunmatrixdense \
                 -lsundials_nvecserial -lsundials_generic
-LDLIBS  = $(YAML_LIBS) $(KLU_LIBS) $(SUNDIALS_LIBS) $(HDF5_LIBS) -lm -pthread
+LDLIBS  = $(YAML_LIBS) $(KLU_LIBS) $(SUNDIALS_LIBS) $(HDF5_LIBS) $(MINPACK_LIBS) -lm -pthread
 LDFLAGS = $(SAN) -pthread
 
 # src/ is one folder per stage of the pipeline, each with one header
@@ -335,9 +336,9 @@ $(BUILD)/bench-solve: bench/bench_solve.c bench/bench_util.h $(BUILD)/libmech.a 
 $(BUILD)/bench-sweep: bench/bench_sweep.c $(BUILD)/libmech.a $(HEADERS)
 	$(CC) $(CFLAGS) -o $@ $< $(BUILD)/libmech.a $(LDLIBS)
 
-# mech fit's lmder (cmd_fit_lm.o, MINPACK) against NLopt's gradient-free methods
-$(BUILD)/bench-fit: bench/bench_fit.c $(BUILD)/obj/cmd_fit_lm.o $(BUILD)/libmech.a $(HEADERS)
-	$(CC) $(CFLAGS) $(NLOPT_CFLAGS) -o $@ $< $(BUILD)/obj/cmd_fit_lm.o $(BUILD)/libmech.a \
+# mech fit's lmder (src/study/fit_lm.c, MINPACK) against NLopt's gradient-free methods
+$(BUILD)/bench-fit: bench/bench_fit.c $(BUILD)/libmech.a $(HEADERS)
+	$(CC) $(CFLAGS) $(NLOPT_CFLAGS) -o $@ $< $(BUILD)/libmech.a \
 	    $(MINPACK_LIBS) $(NLOPT_LIBS) $(LDLIBS)
 
 $(BUILD)/bench-alloc: bench/bench_alloc.c $(BUILD)/libmech.a $(HEADERS)

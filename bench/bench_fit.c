@@ -8,7 +8,7 @@
  *   function  rocker.angle (function generation)
  * each from the start 10 % off (r 22, l 55, b 53 mm) and over the bounds.
  * The methods:
- *   lmder     mech fit's own local fit (fit_lm, src/cli/cmd_fit_lm.c: MINPACK
+ *   lmder     mech fit's own local fit (fit_lm, src/study/fit_lm.c: MINPACK
  *             with the exact Jacobian), one start, then mech fit's 16 starts
  *             (the start, then the Halton points of the bounds) one after
  *             the other on one thread;

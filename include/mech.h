@@ -660,6 +660,58 @@ void mech_simulate_options_default(mech_simulate_options *o);
 int mech_simulate(const mech_model *m, const mech_simulate_options *o, mech_table *out,
                   mech_simulate_stats *stats, mech_diag *d);
 
+/* ---- Synthesis (src/output/fit_setup.c, src/study/fit*.c, docs/synthesis.md)
+ * mech_fit fits the file's free parameters so that solved outputs meet
+ * targets read from a CSV, as `mech fit FILE` does (least squares, MINPACK
+ * lmder, exact Jacobian, bounds, constraints, several starts): the options
+ * are those of the command; what they leave NULL or 0 comes from the file's
+ * `fit:` section. libmech.so links MINPACK (libcminpack); a static link
+ * that calls mech_fit adds -lcminpack. */
+typedef struct mech_fit_options {
+    const char *free;              /* "r=15mm:25mm,l,b" as --free; NULL: the fit: section's */
+    const char *target;            /* the targets' CSV; NULL: the fit: section's (relative
+                                      to the file's folder) */
+    const char *const *columns;    /* [ncolumns] target columns; 0: the section's, or every
+                                      column after the first */
+    int ncolumns;
+    const char *const *weights;    /* [nweights] "COLUMN=W" */
+    int nweights;
+    int starts;                    /* 0: the section's, else 16 with bounds on every free
+                                      parameter, else 1 */
+    int jobs;                      /* worker threads; 0: the default */
+    int whole_range, free_timing;  /* 1: on (as the flags; the section may turn them on) */
+    const char *transmission;      /* "A,B,MIN" as --transmission; NULL: the section's */
+} mech_fit_options;
+
+typedef struct mech_fit_result {
+    int nfree;
+    char **names;           /* [nfree] the free parameters, owned */
+    double *values;         /* [nfree] the best solution, SI */
+    double objective;       /* its sum of squared weighted residuals (SI) */
+    int ncolumns;
+    char **columns;         /* [ncolumns] the target columns, owned */
+    double *worst_error;    /* [ncolumns] the largest |solved - target|, SI */
+    int nconstraints;
+    char **constraints;     /* [nconstraints] the fit: section's constraints as written,
+                               then "transmission A/B" */
+    double *margins;        /* [nconstraints] -g, SI (>= 0: met; a transmission's least
+                               angle minus its min, rad) */
+    int info;               /* lmder's info for the best (1..4 converged, 5 the limit) */
+    int starts, accepted;   /* local fits run; those accepted */
+    int violated;           /* rejected for a violated constraint */
+    long solves;            /* evaluations (the file loaded and the targets solved) */
+    double seconds;         /* wall time */
+} mech_fit_result;
+
+void mech_fit_options_default(mech_fit_options *o);
+/* The fit of the file at path. MECH_OK with the best solution in *r (free
+ * with mech_fit_result_free); MECH_ESOLVE when no start gives a solution
+ * that assembles at every target within the constraints (*r's counts say
+ * how many ran); MECH_EINPUT (the file, the targets, the options), MECH_EIO,
+ * MECH_ENOMEM, with the errors in d. */
+int mech_fit(const char *path, const mech_fit_options *o, mech_fit_result *r, mech_diag *d);
+void mech_fit_result_free(mech_fit_result *r);
+
 /* Sensitivities (src/study/sensitivity.c, docs/sensitivity.md): to `table`, the
  * result of mech_solve(m, o, ...), add for each parameter names[k] and each
  * kinematic column COL (points' x, y, vx, vy, ax, ay; links' angle, omega,

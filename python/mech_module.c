@@ -729,6 +729,129 @@ static PyObject *py_simulate(PyObject *self, PyObject *args, PyObject *kw)
     return result;
 }
 
+/* ---- synthesis (mech_fit) ---------------------------------------------- */
+
+/* A list of str into texts (UTF-8 buffers owned by the str objects, which
+ * the list keeps); NULL/None: none. -1 with an exception set. */
+static int str_list(PyObject *list, const char *what, const char **out, int max, int *n)
+{
+    *n = 0;
+    if (list == NULL || list == Py_None)
+        return 0;
+    if (!PyList_Check(list) && !PyTuple_Check(list)) {
+        PyErr_Format(PyExc_TypeError, "%s must be a list of str", what);
+        return -1;
+    }
+    Py_ssize_t len = PySequence_Fast_GET_SIZE(list);
+    if (len > max) {
+        PyErr_Format(PyExc_ValueError, "%s: at most %d", what, max);
+        return -1;
+    }
+    for (Py_ssize_t i = 0; i < len; i++) {
+        PyObject *item = PySequence_Fast_GET_ITEM(list, i);
+        if (!PyUnicode_Check(item)) {
+            PyErr_Format(PyExc_TypeError, "%s must be a list of str", what);
+            return -1;
+        }
+        if (!(out[i] = PyUnicode_AsUTF8(item)))
+            return -1;
+    }
+    *n = (int)len;
+    return 0;
+}
+
+/* _mech.fit(path, free=None, target=None, columns=None, weights=None,
+ * starts=0, jobs=0, whole_range=False, free_timing=False) -> dict:
+ * mech_fit (docs/synthesis.md), the best solution in SI */
+static PyObject *py_fit(PyObject *self, PyObject *args, PyObject *kw)
+{
+    static char *kwlist[] = {"path", "free", "target", "columns", "weights", "starts", "jobs",
+                             "whole_range", "free_timing", "transmission", NULL};
+    PyObject *path, *columns = Py_None, *weights = Py_None, *bytes = NULL, *tbytes = NULL;
+    PyObject *target = Py_None;
+    const char *free_text = NULL;
+    mech_fit_options o;
+    mech_fit_options_default(&o);
+    (void)self;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "O|zOOOiippz", kwlist, &path, &free_text,
+                                     &target, &columns, &weights, &o.starts, &o.jobs,
+                                     &o.whole_range, &o.free_timing, &o.transmission))
+        return NULL;
+    if (o.starts < 0 || o.starts > 100000 || o.jobs < 0)
+        return PyErr_Format(PyExc_ValueError, "starts must be 1 to 100000 (0: the default), "
+                            "jobs >= 0");
+    const char *cols[64], *ws[64];
+    if (str_list(columns, "columns", cols, 64, &o.ncolumns) < 0 ||
+        str_list(weights, "weights", ws, 64, &o.nweights) < 0)
+        return NULL;
+    o.columns = cols;
+    o.weights = ws;
+    o.free = free_text;
+    if (!PyUnicode_FSConverter(path, &bytes))
+        return NULL;
+    if (target != Py_None && !PyUnicode_FSConverter(target, &tbytes)) {
+        Py_DECREF(bytes);
+        return NULL;
+    }
+    o.target = tbytes ? PyBytes_AS_STRING(tbytes) : NULL;
+    const char *file = PyBytes_AS_STRING(bytes);
+    mech_fit_result r;
+    mech_diag d;
+    int rc;
+    mech_diag_init(&d);
+    Py_BEGIN_ALLOW_THREADS
+    rc = mech_fit(file, &o, &r, &d);
+    Py_END_ALLOW_THREADS
+    PyObject *result = NULL, *params = NULL, *worst = NULL, *margins = NULL;
+    if (rc != MECH_OK) {
+        raise_mech(rc, &d, NULL, NULL);
+        goto out;
+    }
+    params = PyDict_New();
+    worst = PyDict_New();
+    margins = PyDict_New();
+    if (!params || !worst || !margins)
+        goto out;
+    for (int k = 0; k < r.nfree; k++) {
+        PyObject *v = PyFloat_FromDouble(r.values[k]);
+        if (!v || PyDict_SetItemString(params, r.names[k], v) < 0) {
+            Py_XDECREF(v);
+            goto out;
+        }
+        Py_DECREF(v);
+    }
+    for (int j = 0; j < r.ncolumns; j++) {
+        PyObject *v = PyFloat_FromDouble(r.worst_error[j]);
+        if (!v || PyDict_SetItemString(worst, r.columns[j], v) < 0) {
+            Py_XDECREF(v);
+            goto out;
+        }
+        Py_DECREF(v);
+    }
+    for (int c = 0; c < r.nconstraints; c++) {
+        PyObject *v = PyFloat_FromDouble(r.margins[c]);
+        if (!v || PyDict_SetItemString(margins, r.constraints[c], v) < 0) {
+            Py_XDECREF(v);
+            goto out;
+        }
+        Py_DECREF(v);
+    }
+    result = Py_BuildValue("{s:O,s:d,s:O,s:O,s:l,s:d,s:i,s:s,s:i,s:i,s:i}", "params", params,
+                           "objective", r.objective, "worst_error", worst, "margins", margins,
+                           "solves", r.solves, "seconds", r.seconds, "info", r.info, "status",
+                           r.info >= 1 && r.info <= 4 ? "converged" : "not converged",
+                           "starts", r.starts, "accepted", r.accepted, "violated", r.violated);
+out:
+    Py_XDECREF(params);
+    Py_XDECREF(worst);
+    Py_XDECREF(margins);
+    mech_fit_result_free(&r);
+    mech_diag_free(&d);
+    Py_XDECREF(tbytes);
+    Py_DECREF(bytes);
+    return result;
+}
+
 /* ---- sweeps (mech_sweep) ------------------------------------------------ */
 
 /* The rows of a sweep as mech_sweep_run hands them over, written straight
@@ -952,6 +1075,9 @@ static PyMethodDef methods[] = {
      "simulate(path, to=None, step=None, rtol=None, atol=None, method=None, "
      "stop_at_rest=False, stop_when=None) -> "
      "(names, units, arrays, stats, messages): mech_simulate"},
+    {"fit", (PyCFunction)(void (*)(void))py_fit, METH_VARARGS | METH_KEYWORDS,
+     "fit(path, free=None, target=None, columns=None, weights=None, starts=0, jobs=0, "
+     "whole_range=False, free_timing=False, transmission=None) -> dict: mech_fit (synthesis)"},
     {NULL, NULL, 0, NULL}};
 
 static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "mech._mech",

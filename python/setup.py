@@ -2,7 +2,8 @@
 that runs it (pip install ./python; docs/api.md, "Python"). The extension
 mech._mech is python/mech_module.c with libmech's own sources (src/*/*.c but
 the command line's, src/cli/) compiled in, so it needs no installed libmech, only
-Debian's libyaml, SuiteSparse KLU and SUNDIALS CVODE; numpy's headers are those of the
+Debian's libyaml, SuiteSparse KLU, SUNDIALS CVODE and MINPACK (libcminpack, for
+mech.fit); numpy's headers are those of the
 running interpreter's numpy (python/buildinfo.py, which the Makefile's
 `make install PYTHON=...` uses too), and the extension records what it was
 built for, to say so when another interpreter imports it."""
@@ -104,6 +105,16 @@ def sundials_libs():
     return m.group(1).replace('\\\n', ' ').split()
 
 
+def minpack():
+    """MINPACK's flags for mech_fit's lmder (src/study/fit_lm.c): the
+    Makefile's MINPACK_CFLAGS and MINPACK_LIBS, pkg-config's cminpack with the
+    same fallbacks (Debian's libcminpack-dev)."""
+    return (pkg_config('--cflags', 'cminpack', ['-I/usr/include/cminpack-1']),
+            pkg_config('--libs', 'cminpack', ['-lcminpack']))
+
+
+minpack_cflags, minpack_libs = minpack()
+
 extension = Extension(
     'mech._mech',
     sources=['mech_module.c'] + library_sources() + [runtime_text()],
@@ -113,8 +124,10 @@ extension = Extension(
     depends=[os.path.relpath(h, HERE) for h in [os.path.join(ROOT, 'include', 'mech.h')] +
              sorted(glob.glob(os.path.join(ROOT, 'src', '*', '*.h')))],
     define_macros=buildinfo.define_macros(),
-    extra_compile_args=['-std=c11', '-D_POSIX_C_SOURCE=200809L'] + klu_cflags + hdf5_cflags,
-    extra_link_args=yaml_libs + klu_libs + sundials_libs() + hdf5_libs + ['-lm', '-pthread'],
+    extra_compile_args=['-std=c11', '-D_POSIX_C_SOURCE=200809L'] + klu_cflags + hdf5_cflags +
+    minpack_cflags,
+    extra_link_args=yaml_libs + klu_libs + sundials_libs() + hdf5_libs + minpack_libs +
+    ['-lm', '-pthread'],
 )
 
 setup(

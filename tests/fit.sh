@@ -204,6 +204,108 @@ sed 's/^    r: \[15 mm, 25 mm\]/    rr: [15 mm, 25 mm]/' "$tmp/section.yaml" >"$
 run "fit: section, not a parameter" 2 "$MECH" fit "$tmp/section-bad.yaml" &&
     has_line "$tmp/err" "section-bad.yaml:[0-9]*:5: error: fit: 'rr' is not one of the file's parameters" "fit: section: message"
 
+# constraints that steer (docs/synthesis.md 4): the known dimensions (l / r
+# = 3) violate l / r >= 3.2, so the fit must end on that boundary; there it
+# is the fit of the file with l written 3.2 r (the boundary itself) and r, b
+# free, to 1e-8 mm. The Grashof condition r + d <= l + b holds with a margin.
+cp "$tmp/moved.yaml" "$tmp/ratio.yaml"
+cat >>"$tmp/ratio.yaml" <<'END'
+fit:
+  constraints:
+    - "l / r >= 3.2"            # a link ratio the known answer (3) violates
+    - r + d <= l + b            # Grashof, the crank the shortest: it turns
+END
+sed 's/^  l: 55 mm .*/  l: 3.2 * r/' "$tmp/moved.yaml" >"$tmp/ratio-sub.yaml"
+if run "ratio" 0 "$MECH" fit "$tmp/ratio.yaml" --free r,l,b --target "$tmp/path.csv" -o "$tmp/ratio-best.yaml"; then
+    rr=$(value r "$tmp/ratio-best.yaml") rl=$(value l "$tmp/ratio-best.yaml") rb=$(value b "$tmp/ratio-best.yaml")
+    near "$(awk -v l="$rl" -v r="$rr" 'BEGIN { printf "%.17g", l / r }')" 3.2 1e-9 && pass ||
+        fail "ratio: l / r = $rl / $rr, expected 3.2 (on the boundary)"
+    has_line "$tmp/out" '^  l / r >= 3.2  *margin -\{0,1\}[0-9.e+-]*   (active: on the boundary)$' "ratio: its margin"
+    has_line "$tmp/out" '^  r + d <= l + b  *margin 23.19[0-9]* mm$' "ratio: Grashof's margin"
+    has_line "$tmp/out" '^starts  *1 (1 assembled at every target within the constraints, 0 rejected, 0 of them violating a constraint)$' "ratio: starts"
+    if run "ratio, on the boundary" 0 "$MECH" fit "$tmp/ratio-sub.yaml" --free r,b --target "$tmp/path.csv" -o "$tmp/ratio-sub-best.yaml"; then
+        near "$rr" "$(value r "$tmp/ratio-sub-best.yaml")" 1e-8 && pass ||
+            fail "ratio: r = $rr, on the boundary $(value r "$tmp/ratio-sub-best.yaml")"
+        near "$rb" "$(value b "$tmp/ratio-sub-best.yaml")" 1e-8 && pass ||
+            fail "ratio: b = $rb, on the boundary $(value b "$tmp/ratio-sub-best.yaml")"
+    fi
+fi
+# the transmission angle between coupler and rocker, at least 60 deg at
+# every target (the known four-bar's least is 53.13 deg, at q = 0): the
+# written mechanism solved at the targets' angles must keep it; at least
+# 10 deg is inactive and changes nothing
+cp "$tmp/moved.yaml" "$tmp/trans.yaml"
+printf 'fit:\n  transmission: {links: [coupler, rocker], min: 60 deg}\n' >>"$tmp/trans.yaml"
+if run "transmission" 0 "$MECH" fit "$tmp/trans.yaml" --free r=15:25,l=50:70,b=40:60 --starts 4 \
+    --target "$tmp/path.csv" -o "$tmp/trans-best.yaml"; then
+    has_line "$tmp/out" '^  transmission coupler/rocker margin -\{0,1\}[0-9.e+-]* deg (least 60 deg, at q = 0 deg)$' "transmission: its margin"
+    "$MECH" solve "$tmp/trans-best.yaml" --from 0 --to 330 --steps 11 --outputs rocker,coupler \
+        --level positions --units file -o "$tmp/trans.csv" 2>/dev/null || fail "transmission: solve the result"
+    awk -F, 'NR > 1 { d = ($3 - $2) * atan2(1, 1) / 45; s = sin(d); if (s < 0) s = -s
+                      mu = atan2(s, sqrt(1 - s * s)) * 45 / atan2(1, 1); if (mu < least) least = mu }
+             BEGIN { least = 90 } END { exit !(least >= 60 - 1e-6 && least <= 60 + 1e-6) }' \
+        "$tmp/trans.csv" && pass || fail "transmission: the result's least angle is not 60 deg"
+    obj=$(sed -n 's/^objective *\([^ ]*\).*/\1/p' "$tmp/out")
+    near "$obj" 0 1e-8 && fail "transmission: objective $obj, expected a residual" || pass
+fi
+# --transmission states the same on the command line: the same answer
+if run "--transmission" 0 "$MECH" fit "$tmp/moved.yaml" --free r=15:25,l=50:70,b=40:60 --starts 4 \
+    --target "$tmp/path.csv" --transmission coupler,rocker,60deg -o "$tmp/trans-opt.yaml"; then
+    for n in r l b; do
+        near "$(value $n "$tmp/trans-opt.yaml")" "$(value $n "$tmp/trans-best.yaml")" 1e-9 && pass ||
+            fail "--transmission: $n = $(value $n "$tmp/trans-opt.yaml"), the section's $(value $n "$tmp/trans-best.yaml")"
+    done
+fi
+run "--transmission, not a link" 2 "$MECH" fit "$tmp/moved.yaml" --free r,l,b --target "$tmp/path.csv" \
+    --transmission coupler,crankk,60 -o "$tmp/x.yaml" &&
+    has_line "$tmp/err" "error: transmission: 'crankk' is not a moving link of the file" "--transmission, not a link: message"
+run "--transmission, 95 deg" 2 "$MECH" fit "$tmp/moved.yaml" --free r,l,b --target "$tmp/path.csv" \
+    --transmission coupler,rocker,95deg -o "$tmp/x.yaml" &&
+    has_line "$tmp/err" "the least angle must lie between 0 and 90 deg, not '95deg'" "--transmission, 95 deg: message"
+run "--transmission, no angle" 2 "$MECH" fit "$tmp/moved.yaml" --free r,l,b --target "$tmp/path.csv" \
+    --transmission coupler,rocker -o "$tmp/x.yaml" &&
+    has_line "$tmp/err" "transmission needs LINK,LINK,MIN" "--transmission, no angle: message"
+sed 's/min: 60 deg/min: 10 deg/' "$tmp/trans.yaml" >"$tmp/trans10.yaml"
+if run "transmission, inactive" 0 "$MECH" fit "$tmp/trans10.yaml" --free r,l,b --target "$tmp/path.csv" \
+    -o "$tmp/trans10-best.yaml"; then
+    near "$(value r "$tmp/trans10-best.yaml")" 20 1e-6 && pass || fail "transmission, inactive: r"
+    has_line "$tmp/out" '^  transmission coupler/rocker margin 43.130[0-9]* deg (least 53.130[0-9]* deg, at q = 0 deg)$' "transmission, inactive: margin"
+fi
+# both kinds at once, with free timing: the ratio and the transmission
+# (least 55 deg) end on their boundaries, each margin within its tolerance
+cp "$tmp/moved.yaml" "$tmp/both.yaml"
+printf 'fit:\n  constraints: ["l / r >= 3.1"]\n  transmission: {links: [coupler, rocker], min: 55 deg}\n' >>"$tmp/both.yaml"
+if run "constraints, free timing" 0 "$MECH" fit "$tmp/both.yaml" --free r,l,b --target "$tmp/path.csv" --free-timing; then
+    has_line "$tmp/out" '^  l / r >= 3.1  *margin -\{0,1\}[0-9.]*e-1[0-9]   (active: on the boundary)$' "free timing: the ratio on its boundary"
+    has_line "$tmp/out" '^  transmission coupler/rocker margin -\{0,1\}[0-9.]*e-1[0-9] deg (least 55 deg' "free timing: the transmission on its boundary"
+fi
+# a constraint no mechanism within the bounds meets: every start rejected
+# (never reported as a solution), exit 1, no file
+cp "$tmp/moved.yaml" "$tmp/never.yaml"
+printf 'fit:\n  constraints: ["r >= 30 mm"]\n' >>"$tmp/never.yaml"
+if run "constraint never met" 1 "$MECH" fit "$tmp/never.yaml" --free r=15:25,l,b --starts 3 \
+    --target "$tmp/path.csv" -o "$tmp/never-best.yaml"; then
+    has_line "$tmp/out" '^starts  *3 (0 assembled at every target within the constraints, 3 rejected, 3 of them violating a constraint)$' "never met: starts"
+    has_line "$tmp/err" 'no start assembles at every target within the constraints' "never met: message"
+    [ ! -e "$tmp/never-best.yaml" ] && pass || fail "never met: a file was written"
+fi
+# bad constraints: the file, line and column of the problem, exit 2, no file
+bad_constraint() {  # LABEL CONSTRAINT COLUMN MESSAGE
+    cp "$tmp/moved.yaml" "$tmp/badc.yaml"
+    printf 'fit:\n  constraints:\n    - %s\n' "$2" >>"$tmp/badc.yaml"
+    run "constraint: $1" 2 "$MECH" fit "$tmp/badc.yaml" --free r,l,b --target "$tmp/path.csv" -o "$tmp/x.yaml" &&
+        has_line "$tmp/err" "badc.yaml:43:$3: error: fit: constraint $4" "constraint: $1: message"
+}
+bad_constraint "unknown name" '"l / rr >= 3"' 12 "'l / rr >= 3': unknown name 'rr'"
+bad_constraint "mixed units" 'l + phi <= 3 mm' 9 "'l + phi <= 3 mm': cannot add a length (m) and an angle (rad) (both sides"
+bad_constraint "mixed sides" '"l <= 3 kg"' 10 "'l <= 3 kg': cannot subtract a length (m) and a mass (kg)"
+bad_constraint "no comparison" '"l + r"' 7 "'l + r' is not an inequality"
+bad_constraint "two comparisons" 'l <= r <= b' 14 "'l <= r <= b' has more than one comparison"
+cp "$tmp/moved.yaml" "$tmp/badc.yaml"
+printf 'fit:\n  transmission: {links: [coupler, crankk], min: 30 deg}\n' >>"$tmp/badc.yaml"
+run "transmission: not a link" 2 "$MECH" fit "$tmp/badc.yaml" --free r,l,b --target "$tmp/path.csv" -o "$tmp/x.yaml" &&
+    has_line "$tmp/err" "badc.yaml:42:35: error: fit: transmission: 'crankk' is not a moving link of the file" "transmission: not a link: message"
+
 # a constraint the unconstrained optimum violates: targets of a four-bar
 # whose crank cannot turn fully (r 45 mm: s + l = 45 + 70 > 60 + 50, not
 # Grashof), over the part of the turn where it assembles. Free r finds 45;

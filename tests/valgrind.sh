@@ -59,6 +59,10 @@ sed -e 's/^  r: 20 mm/  r: 22 mm/' -e 's/^  l: 60 mm/  l: 55 mm/' tests/fit/four
 check "mech fit (4 starts on 2 threads)" fit "$tmp/moved.yaml" --free r=15:25,l=50:70 --target "$tmp/path.csv" \
     --starts 4 -j 2 -o "$tmp/best.yaml"
 check "mech fit, unknown column" fit "$tmp/moved.yaml" --free r --target "$tmp/all.csv" --column Q.x
+# the fit: section's constraints steering a free-timing fit (both active)
+cp "$tmp/moved.yaml" "$tmp/cons.yaml"
+printf 'fit:\n  constraints: ["l / r >= 3.1"]\n  transmission: {links: [coupler, rocker], min: 55 deg}\n' >>"$tmp/cons.yaml"
+check "mech fit, constraints and free timing" fit "$tmp/cons.yaml" --free r,l,b --target "$tmp/path.csv" --free-timing
 
 # mech watch: served, saved (good, broken, good again), requests refused,
 # a long poll and an idle connection open at SIGINT; nothing may leak

@@ -19,6 +19,7 @@ is the library's, one 'file:line:column: error: message' per line, and whose
 of FAIL_KINDS), so that no program has to read the message's words.
 See docs/api.md.
 """
+import os
 import numbers
 
 try:
@@ -46,7 +47,7 @@ except ModuleNotFoundError as e:
 from . import _mech
 
 __all__ = ['MechError', 'Result', 'SweepResult', 'load', 'check', 'solve', 'simulate', 'sweep',
-           'read',
+           'read', 'fit',
            'VERSION',
            'EINPUT', 'ENOMEM', 'EIO', 'ESOLVE', 'FAIL_KINDS', 'VARIANT_STATUS']
 __version__ = VERSION
@@ -200,6 +201,50 @@ def simulate(path, to=None, step=None, rtol=None, atol=None, method=None, stop_a
             e.partial = Result(*e.partial)
         raise
     return Result(names, units, arrays, stats, messages)
+
+
+def fit(path, free=None, target=None, starts=None, jobs=None, columns=None, weights=None,
+        whole_range=False, free_timing=False, transmission=None):
+    """Dimensional synthesis, as `mech fit` (docs/synthesis.md): the values of
+    the file's free parameters that make the solved outputs meet the targets,
+    by least squares (MINPACK lmder, exact Jacobian, several starts), within
+    the bounds and the constraints of the file's `fit:` section.
+
+    free        the parameters to fit: a list of names, each 'NAME' or
+                'NAME=LO:HI' ('r=15mm:25mm'), or a str 'r,l=50mm:70mm'
+                (default: the fit: section's, with its bounds)
+    target      the targets' CSV (default: the fit: section's)
+    starts      local fits (default: the section's, else 16 when every free
+                parameter has bounds, else 1)
+    jobs        worker threads (default: the cores)
+    columns     the CSV's columns to fit (default: every one after the first)
+    weights     {column: weight} (default 1)
+    whole_range, free_timing   as the command's flags
+    transmission  (link_a, link_b, min) or 'coupler,rocker,40deg': the least
+                angle between two links at every target (default: the
+                section's); min a str with its unit or a number of degrees
+
+    Returns a dict: 'params' {name: value in SI}, 'objective' (sum of
+    squared weighted residuals, SI), 'worst_error' {column: SI},
+    'margins' {constraint: -g in SI, >= 0 met}, 'solves', 'seconds',
+    'status' ('converged' or 'not converged'), 'info' (lmder's), 'starts',
+    'accepted', 'violated'. Raises MechError for bad input, and with
+    status ESOLVE when no start gives a solution (none assembles at every
+    target within the constraints)."""
+    if free is not None and not isinstance(free, str):
+        free = ','.join(free)
+    if weights is not None:
+        weights = ['%s=%r' % (k, float(v)) for k, v in dict(weights).items()]
+    if columns is not None:
+        columns = list(columns)
+    if transmission is not None and not isinstance(transmission, str):
+        a, b, least = transmission
+        transmission = '%s,%s,%s' % (a, b, least if isinstance(least, str) else '%rdeg' % float(least))
+    return _mech.fit(os.fspath(path), free=free,
+                     target=None if target is None else os.fspath(target),
+                     columns=columns, weights=weights, starts=starts or 0, jobs=jobs or 0,
+                     whole_range=bool(whole_range), free_timing=bool(free_timing),
+                     transmission=transmission)
 
 
 # mech_variant_status, in its order: the status column of `mech sweep`

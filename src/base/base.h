@@ -216,8 +216,23 @@ typedef struct model_fit {
     int starts;        /* 0: the default */
     int whole_range;   /* 1: the solution must assemble over the file's whole range */
     int free_timing;   /* 1: each target row's driver position is an unknown too */
+    struct model_fit_con *cons;  /* [ncons] constraints: "EXPR <= EXPR" (docs/synthesis.md 4) */
+    int ncons;
+    char *trans_a, *trans_b;     /* transmission: the two links, or NULL */
+    double trans_min;            /* the least angle between them, rad (0 .. pi/2) */
+    mech_mark trans_mark;
     mech_mark mark;
 } model_fit;
+/* One constraint g <= 0 of the fit: section, g = (the side that must be the
+ * smaller) - (the other), in SI, at the values the file was loaded with. */
+typedef struct model_fit_con {
+    char *text;        /* as written */
+    double g;          /* its value: <= 0 holds */
+    double scale;      /* max(|left|, |right|), SI: the size the tolerance is relative to */
+    int h;             /* g's handle in the model's parameter expressions (param_expr.h) */
+    char unit[32];     /* g's SI unit ("" a pure number) */
+    mech_mark mark;
+} model_fit_con;
 void model_fit_free_all(model_fit *f);  /* accepts NULL */
 
 /* ---- yamltree.c: a bounded YAML document tree with marks. */

@@ -239,15 +239,6 @@ int cmd_convert(int argc, char **argv);
 /* `mech fit FILE --free ... --target CSV` (cmd_fit.c, docs/synthesis.md). */
 extern const cmd_spec cmd_fit_spec;
 int cmd_fit(int argc, char **argv);
-/* cmd_fit_lm.c: one local fit of fp from p[nfree] (in: the start, in the
- * bounds lo[k] < hi[k], or both infinite: none; out: the solution) by
- * MINPACK's lmder with the bounds as a change of variable; r[nq ncols]:
- * the solution's residuals, *objective their sum of squares, *info
- * lmder's. MECH_OK; MECH_ESOLVE when the start (or, never expected, the
- * solution) does not assemble at every target; MECH_ENOMEM. */
-typedef struct fit_problem fit_problem;  /* src/study/study.h */
-int fit_lm(fit_problem *fp, const double *lo, const double *hi, double *p, double *r,
-           double *objective, int *info);
 
 /* `mech draw FILE -o OUT.svg` (cmd_draw.c, docs/plots.md): the assembled
  * position with names, and the stated pose beside it when they differ;

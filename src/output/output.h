@@ -488,4 +488,57 @@ typedef void (*describe_emit)(void *ctx, const char *label, const char *text);
  * gear pair. */
 void model_describe(const mech_model *m, const mech_summary *s, describe_emit emit, void *ctx);
 
+
+/* ==== fit_setup ==== */
+/* fit_setup.c: mech fit's problem stated from the command's options or the
+ * file's fit: section (docs/synthesis.md): the free parameters and bounds,
+ * the targets read and converted to SI, the columns and weights. Declared
+ * for the files that include study.h first (fit_setup.c, cmd_fit.c): this
+ * header does not pull study.h's (and the symbolic stage's) names into
+ * every file of the output stage. */
+#ifdef MECH_STUDY_STAGE_H
+enum { FIT_MAX_COLS = 64 };
+typedef struct fit_request {
+    const char *file;                 /* the mechanism */
+    const char *free;                 /* "r=15mm:25mm,l", or NULL: the fit: section's */
+    const char *target;               /* or NULL: the section's (relative to the file) */
+    const char *const *columns;
+    int ncolumns;
+    const char *const *weights;       /* "COLUMN=W" */
+    int nweights;
+    int whole_range, free_timing;     /* 1: on */
+    const char *transmission;         /* "A,B,MIN" (links and least angle), or NULL: the
+                                         fit: section's */
+} fit_request;
+
+typedef struct fit_setup {
+    fit_problem fp;
+    const char *names[FIT_MAX_FREE];
+    char *free_copy;
+    const char *bound_text[FIT_MAX_FREE][2];  /* LO, HI as given, or NULL */
+    char unit[FIT_MAX_FREE][32];
+    mech_mark mark[FIT_MAX_FREE];
+    double lo[FIT_MAX_VARS], hi[FIT_MAX_VARS], p0[FIT_MAX_FREE];  /* lo, hi: also the timing's */
+    const char *cols[FIT_MAX_COLS];
+    char col_unit[FIT_MAX_COLS][16];
+    double weight[FIT_MAX_COLS];
+    int csv_col[FIT_MAX_COLS];  /* the CSV's column of each target column */
+    compare_table csv;
+    double *q, *target;
+    char target_path[4096];
+    int bounds_given;  /* the bounds are the fit: section's, already in SI */
+    int whole_range;
+} fit_setup;
+
+/* The problem of request rq on the loaded, checked model m into *s (zeroed
+ * by the caller; it borrows rq's texts and m's fit: section). MECH_OK, or
+ * the error in d (file:line:column where there is one). */
+int fit_setup_read(fit_setup *s, const fit_request *rq, const mech_model *m, mech_diag *d);
+/* The number of starts: asked, else the section's, else 16 when every free
+ * parameter has bounds, else 1; an error when more than one and none has. */
+int fit_setup_starts(const fit_setup *s, const mech_model *m, int asked, int *n, mech_diag *d);
+void fit_setup_free(fit_setup *s);
+
+#endif /* MECH_STUDY_STAGE_H */
+
 #endif

@@ -2,14 +2,14 @@
  * the residuals r = w (y(p) - y*) of solved output columns against targets
  * at given driver positions, and their exact Jacobian dr/dp from the
  * sensitivities (sens_table_at: the implicit-function theorem). The
- * minimiser itself (MINPACK lmder) is the command's (src/cli/cmd_fit_lm.c):
- * libmech does not link MINPACK. */
+ * minimiser itself (MINPACK lmder) is fit_lm.c's. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "base.h"
+#include "load.h"
 #include "study.h"
 
 /* Which of the solve's columns a fit may target: positions only. */
@@ -48,6 +48,55 @@ static int outputs_list(fit_problem *fp, mech_diag *d)
         memcpy(o, c, n);
         o += n;
         *o = '\0';
+    }
+    return MECH_OK;
+}
+
+/* The constraints of the file's fit: section: their count and sizes; the
+ * transmission, the caller's or else the file's, its two links added to
+ * the outputs (their angles solved). */
+static int constraints_of(fit_problem *fp, const mech_model *m, mech_diag *d)
+{
+    const model_fit *mf = m->fit;
+    fp->ncons = mf ? mf->ncons : 0;
+    if (!fp->trans_a[0] && mf && mf->trans_a) {
+        snprintf(fp->trans_a, sizeof fp->trans_a, "%s", mf->trans_a);
+        snprintf(fp->trans_b, sizeof fp->trans_b, "%s", mf->trans_b);
+        fp->trans_min = mf->trans_min;
+    }
+    fp->trans = fp->trans_a[0] != '\0';
+    free(fp->con_scale);
+    fp->con_scale = xcalloc((size_t)fp->ncons + 1, sizeof *fp->con_scale);
+    if (!fp->con_scale)
+        return diag_nomem(d, fp->path, (mech_mark){0, 0});
+    for (int c = 0; c < fp->ncons; c++)
+        fp->con_scale[c] = mf->cons[c].scale;
+    if (!fp->trans)
+        return MECH_OK;
+    for (int w = 0; w < 2; w++) {
+        const char *name = w ? fp->trans_b : fp->trans_a;
+        int found = 0;
+        for (int i = 1; i < m->nlinks; i++)
+            found |= strcmp(m->links[i].name, name) == 0;
+        if (!found)
+            return diag_error(d, m->file, (mech_mark){0, 0}, "transmission: '%s' is not a "
+                              "moving link of the file", name);
+    }
+    for (int w = 0; w < 2; w++) {  /* each once */
+        const char *name = w ? fp->trans_b : fp->trans_a;
+        size_t n = strlen(name);
+        int seen = 0;
+        for (const char *x = fp->outputs; *x && !seen; x += strcspn(x, ","), x += *x == ',')
+            seen = strcspn(x, ",") == n && strncmp(x, name, n) == 0;
+        if (seen)
+            continue;
+        size_t len = strlen(fp->outputs) + n + 2;
+        char *o = xcalloc(len, 1);
+        if (!o)
+            return diag_nomem(d, fp->path, (mech_mark){0, 0});
+        snprintf(o, len, "%s%s%s", fp->outputs, fp->outputs[0] ? "," : "", name);
+        free(fp->outputs);
+        fp->outputs = o;
     }
     return MECH_OK;
 }
@@ -101,6 +150,8 @@ int fit_prepare(fit_problem *fp, double *p0, mech_diag *d)
     }
     if (rc == MECH_OK)
         rc = outputs_list(fp, d);
+    if (rc == MECH_OK)
+        rc = constraints_of(fp, m, d);
     if (rc == MECH_OK && fp->free_timing &&
         (m->driver.kind == MECH_DRIVE_TIME || m->ndrivers != 1 || !(m->driver.speed != 0.0)))
         rc = diag_error(d, m->file, (mech_mark){0, 0}, "free timing needs one driver "
@@ -183,9 +234,91 @@ static int load_at(fit_problem *fp, const double *p, mech_model **m, mech_diag *
     return load_values(fp, p, m, quiet, d);
 }
 
+/* The constraint values after the target residuals (fit_ncons of them)
+ * and their rows of the Jacobian: an expression's g and dg/dp from its
+ * recorded tree (exact, param_expr.c); a transmission's g_i = min -
+ * asin|sin(a_i - b_i)| from the two links' solved angles and their
+ * sensitivities (and rates, with free timing). */
+static int eval_constraints(fit_problem *fp, const mech_model *m, const mech_table *t,
+                            double *r, double *jac)
+{
+    int n = fp->nfree, mrows = fit_nres(fp), base = fp->nq * fp->ncols;
+    const model_fit *mf = m->fit;
+    for (int c = 0; c < fp->ncons; c++)
+        r[base + c] = mf->cons[c].g;
+    if (jac && fp->ncons) {
+        const param_exprs *pe = m->pexpr;
+        double *dv = xcalloc((size_t)(pe ? pe->n : 0) + 1, sizeof *dv);
+        if (!dv)
+            return MECH_ENOMEM;
+        for (int k = 0; k < fit_nvars(fp); k++) {
+            int pi = -1;
+            for (int i = 0; k < n && i < m->nparams; i++)
+                if (strcmp(m->params[i].name, fp->names[k]) == 0)
+                    pi = i;
+            if (pe && pi >= 0)
+                pexpr_derivatives(pe, pi, dv);
+            for (int c = 0; c < fp->ncons; c++)
+                jac[(size_t)k * mrows + base + c] =
+                    pe && pi >= 0 ? pexpr_deriv_of(dv, mf->cons[c].h) : 0.0;
+        }
+        free(dv);
+    }
+    if (!fp->trans)
+        return MECH_OK;
+    char name[300];
+    int ca, cb, base2 = base + fp->ncons;
+    snprintf(name, sizeof name, "%s.angle", fp->trans_a);
+    ca = mech_table_column(t, name);
+    snprintf(name, sizeof name, "%s.angle", fp->trans_b);
+    cb = mech_table_column(t, name);
+    if (ca < 0 || cb < 0)
+        return MECH_ESOLVE;
+    for (int i = 0; i < fp->nq; i++) {
+        double da = mech_table_get(t, i, ca) - mech_table_get(t, i, cb);
+        double s = sin(da), c = cos(da);
+        r[base2 + i] = fp->trans_min - asin(fabs(s) < 1.0 ? fabs(s) : 1.0);
+        if (!jac)
+            continue;
+        double f = -((s < 0) ? -1.0 : 1.0) * ((c < 0) ? -1.0 : 1.0);  /* dg/d(da) */
+        for (int k = 0; k < fit_nvars(fp); k++) {
+            double dd = 0.0;
+            if (k < n) {
+                int x[2];
+                for (int w = 0; w < 2; w++) {
+                    snprintf(name, sizeof name, "d(%s.angle)/d(%s)", w ? fp->trans_b : fp->trans_a,
+                             fp->names[k]);
+                    x[w] = mech_table_column(t, name);
+                }
+                dd = (x[0] < 0 ? 0.0 : mech_table_get(t, i, x[0])) -
+                     (x[1] < 0 ? 0.0 : mech_table_get(t, i, x[1]));
+            } else if (k - n == i) {  /* free timing: d(da)/dq_i from the rates */
+                int x[2];
+                for (int w = 0; w < 2; w++) {
+                    snprintf(name, sizeof name, "%s.omega", w ? fp->trans_b : fp->trans_a);
+                    x[w] = mech_table_column(t, name);
+                }
+                dd = ((x[0] < 0 ? 0.0 : mech_table_get(t, i, x[0])) -
+                      (x[1] < 0 ? 0.0 : mech_table_get(t, i, x[1]))) / m->driver.speed;
+            }
+            jac[(size_t)k * mrows + base2 + i] = f * dd;
+        }
+    }
+    return MECH_OK;
+}
+
+int fit_feasible(const fit_problem *fp, const double *r)
+{
+    int base = fp->nq * fp->ncols;
+    for (int c = 0; c < fit_ncons(fp); c++)
+        if (!(r[base + c] <= fit_con_tolerance(fp, c)))
+            return MECH_ESOLVE;
+    return MECH_OK;
+}
+
 int fit_eval(fit_problem *fp, const double *p, double *r, double *jac, mech_diag *d)
 {
-    int n = fp->nfree, mrows = fp->nq * fp->ncols;
+    int n = fp->nfree, mrows = fit_nres(fp);
     mech_model *m = NULL;
     mech_outputs outs = {0};
     mech_table t = {0};
@@ -239,10 +372,13 @@ int fit_eval(fit_problem *fp, const double *p, double *r, double *jac, mech_diag
             }
         }
     }
-    if (fp->observe) {
+    rc = eval_constraints(fp, m, &t, r, jac);
+    if (rc == MECH_ENOMEM)
+        rc = diag_nomem(d, fp->path, (mech_mark){0, 0});
+    if (rc == MECH_OK && fp->observe) {
         double f = 0.0;
-        for (int i = 0; i < mrows; i++)
-            f += r[i] * r[i];
+        for (int k = 0; k < fp->nq * fp->ncols; k++)
+            f += r[k] * r[k];
         fp->observe(fp->observe_ctx, fp->nsolves, f);
     }
 done:
@@ -311,4 +447,6 @@ void fit_problem_free(fit_problem *fp)
 {
     free(fp->outputs);
     fp->outputs = NULL;
+    free(fp->con_scale);
+    fp->con_scale = NULL;
 }

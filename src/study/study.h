@@ -262,7 +262,35 @@ typedef struct fit_problem {
      * traces the objective against the solves); NULL: none */
     void (*observe)(void *ctx, long nsolves, double objective);
     void *observe_ctx;
+    /* the constraints of the file's fit: section (fit_prepare), as values
+     * g <= 0 after the target residuals: the ncons expressions, then with
+     * a transmission one per target row, g_i = min - asin|sin(a_i - b_i)| */
+    int ncons;                 /* expression constraints */
+    int trans;                 /* 1: a transmission constraint (its links' angles solved) */
+    char trans_a[64], trans_b[64];  /* its links: set before fit_prepare (--transmission),
+                                  else fit_prepare takes the file's */
+    double trans_min;          /* its least angle, rad */
+    double *con_scale;         /* [ncons] the size each tolerance is relative to; owned */
 } fit_problem;
+
+/* The constraint values after the nq ncols target residuals. */
+static inline int fit_ncons(const fit_problem *fp)
+{
+    return fp->ncons + (fp->trans ? fp->nq : 0);
+}
+static inline int fit_nres(const fit_problem *fp)
+{
+    return fp->nq * fp->ncols + fit_ncons(fp);
+}
+/* A constraint value g counts as violated above this (docs/synthesis.md 4). */
+static inline double fit_con_tolerance(const fit_problem *fp, int c)
+{
+    double s = c < fp->ncons ? fp->con_scale[c] : 1.0;  /* the transmission's: 1 rad */
+    return 1e-9 * (s > 1e-300 ? s : 1.0);
+}
+/* MECH_OK when every constraint value of r[fit_nres] (fit_eval's) holds to
+ * its tolerance, else MECH_ESOLVE. */
+int fit_feasible(const fit_problem *fp, const double *r);
 
 /* The unknowns of the problem: the free parameters, and with free timing
  * one driver position per target row. */
@@ -275,8 +303,9 @@ static inline int fit_nvars(const fit_problem *fp)
  * p0[nfree], units and marks into fp) and the columns (their units):
  * MECH_OK, or an error in d naming the unknown parameter or column. */
 int fit_prepare(fit_problem *fp, double *p0, mech_diag *d);
-/* r[nq ncols] at p[fit_nvars] and, when jac is not NULL, dr/dp into
- * jac[k * nq ncols + row] (column-major, MINPACK's layout). MECH_OK;
+/* r[fit_nres] at p[fit_nvars] (the target residuals, then the constraint
+ * values g) and, when jac is not NULL, dr/dp into jac[k * fit_nres + row]
+ * (column-major, MINPACK's layout). MECH_OK;
  * MECH_ESOLVE (nothing in d) when the mechanism does not assemble at
  * every target; MECH_ENOMEM. */
 int fit_eval(fit_problem *fp, const double *p, double *r, double *jac, mech_diag *d);
@@ -296,6 +325,32 @@ int fit_sweep(const fit_problem *fp, const double *p, mech_table *t, mech_diag *
  * (bench/bench_fit.c, NLopt): the same evaluation as the fit's. */
 int fit_objective(fit_problem *fp, const double *p, double *r, double *objective, mech_diag *d);
 void fit_problem_free(fit_problem *fp);
+
+/* fit_lm.c: one local fit of fp from p[fit_nvars] (in: the start, in the
+ * bounds lo[k] < hi[k], or both infinite: none; out: the solution) by
+ * MINPACK's lmder with the bounds as a change of variable and the
+ * constraints as a shifted penalty; r[fit_nres]: the solution's residuals
+ * and constraint values, *objective the targets' sum of squares, *info
+ * lmder's (-2: rejected, a constraint violated). MECH_OK; MECH_ESOLVE when
+ * the start does not assemble at every target, or the solution does not
+ * or violates a constraint; MECH_ENOMEM. */
+int fit_lm(fit_problem *fp, const double *lo, const double *hi, double *p, double *r,
+           double *objective, int *info);
+
+enum { FIT_MAX_FREE = 32, FIT_MAX_TIMED = 512, FIT_MAX_VARS = FIT_MAX_FREE + FIT_MAX_TIMED };
+typedef struct fit_start {
+    double p[FIT_MAX_VARS];  /* the parameters, then (free timing) the driver positions */
+    double objective;        /* the targets' sum of squares; INFINITY: rejected */
+    int rc, info;            /* fit_lm's (then whole-range's) status, lmder's info */
+    long solves;
+} fit_start;
+/* n local fits on jobs threads (0: the default): start 0 at p0, start i at
+ * the Halton point i of the bounds (a parameter without bounds at p0); with
+ * whole_range each solution must assemble over the file's range
+ * (fit_check_range). st[n] sorted by objective (the rejected last).
+ * MECH_OK, or MECH_ENOMEM (MECH_EINPUT: too many unknowns). */
+int fit_run_starts(const fit_problem *fp, const double *lo, const double *hi, const double *p0,
+                   int whole_range, int n, int jobs, fit_start *st);
 
 /* ==== flywheel ==== */
 /* flywheel.c: flywheel sizing from the driver torque over one cycle

@@ -360,3 +360,77 @@ def test_read_gives_back_the_hdf5_and_the_csv_of_the_cli(tmp_path):
         assert t.units == r.units
     with pytest.raises(mech.MechError):
         mech.read(path)
+
+def fit_targets(tmp_path):
+    """The worked example of docs/synthesis.md section 6: the coupler curve
+    of tests/fit/fourbar.yaml (r 20, l 60, b 50 mm) at 12 crank angles, and
+    the file with r 22, l 55, b 53 mm, the start."""
+    out = subprocess.run([MECH, 'solve', 'tests/fit/fourbar.yaml', '--from', '0', '--to', '330',
+                          '--steps', '11', '--outputs', 'P', '--level', 'positions', '--units',
+                          'file'], check=True, capture_output=True, text=True).stdout
+    lines = [l for l in out.splitlines() if l and not l.startswith('#')]
+    path = tmp_path / 'path.csv'
+    path.write_text(''.join(','.join(l.split(',')[:3]) + '\n' for l in lines))
+    with open('tests/fit/fourbar.yaml') as f:
+        text = f.read()
+    moved = (text.replace('  r: 20 mm', '  r: 22 mm').replace('  l: 60 mm', '  l: 55 mm')
+             .replace('  b: 50 mm', '  b: 53 mm'))
+    assert moved != text
+    return path, moved
+
+
+def test_fit_recovers_the_worked_example(tmp_path):
+    """mech.fit (docs/synthesis.md section 6): the dimensions back to 1e-8
+    relative, from one start and from 8 bounded ones; the same as `mech fit`."""
+    path, moved = fit_targets(tmp_path)
+    f = tmp_path / 'moved.yaml'
+    f.write_text(moved)
+    r = mech.fit(f, free=['r', 'l', 'b'], target=path)
+    for name, want in (('r', 0.020), ('l', 0.060), ('b', 0.050)):
+        assert abs(r['params'][name] - want) <= 1e-8 * want, (name, r['params'][name])
+    assert r['objective'] < 1e-20 and r['status'] == 'converged'
+    assert r['starts'] == 1 and r['accepted'] == 1 and r['solves'] > 0 and r['seconds'] > 0
+    assert max(r['worst_error'].values()) < 1e-12 and r['margins'] == {}
+    cli = subprocess.run([MECH, 'fit', str(f), '--free', 'r,l,b', '--target', str(path)],
+                         check=True, capture_output=True, text=True).stdout
+    assert 'objective    %.6g ' % r['objective'] in cli
+    b = mech.fit(str(f), free='r=15mm:25mm,l=50mm:70mm,b=40mm:60mm', target=str(path),
+                 starts=8, jobs=2)
+    assert b['starts'] == 8 and b['accepted'] == 8
+    for name, want in (('r', 0.020), ('l', 0.060), ('b', 0.050)):
+        assert abs(b['params'][name] - want) <= 1e-8 * want, (name, b['params'][name])
+
+
+def test_fit_keeps_the_constraints(tmp_path):
+    """The fit: section's constraints (docs/synthesis.md section 4): l / r >=
+    3.2 excludes the answer (3); the fit ends on that boundary, at the fit of
+    the file with l written 3.2 r; a bad constraint raises with its place."""
+    path, moved = fit_targets(tmp_path)
+    f = tmp_path / 'ratio.yaml'
+    f.write_text(moved + 'fit:\n  constraints: ["l / r >= 3.2", "r + d <= l + b"]\n')
+    r = mech.fit(f, free=['r', 'l', 'b'], target=path)
+    p = r['params']
+    assert abs(p['l'] / p['r'] - 3.2) < 1e-9
+    assert abs(r['margins']['l / r >= 3.2']) < 1e-9
+    assert r['margins']['r + d <= l + b'] > 0.02
+    sub = tmp_path / 'sub.yaml'
+    sub.write_text(re.sub(r'(?m)^  l: 55 mm.*$', '  l: 3.2 * r', moved))
+    s = mech.fit(sub, free=['r', 'b'], target=path)
+    assert abs(s['params']['r'] - p['r']) < 1e-11 and abs(s['params']['b'] - p['b']) < 1e-11
+    bad = tmp_path / 'bad.yaml'
+    bad.write_text(moved + 'fit:\n  constraints: ["l <= 3 kg"]\n')
+    with pytest.raises(mech.MechError) as e:
+        mech.fit(bad, free=['r', 'l', 'b'], target=path)
+    assert "bad.yaml:42:20: error: fit: constraint 'l <= 3 kg': cannot subtract" in str(e.value)
+    assert e.value.status == mech.EINPUT
+    # the least transmission angle (53.13 deg for the answer) held at 60 deg
+    plain = tmp_path / 'moved.yaml'
+    plain.write_text(moved)
+    t = mech.fit(plain, free=['r=15mm:25mm', 'l=50mm:70mm', 'b=40mm:60mm'], target=path,
+                 starts=2, transmission=('coupler', 'rocker', 60))
+    assert abs(t['margins']['transmission coupler/rocker']) < 1e-9
+    never = tmp_path / 'never.yaml'
+    never.write_text(moved + 'fit:\n  constraints: ["r >= 30 mm"]\n')
+    with pytest.raises(mech.MechError) as e:
+        mech.fit(never, free=['r=15:25', 'l', 'b'], target=path, starts=2)
+    assert e.value.status == mech.ESOLVE

@@ -1,5 +1,5 @@
 /* tests/unit/test_fit.c: mech fit's problem (src/study/fit.c) and its local
- * solver (src/cli/cmd_fit_lm.c) against independent truths, on
+ * solver (src/study/fit_lm.c) against independent truths, on
  * tests/fit/fourbar.yaml. (1) The Jacobian fit_eval gives (from the
  * sensitivities) against central differences of the residuals themselves
  * (each a whole solve with the parameter replaced), relative step 1e-5:
@@ -10,17 +10,20 @@
  * off (bounded and unbounded) must give them back to 1e-9 relative.
  * (3) fit_objective and the observer (bench/bench_fit.c's objective and
  * trace) against fit_eval's residuals; fit_sweep (mech fit --plot) over
- * the file's range, whole and with gaps. */
+ * the file's range, whole and with gaps.
+ * (4) The constraints' rows (docs/synthesis.md 4: expressions differentiated
+ * on their recorded trees, the transmission from the sensitivities)
+ * against central differences. */
 #include <criterion/criterion.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "helpers.h"
 #include "base.h"
 #include "study.h"
-#include "cli.h"
 
 #define NQ 8
 #define NC 3
@@ -35,11 +38,11 @@ static double qs[NQ], targets[NQ * NC];
 
 /* The problem on the fixture, targets 0 (the residuals are then the solved
  * values themselves), p0 the file's values. */
-static fit_problem problem(double *p0, int timing)
+static fit_problem problem_of(const char *path, double *p0, int timing)
 {
     fit_problem fp = {0};
     fp.free_timing = timing;
-    fp.path = "tests/fit/fourbar.yaml";
+    fp.path = path;
     fp.nfree = NF;
     fp.names = (const char **)names;
     fp.unit = units;
@@ -60,6 +63,11 @@ static fit_problem problem(double *p0, int timing)
     mech_diag_free(&d);
     cr_assert_eq(rc, MECH_OK, "fit_prepare");
     return fp;
+}
+
+static fit_problem problem(double *p0, int timing)
+{
+    return problem_of("tests/fit/fourbar.yaml", p0, timing);
 }
 
 Test(fit, jacobian_against_central_differences)
@@ -233,3 +241,56 @@ Test(fit, sweep_over_the_file_range)
     mech_diag_free(&d);
     fit_problem_free(&fp);
 }
+
+/* The constraint rows of the Jacobian: the fixture with a fit: section of
+ * two expressions (a ratio, and a nonlinear one of three parameters) and a
+ * transmission between coupler and rocker, with and without free timing. */
+static void constraint_rows(int timing)
+{
+    static char path[64];
+    snprintf(path, sizeof path, "/tmp/mech-test-fitc-%d-%d.yaml", (int)getpid(), timing);
+    FILE *in = fopen("tests/fit/fourbar.yaml", "r"), *out = fopen(path, "w");
+    cr_assert(in && out);
+    char buf[4096];
+    size_t n;
+    while ((n = fread(buf, 1, sizeof buf, in)) > 0)
+        fwrite(buf, 1, n, out);
+    fputs("fit:\n  constraints:\n    - \"l / r >= 3.2\"\n"
+          "    - \"sqrt(r^2 + b^2) * sin(phi + 10 deg) <= l - 5 mm\"\n"
+          "  transmission: {links: [coupler, rocker], min: 30 deg}\n", out);
+    fclose(in);
+    fclose(out);
+    enum { NV = NF + NQ, NR = NQ * NC + 2 + NQ };
+    double p[NV], r[NR], jac[NR * NV], rp[NR], rm[NR];
+    fit_problem fp = problem_of(path, p, timing);
+    int nv = fit_nvars(&fp);
+    cr_assert_eq(fit_nres(&fp), NR);
+    cr_assert_eq(fp.ncons, 2);
+    for (int i = 0; timing && i < NQ; i++)
+        p[NF + i] = qs[i] + 0.1;
+    mech_diag d;
+    mech_diag_init(&d);
+    cr_assert_eq(fit_eval(&fp, p, r, jac, &d), MECH_OK);
+    cr_expect(fabs(r[NQ * NC] - (3.2 - p[1] / p[0])) <= 1e-15, "g of l / r >= 3.2: %.17g",
+              r[NQ * NC]);
+    for (int k = 0; k < nv; k++) {
+        double pp[NV], h = k < NF ? 1e-5 * fabs(p[k]) : 1e-6;
+        memcpy(pp, p, sizeof pp);
+        pp[k] = p[k] + h;
+        cr_assert_eq(fit_eval(&fp, pp, rp, NULL, &d), MECH_OK);
+        pp[k] = p[k] - h;
+        cr_assert_eq(fit_eval(&fp, pp, rm, NULL, &d), MECH_OK);
+        for (int row = NQ * NC; row < NR; row++) {
+            double exact = jac[k * NR + row], fd = (rp[row] - rm[row]) / (2.0 * h);
+            cr_expect(fabs(exact - fd) <= 1e-6 * (fabs(exact) + 0.01 * (k < NF ? 1.0 / p[k] : 1.0)),
+                      "d(constraint row %d)/d(%d): exact %.12g, central difference %.12g",
+                      row - NQ * NC, k, exact, fd);
+        }
+    }
+    mech_diag_free(&d);
+    fit_problem_free(&fp);
+    remove(path);
+}
+
+Test(fit, constraint_jacobian_against_central_differences) { constraint_rows(0); }
+Test(fit, constraint_timing_jacobian_against_central_differences) { constraint_rows(1); }
