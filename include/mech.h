@@ -681,6 +681,7 @@ typedef struct mech_fit_options {
     int jobs;                      /* worker threads; 0: the default */
     int whole_range, free_timing;  /* 1: on (as the flags; the section may turn them on) */
     const char *transmission;      /* "A,B,MIN" as --transmission; NULL: the section's */
+    unsigned long seed;            /* as --seed: 0 the Halton starts, else shifted at random */
 } mech_fit_options;
 
 typedef struct mech_fit_result {

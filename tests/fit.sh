@@ -84,6 +84,23 @@ if run "path, bounded starts" 0 "$MECH" fit "$tmp/moved.yaml" --free r=15:25,l=5
     has_line "$tmp/out" '^  1\. objective [0-9.e-]*: r=20 l=60 b=50$' "starts: the best distinct solution"
 fi
 
+# --seed: another set of starts (the Halton points shifted), the same set
+# for the same seed; seed 0 is no shift
+for sd in 0 7 7; do
+    "$MECH" fit "$tmp/moved.yaml" --free r=15:25,l=50:70,b=40:60 --target "$tmp/path.csv" \
+        --starts 4 --seed $sd -j $((sd % 3 + 1)) 2>&1 | grep -v '^time' >"$tmp/seed$sd.$$" || true
+    [ -f "$tmp/seed7.first" ] || { [ "$sd" = 7 ] && mv "$tmp/seed7.$$" "$tmp/seed7.first"; }
+done
+"$MECH" fit "$tmp/moved.yaml" --free r=15:25,l=50:70,b=40:60 --target "$tmp/path.csv" \
+    --starts 4 -j 2 2>&1 | grep -v '^time' >"$tmp/noseed"
+cmp -s "$tmp/seed0.$$" "$tmp/noseed" && pass || fail "--seed 0 is not the unshifted starts"
+cmp -s "$tmp/seed7.first" "$tmp/seed7.$$" && pass || fail "--seed 7 twice gave two results"
+grep '^solves' "$tmp/seed7.first" >"$tmp/s7"; grep '^solves' "$tmp/noseed" >"$tmp/s0"
+cmp -s "$tmp/s7" "$tmp/s0" && fail "--seed 7 ran the same starts as no seed ($(cat "$tmp/s0"))" || pass
+has_line "$tmp/seed7.first" '^  r  *20 mm   (bounds 15 .. 25 mm)$' "--seed 7: the same solution"
+run "--seed -1" 2 "$MECH" fit "$tmp/moved.yaml" --free r=15:25 --target "$tmp/path.csv" --seed -1 &&
+    has_line "$tmp/err" "seed" "--seed -1: the message names the option"
+
 # 2. function generation: the rocker's angle against the crank's
 if run "function" 0 "$MECH" fit "$tmp/moved.yaml" --free r,l,b --target "$tmp/function.csv" -o "$tmp/fn.yaml"; then
     near "$(value r "$tmp/fn.yaml")" 20 1e-6 && pass || fail "function: r = $(value r "$tmp/fn.yaml")"

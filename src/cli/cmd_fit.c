@@ -26,6 +26,7 @@ typedef struct fit_args {
     fit_list columns;            /* --column NAME (repeatable) */
     fit_list weights;            /* --weight NAME=W (repeatable) */
     int starts, jobs, quiet;
+    int seed;                    /* --seed S: the starts' random shift (0: none) */
     int whole_range;             /* --whole-range */
     int free_timing;             /* --free-timing */
 } fit_args;
@@ -66,6 +67,12 @@ static const cmd_opt options[] = {
              "Halton sequence over the bounds (a parameter without\n"
              "bounds keeps its value; default 16 when every free\n"
              "parameter has bounds, else 1)"},
+    {.names = "--seed", .kind = CMD_OPT_INT, .at = AT(seed), .lo = 0, .hi = 2147483647,
+     .expect = "needs a whole number from 0 to 2147483647", .label = "--seed S",
+     .help = "shift the Halton starts by a random fraction of the\n"
+             "bounds drawn from S (another spread-out set of starts\n"
+             "for each S; default 0: no shift). The first start is\n"
+             "the file's values whatever S"},
     {.names = "--whole-range", .kind = CMD_OPT_FLAG, .at = AT(whole_range), .flag = 1,
      .label = "--whole-range",
      .help = "a constraint: the solution must assemble over the file's\n"
@@ -101,7 +108,7 @@ const cmd_spec cmd_fit_spec = {
     .name = "fit",
     .summary = "fit parameters so that outputs meet targets (synthesis)",
     .usage = "usage: mech fit FILE --free NAME[=LO:HI],... --target TARGETS.csv\n"
-             "                [--column NAME]... [--weight NAME=W]... [--starts N]\n"
+             "                [--column NAME]... [--weight NAME=W]... [--starts N] [--seed S]\n"
              "                [--whole-range] [--free-timing] [--transmission A,B,MIN]\n"
              "                [-j N] [-o BEST.yaml] [--plot FIT.svg] [--quiet]\n"
              "       mech fit FILE [-o BEST.yaml]   (the file's fit: section)\n",
@@ -746,6 +753,7 @@ int cmd_fit(int argc, char **argv)
     if (code < 0) {
         fit_start *st = xcalloc((size_t)n, sizeof *st);
         double t0 = clock_seconds();
+        s->fp.seed = (unsigned long)a.seed;
         int rc = st ? fit_run_starts(&s->fp, s->lo, s->hi, s->p0, s->whole_range, n, a.jobs, st)
                     : MECH_ENOMEM;
         if (rc == MECH_OK) {

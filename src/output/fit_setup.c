@@ -454,6 +454,7 @@ int mech_fit(const char *path, const mech_fit_options *o, mech_fit_result *r, me
     if (rc == MECH_OK && !st)
         rc = diag_nomem(d, path, (mech_mark){0, 0});
     if (rc == MECH_OK) {
+        s->fp.seed = o->seed;
         rc = fit_run_starts(&s->fp, s->lo, s->hi, s->p0, s->whole_range, n, o->jobs, st);
         if (rc == MECH_ENOMEM)
             rc = diag_nomem(d, path, (mech_mark){0, 0});

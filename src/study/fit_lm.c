@@ -239,15 +239,19 @@ typedef struct fit_runs {
 } fit_runs;
 
 /* Start i: the file's values (i = 0), else the Halton point i of the
- * bounds (an unbounded parameter keeps the file's value); with free timing
- * the targets' driver positions. */
+ * bounds (an unbounded parameter keeps the file's value), with a seed
+ * shifted in each coordinate by a random fraction, modulo 1 (a
+ * Cranley-Patterson rotation: still spread evenly, another set for each
+ * seed); with free timing the targets' driver positions. */
 static void start_point(const fit_runs *runs, long i, double *p)
 {
     const fit_problem *fp = runs->fp;
     for (int k = 0; k < fp->nfree; k++) {
         int b = isfinite(runs->lo[k]) && isfinite(runs->hi[k]);
-        p[k] = i == 0 || !b ? runs->p0[k]
-                            : runs->lo[k] + (runs->hi[k] - runs->lo[k]) * halton(i, primes[k]);
+        double u = halton(i, primes[k]);
+        if (fp->seed)
+            u = fmod(u + sweep_random_unit((uint64_t)fp->seed, 0, k), 1.0);
+        p[k] = i == 0 || !b ? runs->p0[k] : runs->lo[k] + (runs->hi[k] - runs->lo[k]) * u;
     }
     for (int j = 0; fp->free_timing && j < fp->nq; j++)
         p[fp->nfree + j] = fp->q[j];

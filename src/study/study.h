@@ -255,6 +255,9 @@ typedef struct fit_problem {
     const double *weight;      /* [ncols] or NULL (all 1) */
     char *outputs;             /* the objects the columns need, "P,rocker"; owned */
     long nsolves;              /* evaluations so far */
+    unsigned long seed;        /* 0: the Halton starts as they are; else each coordinate
+                                  shifted by a random fraction of its bounds (mod 1) drawn
+                                  from this seed (--seed) */
     int free_timing;           /* 1: the driver positions are unknowns too, p[nfree + i]
                                   (q is then only the start); dr/dq from the rates */
     /* called by fit_eval after each evaluation that assembles, with the
