@@ -84,6 +84,14 @@ static int visit(codegen *g, ex e, int user, int root, mech_diag *d)
                           g->sp.sys->names[nd->var]);
     case EX_ADD: case EX_MUL: case EX_NEG: case EX_SIN: case EX_COS:
         break;
+    case EX_CALL:
+        return diag_error(d, g->m->file, g->m->driver.mark,
+                          "codegen: the law of time %s (a motion program, or a function the "
+                          "generated code does not have: exp, log, tanh, abs, min, max, step, "
+                          "sign, smoothsign, atan, a division by an expression of t) is not "
+                          "supported by the generated code; use mech solve "
+                          "(docs/motion-programs.md)",
+                          g->sp.sys->ex.fns[nd->var].name);
     default:
         return diag_error(d, g->m->file, g->m->driver.mark,
                           "codegen: expression node kind %d is not supported by the "

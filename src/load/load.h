@@ -282,19 +282,36 @@ int pexpr_point_gradient(const mech_model *m, int p, double *out);
  * unknowns. */
 enum { LAW_MAX_NODES = 2048 };  /* operations in one law (law_eval's buffer) */
 
-typedef enum { LAW_CONST, LAW_T, LAW_ADD, LAW_MUL, LAW_NEG, LAW_SIN, LAW_COS } law_op;
+/* ORDER LAW: law_eval (law_eval.c), law_expr and law_why switch on these.
+ * The operations up to LAW_COS are the DAG's (expr.c): a law made of them
+ * only enters the system as its expression, as the generated code does.
+ * A law with any later one (docs/motion-programs.md) enters as one opaque
+ * function of q (EX_CALL) whose value and derivatives law_eval gives. */
+typedef enum {
+    LAW_CONST, LAW_T, LAW_ADD, LAW_MUL, LAW_NEG, LAW_SIN, LAW_COS,
+    LAW_DIV, LAW_EXP, LAW_LOG, LAW_SQRT, LAW_TAN, LAW_TANH, LAW_ATAN2, LAW_ABS, LAW_MIN,
+    LAW_MAX, LAW_STEP, LAW_SIGN,
+    LAW_PROGRAM  /* progs[b] of the variable a (a motion program, programs.c) */
+} law_op;
 
 typedef struct law_node {
     law_op op;
-    int a, b;    /* operands (node indices), -1 when unused */
+    int a, b;    /* operands (node indices), -1 when unused; LAW_PROGRAM: b is the program */
     double k;    /* LAW_CONST: the value, SI */
 } law_node;
+
+struct mech_program;
 
 struct mech_law {
     law_node *nodes;  /* [n] operands come before the node that uses them */
     int n, cap;
     int root;
     int nomem;        /* parsing ran out of memory */
+    char var;         /* the variable's name: 't' (a time), or 'u' (a program segment's
+                         normalised variable, a pure number) */
+    char name[72];    /* "p_crank": the law in printed equations and messages */
+    struct mech_program **progs;  /* [nprogs] owned */
+    int nprogs;
 };
 
 /* Parse the law `text`, a quantity `want` (Q_ANGLE or Q_LENGTH) of the
@@ -307,8 +324,69 @@ void law_free(struct mech_law *l);
 /* The law's value at time t (SI), and its first and second time derivatives
  * (by forward differentiation of the tree, independent of expr.c). */
 double law_eval(const struct mech_law *l, double t, double *dt, double *dtt);
+/* law_eval.c: the same, with the third derivative (NULL: not wanted), into
+ * a caller's buffer buf[4 * l->n] (no allocation); NaN where the law or a
+ * derivative is not defined. */
+double law_eval3(const struct mech_law *l, double t, double *buf, double d[3]);
+/* Is the law (and its first two derivatives) defined at t? 1; else 0 with
+ * why it is not ("log of a negative number (-0.5)") in why. */
+int law_defined(const struct mech_law *l, double t, char *why, size_t size);
+/* Does the law use an operation the DAG does not have (LAW_DIV ...)? */
+int law_is_opaque(const struct mech_law *l);
+/* expr_fn's eval for an opaque law (data: the law): order 0, 1, 2, 3. */
+double law_fn_eval(const void *data, int order, double t);
 /* The law as an expression of the variable t in c. */
 ex law_expr(const struct mech_law *l, expr_ctx *c, ex t);
+/* Parse `text` as a law of the variable l->var into l (a new tree or one
+ * under way), one of the quantities wants[0..nwants-1]; *got: which.
+ * As law_parse otherwise. */
+int law_parse_into(const char *text, const quantity *wants, int nwants, const expr_env *env,
+                   struct mech_law *l, quantity *got, char *err, size_t errsize,
+                   size_t *err_pos);
+/* A new empty law of the variable var ('t' or 'u'), or NULL. */
+struct mech_law *law_new(char var);
+/* Append a node to l; its index, or -1 when out of memory or too long. */
+int law_add_node(struct mech_law *l, law_op op, int a, int b, double k);
+
+/* ---- programs.c: motion programs (docs/motion-programs.md) -------------
+ * A displacement program over one period of its variable x (a law of t):
+ * segments (dwell, rise, return) each over a span of x, with a standard
+ * law or a user's f(u), u in [0, 1]. Repeats: s(x + P) = s(x) + net. */
+typedef enum { PROG_DWELL, PROG_RISE, PROG_RETURN } prog_kind;
+typedef enum {
+    SHAPE_NONE, SHAPE_CYCLOIDAL, SHAPE_HARMONIC, SHAPE_345, SHAPE_4567, SHAPE_MODTRAP,
+    SHAPE_MODSINE, SHAPE_USER
+} prog_shape;
+enum { PROG_USER_MAX_NODES = 256 };  /* operations in a segment's f(u) */
+typedef struct prog_piece {  /* f'' = c0 + c1 sin(w u + phi) on [u0, next u0) */
+    double u0, f0, f1, c0, c1, w, phi;
+} prog_piece;
+typedef struct prog_segment {
+    prog_kind kind;
+    prog_shape shape;
+    double x0, span;   /* where it starts in the period, and its span (SI of x) */
+    double s0, lift;   /* displacement at its start; signed lift (SI of s) */
+    prog_piece piece[5];  /* SHAPE_MODTRAP, SHAPE_MODSINE */
+    int npieces;
+    struct mech_law *user;  /* SHAPE_USER: f(u) */
+    mech_mark mark;
+} prog_segment;
+typedef struct mech_program {
+    prog_segment *seg;  /* [n] */
+    int n;
+    double start, period, net;  /* s at x = 0; the period; s(P) - s(0) */
+    int continuity;     /* checked at load: 0 displacement, 1 + velocity, 2 + acceleration */
+} mech_program;
+/* The normalised law of segment kind `shape`: f, f', f'', f''' at u. */
+void prog_shape_eval(const prog_segment *sg, double u, double f[4]);
+/* Fill a segment's pieces (modified trapezoid and sine). */
+void prog_shape_init(prog_segment *sg);
+/* s(x) and its derivatives d[0..3] in x. */
+void program_eval(const mech_program *p, double x, double d[4]);
+void program_free(struct mech_program *p);
+/* A shape by its name in the file ("cycloidal", "3-4-5", ...), or SHAPE_NONE. */
+prog_shape prog_shape_by_name(const char *name);
+const char *prog_shape_name(prog_shape s);
 
 /* ---- the one model of drivers ------------------------------------------
  * Driver k holds its coordinate x_k (a link angle or a slider
@@ -623,6 +701,10 @@ void load_driver(loader *ld, const ynode *map);
 void load_range(loader *ld, const ynode *n, quantity q, mech_driver *dr);
 /* load_drivers.c: 'sweep: {time: RANGE}' and 'drivers: [...]' (laws of time) */
 void load_sweep_drivers(loader *ld, const ynode *sweep, const ynode *drivers);
+/* load_programs.c: `program:` of a driver's law (q: Q_ANGLE or Q_LENGTH),
+ * into *out (the law of t, its last node the program). 1, or 0 reported. */
+int load_program(loader *ld, const ynode *map, quantity q, const char *driver,
+                 struct mech_law **out);
 void load_initial(loader *ld, const ynode *map);
 /* load.c: the whole file at path, at most max bytes, checked before and while
  * reading (NULL with *rc set and the problem recorded in d). */
