@@ -504,6 +504,15 @@ void drivers_guess(const mech_model *m, const int *link_var, const int *joint_va
     }
 }
 
+int drivers_undefined(const mech_model *m, double q, char *why, size_t size)
+{
+    for (int k = 0; k < m->ndrivers; k++)
+        if (!drivers_is_sweep(m, k) && law_is_opaque(m->drivers[k].law) &&
+            !law_defined(m->drivers[k].law, q, why, size))
+            return k;
+    return -1;
+}
+
 const char *drivers_name(const mech_model *m, int i)
 {
     const mech_motion *mo = &m->drivers[i];

@@ -418,6 +418,9 @@ ex drivers_row(const mech_model *m, int k, expr_ctx *c, const ex *link_angle, co
  * joint_var: the system's). */
 void drivers_guess(const mech_model *m, const int *link_var, const int *joint_var, double q,
                    double *guess);
+/* The first driver whose law (or its rate, or its second derivative) is
+ * not defined at q, why in why; -1 when all are (sweep.c, at every row). */
+int drivers_undefined(const mech_model *m, double q, char *why, size_t size);
 /* The name of driver k ("crank" or the slider's name). */
 const char *drivers_name(const mech_model *m, int k);
 /* The driver of link l's angle or of slider joint j, or -1. */

@@ -147,8 +147,8 @@ static int check_boundaries(loader *ld, const mech_program *p, quantity q, quant
     static const char *const what[3] = {"a displacement", "a velocity", "an acceleration"};
     char su[24], xu[24], l1[96], l2[96];
     double ss = unit_of(ld, q, su, sizeof su), xs = unit_of(ld, xq, xu, sizeof xu);
-    for (int i = 0; i < p->n; i++) {
-        int prev = i > 0 ? i - 1 : p->n - 1;
+    for (int j = 1; j <= p->n; j++) {  /* in order, the period's end last */
+        int i = j % p->n, prev = j - 1;
         double left[3], right[3];
         seg_ends(&p->seg[prev], 1, left);
         seg_ends(&p->seg[i], 0, right);
