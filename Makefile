@@ -226,6 +226,7 @@ define SUITES
 	$(TIMED) draw $(SUITE_ENV) sh tests/draw.sh
 	$(TIMED) watch $(SUITE_ENV) sh tests/watch.sh
 	$(TIMED) drivers $(SUITE_ENV) sh tests/drivers.sh
+	$(TIMED) programs $(SUITE_ENV) sh tests/programs.sh
 	$(TIMED) fit $(SUITE_ENV) sh tests/fit.sh
 	$(TIMED) dynamics $(SUITE_ENV) sh tests/dynamics.sh
 	$(TIMED) drawn $(SUITE_ENV) sh tests/drawn.sh

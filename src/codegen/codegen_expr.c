@@ -68,6 +68,26 @@ static int driver_only(codegen *g, ex e)
     return g->driver_only[e];
 }
 
+/* An opaque law of time (a motion program, exp, log, ...: law_expr): the
+ * generated code has no evaluator of it, so it refuses, at the driver. */
+static int refuse_law(const codegen *g, const expr_node *nd, mech_diag *d)
+{
+    const expr_fn *fn = &g->sp.sys->ex.fns[nd->var];
+    mech_mark at = g->m->driver.mark;
+    const char *who = fn->name;
+    for (int k = 0; k < g->m->ndrivers; k++)
+        if ((const void *)g->m->drivers[k].law == fn->data) {
+            at = g->m->drivers[k].mark;
+            who = drivers_name(g->m, k);
+        }
+    return diag_error(d, g->m->file, at,
+                      "codegen: driver '%s': its law (a motion program, or a function the "
+                      "generated code does not evaluate: exp, log, tanh, abs, min, max, step, "
+                      "sign, smoothsign, tan, sqrt, atan2 of t, a division by an expression of "
+                      "t) is not supported by the generated code; mech solve evaluates it "
+                      "(docs/motion-programs.md)", who);
+}
+
 /* Give e (used by a node or root of phase `user`, under a root of phase
  * `root`) its phase, and a keep slot when a later phase uses it. */
 static int visit(codegen *g, ex e, int user, int root, mech_diag *d)
@@ -85,13 +105,7 @@ static int visit(codegen *g, ex e, int user, int root, mech_diag *d)
     case EX_ADD: case EX_MUL: case EX_NEG: case EX_SIN: case EX_COS:
         break;
     case EX_CALL:
-        return diag_error(d, g->m->file, g->m->driver.mark,
-                          "codegen: the law of time %s (a motion program, or a function the "
-                          "generated code does not have: exp, log, tanh, abs, min, max, step, "
-                          "sign, smoothsign, atan, a division by an expression of t) is not "
-                          "supported by the generated code; use mech solve "
-                          "(docs/motion-programs.md)",
-                          g->sp.sys->ex.fns[nd->var].name);
+        return refuse_law(g, nd, d);
     default:
         return diag_error(d, g->m->file, g->m->driver.mark,
                           "codegen: expression node kind %d is not supported by the "
