@@ -341,12 +341,30 @@ static const qparse_ops law_ops = {
     .after = "law",
 };
 
+/* the same for a program segment's f(u) */
+static const qparse_ops law_u_ops = {
+    .constant = l_constant,
+    .unit = l_unit,
+    .word = l_word,
+    .call = l_call,
+    .neg = l_neg,
+    .scale = scaled,
+    .add = l_add,
+    .mul = l_mul,
+    .powi = l_powi,
+    .unknown_name = " (not u, a function, or a parameter defined under 'parameters')",
+    .unit_alone = 1,
+    .strict_exponent = 0,
+    .checked_dims = 0,
+    .after = "law",
+};
+
 int law_parse_into(const char *text, const quantity *wants, int nwants, const expr_env *env,
                    struct mech_law *l, quantity *got, char *err, size_t errsize,
                    size_t *err_pos)
 {
     qparse p;
-    qparse_init(&p, text, env, &law_ops, l, err, errsize);
+    qparse_init(&p, text, env, l->var == 'u' ? &law_u_ops : &law_ops, l, err, errsize);
     qv v = qparse_run(&p);
     int k = 0;
     while (!p.failed && !v.bare && k + 1 < nwants && !dim_equal(v.d, quantity_get(wants[k])->d))

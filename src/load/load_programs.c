@@ -93,10 +93,13 @@ static int load_segment(loader *ld, const ynode *e, quantity q, quantity xq, con
         if (!load_get_quantity(ld, ri ? ri : re, q, "a lift", &h) ||
             !load_get_quantity(ld, ov, xq, "a span", &sg->span))
             return 0;
-        if (!(h > 0))
-            return load_err(ld, ri ? ri : re, "a lift must be positive (a %s of %g goes the "
-                            "other way: write '%s')", kind_name(sg->kind), h,
-                            ri ? "return" : "rise"), 0;
+        if (!(h > 0)) {
+            char su[24];
+            double ss = unit_of(ld, q, su, sizeof su);
+            return load_err(ld, ri ? ri : re, "driver '%s': a lift must be positive (a %s of "
+                            "%.10g %s goes the other way: write '%s')", who, kind_name(sg->kind),
+                            h / ss, su, ri ? "return" : "rise"), 0;
+        }
         sg->lift = sg->kind == PROG_RISE ? h : -h;
         if (!load_want_kind(ld, lw, YNODE_SCALAR, "a segment's law"))
             return 0;
@@ -197,7 +200,7 @@ static int load_variable(loader *ld, const ynode *map, const char *who, struct m
     return 1;
 }
 
-static int load_continuity(loader *ld, const ynode *n, int *out)
+static int load_continuity(loader *ld, const ynode *n, const char *who, int *out)
 {
     static const char *const names[] = {"displacement", "velocity", "acceleration"};
     *out = 2;
@@ -208,8 +211,9 @@ static int load_continuity(loader *ld, const ynode *n, int *out)
     for (int k = 0; k < 3; k++)
         if (strcmp(n->text, names[k]) == 0)
             return *out = k, 1;
-    return load_err(ld, n, "'continuity' is displacement, velocity or acceleration (checked "
-                           "at every boundary up to it), not '%s'", n->text), 0;
+    return load_err(ld, n, "driver '%s': 'continuity' is displacement, velocity or "
+                           "acceleration (checked at every boundary up to it), not '%s'", who,
+                    n->text), 0;
 }
 
 /* The segments: their places in the period, their starting displacements. */
@@ -280,7 +284,7 @@ int load_program(loader *ld, const ynode *map, quantity q, const char *who,
     l->nprogs = 1;
     quantity xq = Q_TIME;
     int ok = load_variable(ld, map, who, l, &xq) &&
-             load_continuity(ld, ymap_get(map, "continuity"), &p->continuity) &&
+             load_continuity(ld, ymap_get(map, "continuity"), who, &p->continuity) &&
              (!st || load_get_quantity(ld, st, q, "the start", &p->start)) &&
              load_segments(ld, seq, q, xq, who, p) &&
              check_period(ld, ymap_get(map, "period"), xq, who, p) &&
