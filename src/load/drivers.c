@@ -187,8 +187,11 @@ static int check_args(qparse *p, const char *name, size_t n, const char *at, qv 
         return -1;
     }
     if (two != two_args(name, n)) {
-        qparse_fail(p, at, two ? "%.*s takes one argument" : "%.*s takes two arguments",
-                    (int)n, name);
+        if (!two && qparse_is_fn(name, n, "atan2"))
+            qparse_fail(p, at, "atan2 takes two arguments: atan2(y, x)");
+        else
+            qparse_fail(p, at, two ? "%.*s takes one argument" : "%.*s takes two arguments",
+                        (int)n, name);
         return -1;
     }
     if (two)
