@@ -574,7 +574,8 @@ static int same_bits(double a, double b) { return memcmp(&a, &b, sizeof a) == 0;
 static int same_program(const mech_program *p, const mech_program *q)
 {
     if (p->n != q->n || p->continuity != q->continuity || !same_bits(p->start, q->start) ||
-        !same_bits(p->period, q->period) || !same_bits(p->net, q->net))
+        !same_bits(p->period, q->period) || !same_bits(p->net, q->net) ||
+        !same_bits(p->speed, q->speed))
         return 0;
     for (int i = 0; i < p->n; i++) {
         const prog_segment *x = &p->seg[i], *y = &q->seg[i];

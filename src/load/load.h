@@ -376,6 +376,7 @@ typedef struct mech_program {
     int n;
     double start, period, net;  /* s at x = 0; the period; s(P) - s(0) */
     int continuity;     /* checked at load: 0 displacement, 1 + velocity, 2 + acceleration */
+    double speed;       /* `speed:` dx/dt (x = speed * of), SI; 0 when not given */
 } mech_program;
 /* The normalised law of segment kind `shape`: f, f', f'', f''' at u. */
 void prog_shape_eval(const prog_segment *sg, double u, double f[4]);

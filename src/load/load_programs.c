@@ -166,10 +166,14 @@ static int check_boundaries(loader *ld, const mech_program *p, quantity q, quant
             double shown = jump / ss * pow(xs, k);
             char unit[64];
             snprintf(unit, sizeof unit, k == 0 ? "%s" : k == 1 ? "%s/%s" : "%s/%s^2", su, xu);
+            char in_time[80] = "";  /* with `speed:`, x' is known: the jump in time */
+            if (p->speed != 0 && k > 0)
+                snprintf(in_time, sizeof in_time, " = %.6g %s/s%s in time", jump / ss *
+                         pow(p->speed, k), su, k == 2 ? "^2" : "");
             diag_error(ld->d, ld->file, p->seg[i].mark,
-                       "driver '%s': %s jump of %.6g %s (d%ss/dx%s) at %.10g %s between %s and "
+                       "driver '%s': %s jump of %.6g %s (d%ss/dx%s%s) at %.10g %s between %s and "
                        "%s%s", who, what[k], shown, unit, k == 2 ? "2" : "", k == 2 ? "2" : "",
-                       p->seg[i].x0 > 0 ? p->seg[i].x0 / xs : p->period / xs, xu, l1, l2,
+                       in_time, p->seg[i].x0 > 0 ? p->seg[i].x0 / xs : p->period / xs, xu, l1, l2,
                        k == 2 ? ": use laws whose accelerations meet, or 'continuity: velocity'"
                        : k == 1 ? ": use laws whose velocities meet" : "");
             return 0;
@@ -180,17 +184,47 @@ static int check_boundaries(loader *ld, const mech_program *p, quantity q, quant
 
 /* `of`: the program's variable, a law of t (an angle, a length or a time),
  * parsed into the driver's law l. 1, or 0 reported. */
+/* `speed:` a constant rate of x in t (x = speed * of): an angular speed
+ * (the cam angle) or a speed; *xq the variable's quantity then. */
+static int load_speed(loader *ld, const ynode *sp, const char *who, double *out, quantity *xq)
+{
+    char msg[256];
+    size_t pos = 0;
+    if (!load_want_kind(ld, sp, YNODE_SCALAR, "'speed'"))
+        return 0;
+    if (quantity_eval(sp->text, Q_ANGULAR_SPEED, &ld->env, out, msg, sizeof msg, &pos) == 0)
+        *xq = Q_ANGLE;
+    else if (quantity_eval(sp->text, Q_SPEED, &ld->env, out, msg, sizeof msg, &pos) == 0)
+        *xq = Q_LENGTH;
+    else
+        return load_err(ld, sp, "driver '%s': 'speed' is the rate of the program's variable: "
+                        "an angular speed (60 rpm) or a speed (m/s), not '%s'", who,
+                        sp->text), 0;
+    if (!(*out != 0) || !isfinite(*out))
+        return load_err(ld, sp, "driver '%s': 'speed' must not be 0", who), 0;
+    return 1;
+}
+
 static int load_variable(loader *ld, const ynode *map, const char *who, struct mech_law *l,
-                         quantity *xq)
+                         mech_program *p, quantity *xq)
 {
     static const quantity wants[] = {Q_TIME, Q_ANGLE, Q_LENGTH};
-    const ynode *of = ymap_get(map, "of");
+    const ynode *of = ymap_get(map, "of"), *sp = ymap_get(map, "speed");
     char msg[256];
     size_t pos = 0;
     if (of && !load_want_kind(ld, of, YNODE_SCALAR, "'of'"))
         return 0;
-    int rc = law_parse_into(of ? of->text : "t", wants, 3, &ld->env, l, xq, msg, sizeof msg,
-                            &pos);
+    int rc = law_parse_into(of ? of->text : "t", wants, sp ? 1 : 3, &ld->env, l, xq, msg,
+                            sizeof msg, &pos);
+    if (rc == 0 && sp) {  /* x = speed * of */
+        if (!load_speed(ld, sp, who, &p->speed, xq))
+            return 0;
+        int k = law_add_node(l, LAW_CONST, -1, -1, p->speed);
+        int root = k < 0 ? -1 : law_add_node(l, LAW_MUL, k, l->root, 0.0);
+        if (root < 0)
+            return load_nomem(ld, map), 0;
+        l->root = root;
+    }
     if (rc == MECH_ENOMEM)
         return load_nomem(ld, map), 0;
     if (rc < 0) {
@@ -261,7 +295,8 @@ static int check_period(loader *ld, const ynode *pn, quantity xq, const char *wh
 int load_program(loader *ld, const ynode *map, quantity q, const char *who,
                  struct mech_law **out)
 {
-    static const char *const keys[] = {"of", "period", "start", "continuity", "segments"};
+    static const char *const keys[] = {"of", "speed", "period", "start", "continuity",
+                                       "segments"};
     *out = NULL;
     if (!load_want_kind(ld, map, YNODE_MAP, "'program'") ||
         !load_check_keys(ld, map, keys, COUNT(keys), "program"))
@@ -283,7 +318,7 @@ int load_program(loader *ld, const ynode *map, quantity q, const char *who,
     l->progs = slot;
     l->nprogs = 1;
     quantity xq = Q_TIME;
-    int ok = load_variable(ld, map, who, l, &xq) &&
+    int ok = load_variable(ld, map, who, l, p, &xq) &&
              load_continuity(ld, ymap_get(map, "continuity"), who, &p->continuity) &&
              (!st || load_get_quantity(ld, st, q, "the start", &p->start)) &&
              load_segments(ld, seq, q, xq, who, p) &&

@@ -18,6 +18,9 @@ static const struct {
     {"simple-harmonic", SHAPE_HARMONIC}, {"3-4-5", SHAPE_345},
     {"4-5-6-7", SHAPE_4567},            {"modified-trapezoid", SHAPE_MODTRAP},
     {"modified-sine", SHAPE_MODSINE},
+    /* the same with spaces, as books write them */
+    {"simple harmonic", SHAPE_HARMONIC}, {"modified trapezoid", SHAPE_MODTRAP},
+    {"modified sine", SHAPE_MODSINE},
 };
 
 prog_shape prog_shape_by_name(const char *name)

@@ -261,9 +261,9 @@ static mech_model *program_model(const char *body)
 /* rise 20 mm cycloidal over 120 deg, dwell 60, return 3-4-5 over 120,
  * dwell 60, of the cam angle 144 deg/s * t + 30 deg, from 10 mm: s, v, a by
  * hand with the chain rule (x' = 144 deg/s, x'' = 0) */
-static void closed_program(double t, double out[3])
+static void closed_program(double t, double w, double x0, double out[3])
 {
-    const double D = PI / 180, w = 144 * D, x = fmod(30 * D + w * t, 2 * PI), b = 120 * D;
+    const double D = PI / 180, x = fmod(x0 + w * t, 2 * PI), b = 120 * D;
     double f[3] = {0, 0, 0}, s0 = 0.010, h = 0.020;
     if (x < b)
         cycloidal(x / b, f), f[0] *= h, f[1] *= h, f[2] *= h;
@@ -295,7 +295,7 @@ Test(programs, rise_dwell_return_dwell_solved)
     static const char *const col[3] = {"x_B.s", "x_B.v", "x_B.a"};
     for (int r = 0; r < t.nrows; r++) {
         double tm = mech_table_get(&t, r, 0), truth[3];
-        closed_program(tm, truth);
+        closed_program(tm, 144 * PI / 180, 30 * PI / 180, truth);
         for (int k = 0; k < 3; k++) {
             double e = fabs(table_at(&t, r, col[k]) - truth[k]);
             worst[k] = fmax(worst[k], e);
@@ -507,4 +507,39 @@ Test(programs, piecewise_laws_against_high_precision)
         cr_log_info("[programs] %s against 40 digits: worst %.2g", prog_shape_name(cases[k].s),
                     worst);
     }
+}
+
+/* `speed:` (x = speed * t, the cam angle at 60 rpm): the same program, and
+ * a jump reported in time too */
+Test(programs, speed_gives_the_cam_angle)
+{
+    mech_model *m = program_model(
+        "        speed: 60 rpm\n"
+        "        start: 10 mm\n"
+        "        segments:\n"
+        "          - {rise: 20 mm, over: 120 deg, law: cycloidal}\n"
+        "          - {dwell: 60 deg}\n"
+        "          - {return: 20 mm, over: 120 deg, law: 3-4-5}\n"
+        "          - {dwell: 60 deg}\n");
+    mech_table t = must_solve(m, NULL);
+    static const char *const col[3] = {"x_B.s", "x_B.v", "x_B.a"};
+    for (int r = 0; r < t.nrows; r++) {
+        double tm = mech_table_get(&t, r, 0), truth[3];
+        closed_program(tm, 2 * PI, 0, truth);
+        for (int k = 0; k < 3; k++)
+            cr_assert(fabs(table_at(&t, r, col[k]) - truth[k]) <= 1e-12 * (k == 0 ? 0.03 : k == 1 ? 0.2 : 2),
+                      "row %d (t %g) %s: %.17g, truth %.17g", r, tm, col[k], table_at(&t, r, col[k]),
+                      truth[k]);
+    }
+    mech_table_free(&t);
+    mech_model_free(&m);
+    int line;
+    const char *e = load_error("        speed: 60 rpm\n"
+                               "        segments:\n"
+                               "          - {rise: 20 mm, over: 120 deg, law: simple harmonic}\n"
+                               "          - {dwell: 240 deg}\n", &line);
+    char want[200];  /* pi^2/2 h / beta^2 * omega^2: 20 mm / (2 pi / 3)^2 * (2 pi)^2 */
+    snprintf(want, sizeof want, "(d2s/dx2 = %.6g mm/s^2 in time) at 120 deg",
+             PI * PI / 2 * 20.0 * 9.0);
+    cr_assert(strstr(e, want), "'%s' lacks '%s'", e, want);
 }
