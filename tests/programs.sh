@@ -99,5 +99,7 @@ done
 
 run "equations" 0 "$MECH" equations "$D/follower.yaml" &&
     has_line "$tmp/out" "p_x_B''(t)" "equations: the program as p_x_B(t)"
+run "equations latex" 0 "$MECH" equations --format latex "$D/follower.yaml" &&
+    has_line "$tmp/out" "mathrm{p\\\\_x\\\\_B}''" "equations latex: the name's underscores escaped"
 
 summary

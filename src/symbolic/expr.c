@@ -460,7 +460,14 @@ static void print_rec(const expr_ctx *c, ex e, const expr_names *nm, int latex, 
         break;
     case EX_CALL: {  /* p_crank(t), p_crank'(t), p_crank''(t), p_crank^(3)(t) */
         int k = (int)n->value;
-        fputs(c->fns[n->var].name, out);
+        if (latex) {  /* \mathrm{p\_crank}: a name's underscores are no subscripts */
+            fputs("\\mathrm{", out);
+            for (const char *ch = c->fns[n->var].name; *ch; ch++)
+                fputs(*ch == '_' ? "\\_" : (char[2]){*ch, 0}, out);
+            fputs("}", out);
+        } else {
+            fputs(c->fns[n->var].name, out);
+        }
         if (k > 0 && k <= 2)
             fputs(k == 1 ? "'" : "''", out);
         else if (k > 2)
