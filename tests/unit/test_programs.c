@@ -543,3 +543,43 @@ Test(programs, speed_gives_the_cam_angle)
              PI * PI / 2 * 20.0 * 9.0);
     cr_assert(strstr(e, want), "'%s' lacks '%s'", e, want);
 }
+
+/* an accelerating cam, x = 90 deg/s^2 * t^2 + 20 deg/s * t: the chain rule
+ * with x'' != 0, p' = s'(x) x', p'' = s''(x) x'^2 + s'(x) x'' (a 4-5-6-7 rise
+ * over 180 deg, a modified-sine return over 180 deg) */
+Test(programs, accelerating_variable_chain_rule)
+{
+    mech_model *m = program_model(
+        "        of: 90 deg/s^2 * t^2 + 20 deg/s * t\n"
+        "        segments:\n"
+        "          - {rise: 15 mm, over: 180 deg, law: 4-5-6-7}\n"
+        "          - {return: 15 mm, over: 180 deg, law: modified-sine}\n");
+    mech_table t = must_solve(m, NULL);
+    const double D = PI / 180, b = PI, h = 0.015;
+    prog_segment rise = segment_of(SHAPE_4567), ret = segment_of(SHAPE_MODSINE);
+    double worst = 0;
+    for (int r = 0; r < t.nrows; r++) {
+        double tm = mech_table_get(&t, r, 0);
+        double x = 90 * D * tm * tm + 20 * D * tm, x1 = 180 * D * tm + 20 * D, x2 = 180 * D;
+        double xl = fmod(x, 2 * PI), f[4], s, s1, s2;
+        if (xl < b) {
+            prog_shape_eval(&rise, xl / b, f);
+            s = h * f[0], s1 = h * f[1] / b, s2 = h * f[2] / (b * b);
+        } else {
+            prog_shape_eval(&ret, (xl - b) / b, f);
+            s = h - h * f[0], s1 = -h * f[1] / b, s2 = -h * f[2] / (b * b);
+        }
+        double truth[3] = {s, s1 * x1, s2 * x1 * x1 + s1 * x2};
+        static const char *const col[3] = {"x_B.s", "x_B.v", "x_B.a"};
+        for (int k = 0; k < 3; k++) {
+            double e = fabs(table_at(&t, r, col[k]) - truth[k]);
+            worst = fmax(worst, e / (k == 0 ? h : k == 1 ? h * 10 : h * 100));
+            cr_assert(e <= 1e-12 * (k == 0 ? h : k == 1 ? h * 10 : h * 100),
+                      "row %d (t %g) %s: %.17g, truth %.17g", r, tm, col[k],
+                      table_at(&t, r, col[k]), truth[k]);
+        }
+    }
+    cr_log_info("[programs] accelerating variable: worst relative %.2g", worst);
+    mech_table_free(&t);
+    mech_model_free(&m);
+}
