@@ -426,6 +426,7 @@ void law_free(struct mech_law *l)
     for (int i = 0; i < l->nprogs; i++)
         program_free(l->progs[i]);
     free(l->progs);
+    free((void *)l->rtprogs);
     free(l->nodes);
     free(l);
 }
@@ -581,7 +582,7 @@ static int same_program(const mech_program *p, const mech_program *q)
         const prog_segment *x = &p->seg[i], *y = &q->seg[i];
         if (x->kind != y->kind || x->shape != y->shape || !same_bits(x->x0, y->x0) ||
             !same_bits(x->span, y->span) || !same_bits(x->s0, y->s0) ||
-            !same_bits(x->lift, y->lift) || !same_law(x->user, y->user))
+            !same_bits(x->lift, y->lift) || !same_law(x->user_law, y->user_law))
             return 0;
     }
     return 1;

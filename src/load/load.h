@@ -12,6 +12,7 @@
 #include "base.h"
 #include "symbolic.h"
 #include "rt_forces.h"
+#include "rt_law.h"
 
 /* ==== qparse ==== */
 /* qparse.c: the one parser of quantity expressions (docs/format.md,
@@ -293,12 +294,12 @@ typedef enum {
     LAW_MAX, LAW_STEP, LAW_SIGN,
     LAW_PROGRAM  /* progs[b] of the variable a (a motion program, programs.c) */
 } law_op;
+_Static_assert((int)LAW_PROGRAM == (int)RT_LAW_PROGRAM && (int)LAW_DIV == (int)RT_LAW_DIV,
+               "law_op and rt_law.h's RT_LAW_ in the same order");
 
-typedef struct law_node {
-    law_op op;
-    int a, b;    /* operands (node indices), -1 when unused; LAW_PROGRAM: b is the program */
-    double k;    /* LAW_CONST: the value, SI */
-} law_node;
+/* a node: op (law_op), operands a, b (-1 when unused; LAW_PROGRAM: b is the
+ * program), k (LAW_CONST: the value, SI); rt_law.h's, which evaluates it */
+typedef rt_law_node law_node;
 
 struct mech_program;
 
@@ -311,6 +312,7 @@ struct mech_law {
                          normalised variable, a pure number) */
     char name[72];    /* "p_crank": the law in printed equations and messages */
     struct mech_program **progs;  /* [nprogs] owned */
+    const rt_program **rtprogs;   /* [nprogs] owned array: each program's rt view */
     int nprogs;
 };
 
@@ -354,29 +356,23 @@ int law_add_node(struct mech_law *l, law_op op, int a, int b, double k);
  * law or a user's f(u), u in [0, 1]. Repeats: s(x + P) = s(x) + net. */
 typedef enum { PROG_DWELL, PROG_RISE, PROG_RETURN } prog_kind;
 typedef enum {
-    SHAPE_NONE, SHAPE_CYCLOIDAL, SHAPE_HARMONIC, SHAPE_345, SHAPE_4567, SHAPE_MODTRAP,
-    SHAPE_MODSINE, SHAPE_USER
+    SHAPE_NONE = RT_SHAPE_NONE, SHAPE_CYCLOIDAL = RT_SHAPE_CYCLOIDAL,
+    SHAPE_HARMONIC = RT_SHAPE_HARMONIC, SHAPE_345 = RT_SHAPE_345, SHAPE_4567 = RT_SHAPE_4567,
+    SHAPE_MODTRAP = RT_SHAPE_MODTRAP, SHAPE_MODSINE = RT_SHAPE_MODSINE,
+    SHAPE_USER = RT_SHAPE_USER
 } prog_shape;
-enum { PROG_USER_MAX_NODES = 256 };  /* operations in a segment's f(u) */
-typedef struct prog_piece {  /* f'' = c0 + c1 sin(w u + phi) on [u0, next u0) */
-    double u0, f0, f1, c0, c1, w, phi;
-} prog_piece;
-typedef struct prog_segment {
-    prog_kind kind;
-    prog_shape shape;
-    double x0, span;   /* where it starts in the period, and its span (SI of x) */
-    double s0, lift;   /* displacement at its start; signed lift (SI of s) */
-    prog_piece piece[5];  /* SHAPE_MODTRAP, SHAPE_MODSINE */
-    int npieces;
-    struct mech_law *user;  /* SHAPE_USER: f(u) */
-    mech_mark mark;
-} prog_segment;
+enum { PROG_USER_MAX_NODES = RT_LAW_USER_MAX };  /* operations in a segment's f(u) */
+/* a segment (rt_law.h): kind, shape, x0, span (SI of x), s0 (s at its
+ * start), lift (signed), its pieces, its own law f(u) (user: the rt view;
+ * user_law: the struct mech_law, owned), line and col in the file */
+typedef rt_segment prog_segment;
 typedef struct mech_program {
     prog_segment *seg;  /* [n] */
     int n;
     double start, period, net;  /* s at x = 0; the period; s(P) - s(0) */
     int continuity;     /* checked at load: 0 displacement, 1 + velocity, 2 + acceleration */
     double speed;       /* `speed:` dx/dt (x = speed * of), SI; 0 when not given */
+    rt_program rt;      /* the view rt_law.h evaluates (set when loaded) */
 } mech_program;
 /* The normalised law of segment kind `shape`: f, f', f'', f''' at u. */
 void prog_shape_eval(const prog_segment *sg, double u, double f[4]);

@@ -31,9 +31,10 @@ static int user_law(loader *ld, const ynode *n, const char *who, prog_segment *s
     char msg[256];
     size_t pos = 0;
     quantity none = Q_NUMBER;
-    if (!(sg->user = law_new('u')))
+    struct mech_law *ul = law_new('u');
+    if (!(sg->user_law = ul))
         return load_nomem(ld, n), 0;
-    int rc = law_parse_into(n->text, &none, 1, &ld->env, sg->user, NULL, msg, sizeof msg, &pos);
+    int rc = law_parse_into(n->text, &none, 1, &ld->env, ul, NULL, msg, sizeof msg, &pos);
     if (rc == MECH_ENOMEM)
         return load_nomem(ld, n), 0;
     if (rc < 0) {
@@ -44,12 +45,13 @@ static int user_law(loader *ld, const ynode *n, const char *who, prog_segment *s
         law_error(ld, n, pos, who, full);
         return 0;
     }
-    if (sg->user->n > PROG_USER_MAX_NODES)
+    if (ul->n > PROG_USER_MAX_NODES)
         return load_err(ld, n, "a segment's law has at most %d operations",
                         PROG_USER_MAX_NODES), 0;
+    sg->user = (rt_law){ul->nodes, ul->n, ul->root, NULL};  /* the view rt_law.h reads */
     double d[3], buf[4 * PROG_USER_MAX_NODES];
     for (int end = 0; end <= 1; end++) {
-        double f = law_eval3(sg->user, end, buf, d);
+        double f = law_eval3(ul, end, buf, d);
         if (!(fabs(f - end) <= 1e-9))
             return load_err(ld, n, "driver '%s': a segment's law f(u) must go from f(0) = 0 to "
                             "f(1) = 1 (the lift scales it); f(%d) = %.10g", who, end, f), 0;
@@ -72,7 +74,7 @@ static int load_segment(loader *ld, const ynode *e, quantity q, quantity xq, con
         return 0;
     const ynode *ri = ymap_get(e, "rise"), *re = ymap_get(e, "return"),
                 *dw = ymap_get(e, "dwell"), *ov = ymap_get(e, "over"), *lw = ymap_get(e, "law");
-    sg->mark = e->mark;
+    sg->line = e->mark.line, sg->col = e->mark.col;
     if ((ri != NULL) + (re != NULL) + (dw != NULL) != 1)
         return load_err(ld, e, "a segment is one of {rise: LIFT, over: SPAN, law: LAW}, "
                                "{return: LIFT, over: SPAN, law: LAW}, {dwell: SPAN}"), 0;
@@ -170,7 +172,7 @@ static int check_boundaries(loader *ld, const mech_program *p, quantity q, quant
             if (p->speed != 0 && k > 0)
                 snprintf(in_time, sizeof in_time, " = %.6g %s/s%s in time", jump / ss *
                          pow(p->speed, k), su, k == 2 ? "^2" : "");
-            diag_error(ld->d, ld->file, p->seg[i].mark,
+            diag_error(ld->d, ld->file, (mech_mark){p->seg[i].line, p->seg[i].col},
                        "driver '%s': %s jump of %.6g %s (d%ss/dx%s%s) at %.10g %s between %s and "
                        "%s%s", who, what[k], shown, unit, k == 2 ? "2" : "", k == 2 ? "2" : "",
                        in_time, p->seg[i].x0 > 0 ? p->seg[i].x0 / xs : p->period / xs, xu, l1, l2,
@@ -314,14 +316,24 @@ int load_program(loader *ld, const ynode *map, quantity q, const char *who,
         free(slot);
         return load_nomem(ld, map), 0;
     }
+    const rt_program **rslot = xcalloc(1, sizeof *rslot);
+    if (!rslot) {
+        law_free(l);
+        free(p);
+        free(slot);
+        return load_nomem(ld, map), 0;
+    }
     slot[0] = p;
+    rslot[0] = &p->rt;
     l->progs = slot;
+    l->rtprogs = rslot;
     l->nprogs = 1;
     quantity xq = Q_TIME;
     int ok = load_variable(ld, map, who, l, p, &xq) &&
              load_continuity(ld, ymap_get(map, "continuity"), who, &p->continuity) &&
              (!st || load_get_quantity(ld, st, q, "the start", &p->start)) &&
              load_segments(ld, seq, q, xq, who, p) &&
+             (p->rt = (rt_program){p->seg, p->n, p->start, p->period, p->net}, 1) &&
              check_period(ld, ymap_get(map, "period"), xq, who, p) &&
              check_boundaries(ld, p, q, xq, who);
     if (ok) {
