@@ -6,7 +6,7 @@
 # division by an expression of t) and against differences of its own
 # positions, the load-time checks (a jump at a boundary, a gap in the
 # period) with file:line:column and exit status 2, a law not defined at a
-# row's time, and mech codegen's refusal. The laws themselves are checked
+# row's time, and mech codegen bit for bit. The laws themselves are checked
 # to 1e-13 by tests/unit/test_programs.c.
 # Run from the repository root:  MECH=build/mech sh tests/programs.sh
 NAME=programs . tests/lib.sh
@@ -89,13 +89,27 @@ if run "log of a negative number" 2 "$MECH" solve "$tmp/log.yaml" -o "$tmp/log.c
     has_line "$tmp/err" "log.yaml:13:5: error: driver 'x_B': its law is not defined at t = 2 s: log of 0" "log: the time and why"
 fi
 
-# mech codegen refuses a program and the new functions, writing nothing
-for f in follower functions; do
-    if run "codegen $f refused" 2 "$MECH" codegen "$D/$f.yaml" -o "$tmp/$f.c"; then
-        has_line "$tmp/err" "error: codegen: driver 'x_B': its law .* is not supported by the generated code" "codegen $f: the refusal"
-        [ ! -e "$tmp/$f.c" ] && pass || fail "codegen $f: a refused run wrote its source"
+# mech codegen generates the programs and the functions (rt_law.h, shared
+# with the interpreter): its solver's rows are mech solve's bit for bit
+# (tolerance 0); mech solve --jit writes the same table
+for f in follower functions rocker mixed; do
+    dir=$tmp/gen-$f
+    mkdir -p "$dir"
+    if run "codegen $f" 0 "$MECH" codegen "$D/$f.yaml" -o "$dir/gen.c" --header "$dir/gen.h" --prefix gen &&
+            ${CC:-cc} -std=c11 -Wall -Wextra -Werror -pedantic -O2 -I"$dir" -o "$dir/drv" "$dir/gen.c" \
+                tests/codegen_driver.c -lm 2>"$dir/cc" &&
+            "$MECH" solve "$D/$f.yaml" -q -o "$dir/ref.csv"; then
+        "$dir/drv" "$dir/ref.csv" 0 >"$dir/out" 2>&1 && pass ||
+            fail "codegen $f: the generated solver against mech solve: $(head -n 2 "$dir/out" "$dir/cc")"
+    else
+        fail "codegen $f: $(head -n 2 "$tmp/err" "$dir/cc" 2>/dev/null)"
     fi
 done
+if run "solve --jit" 0 "$MECH" solve --jit "$D/mixed.yaml" -o "$tmp/jit.csv" &&
+        run "solve" 0 "$MECH" solve "$D/mixed.yaml" -o "$tmp/int.csv"; then
+    cmp -s "$tmp/jit.csv" "$tmp/int.csv" && pass || fail "solve --jit: not the interpreter's table"
+    has_line "$tmp/int.csv" "^t \\[s\\],x1.s \\[m\\]" "mixed: both sliders' columns"
+fi
 
 run "equations" 0 "$MECH" equations "$D/follower.yaml" &&
     has_line "$tmp/out" "p_x_B''(t)" "equations: the program as p_x_B(t)"
