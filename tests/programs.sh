@@ -111,6 +111,17 @@ if run "solve --jit" 0 "$MECH" solve --jit "$D/mixed.yaml" -o "$tmp/jit.csv" &&
     has_line "$tmp/int.csv" "^t \\[s\\],x1.s \\[m\\]" "mixed: both sliders' columns"
 fi
 
+# a parameter in a program: each variant its own laws (drivers_same), the
+# peak acceleration h 2 pi / beta^2 * w^2 linear in the lift
+sed 's/^units: {length: mm, angle: deg}$/units: {length: mm, angle: deg}\nparameters: {lift: 20 mm}/; s/rise: 20 mm,/rise: lift,/; s/return: 20 mm,/return: lift,/' \
+    "$D/follower.yaml" >"$tmp/swp.yaml"
+if run "sweep a lift" 0 "$MECH" sweep "$tmp/swp.yaml" --vary lift=10:30:3 --metric max:x_B.a -o "$tmp/swp.csv"; then
+    awk -F, 'BEGIN { PI = atan2(0, -1); b = 120 * PI / 180; w = 144 * PI / 180; bad = 0 }
+        NR > 1 { h = (NR - 1) * 0.010; a = h * 2 * PI / (b * b) * w * w
+                 d = ($5 - a) / a; if (d < 0) d = -d; if (d > 1e-6) bad++ }
+        END { exit bad > 0 || NR != 4 }' "$tmp/swp.csv" && pass || fail "sweep a lift: $(cat "$tmp/swp.csv")"
+fi
+
 run "equations" 0 "$MECH" equations "$D/follower.yaml" &&
     has_line "$tmp/out" "p_x_B''(t)" "equations: the program as p_x_B(t)"
 run "equations latex" 0 "$MECH" equations --format latex "$D/follower.yaml" &&
