@@ -91,7 +91,7 @@ LIB_OBJ  = $(patsubst %.c,$(BUILD)/pic/%.o,$(notdir $(LIB_SRC))) $(BUILD)/pic/rt
 # The runtime libmech and the generated code share (docs/codegen.md): real C,
 # compiled into libmech through its includers, and its text carried by `mech
 # codegen` (build/gen/rt_text.c, in the order the generated source needs it).
-RT_SRC   = $(addprefix src/runtime/,rt_base.h rt_blocklu.h rt_newton.h rt_frame.h rt_forces.h rt_solver.h)
+RT_SRC   = $(addprefix src/runtime/,rt_base.h rt_blocklu.h rt_newton.h rt_frame.h rt_forces.h rt_law.h rt_solver.h)
 TEST_SRC = $(wildcard tests/unit/*.c)
 TEST_OBJ = $(TEST_SRC:tests/unit/%.c=$(BUILD)/tests/%.o)
 
@@ -235,6 +235,7 @@ define SUITES
 	$(TIMED) draw $(SUITE_ENV) sh tests/draw.sh
 	$(TIMED) watch $(SUITE_ENV) sh tests/watch.sh
 	$(TIMED) drivers $(SUITE_ENV) sh tests/drivers.sh
+	$(TIMED) programs $(SUITE_ENV) sh tests/programs.sh
 	$(TIMED) fit $(SUITE_ENV) sh tests/fit.sh
 	$(TIMED) dynamics $(SUITE_ENV) sh tests/dynamics.sh
 	$(TIMED) drawn $(SUITE_ENV) sh tests/drawn.sh

@@ -18,14 +18,16 @@ NAME=codegen . tests/lib.sh
 CC=${CC:-cc}
 CFLAGS_GEN="-std=c11 -Wall -Wextra -Werror -pedantic -O2"
 files="mechanisms/*.yaml tests/hard/high-speed.yaml tests/hard/micrometre-fourbar.yaml
-    tests/hard/mixed-scale.yaml tests/hard/dead-centre-slider.yaml tests/solve/dead-centre.yaml"
+    tests/hard/mixed-scale.yaml tests/hard/dead-centre-slider.yaml tests/solve/dead-centre.yaml
+    tests/programs/*.yaml"
 min_rcond="conveyor:0.03 conveyor:0.05 stirling:0.04 stirling:0.05"
 # (with the runtime's rt_ names that end in no public suffix)
 prefixes="cg block linear newton rt_step rt_column cg_newton"
 force_prefixes="force friction kinetostatics smooth fv rt_power rt_load"
 if [ -n "$MECH_QUICK" ]; then
     CFLAGS_GEN="-std=c11 -Wall -Wextra -Werror -pedantic -O0"
-    files="mechanisms/fourbar.yaml mechanisms/stirling.yaml" min_rcond=stirling:0.04
+    files="mechanisms/fourbar.yaml mechanisms/stirling.yaml tests/programs/mixed.yaml"
+    min_rcond=stirling:0.04
     prefixes=block force_prefixes=friction
 fi
 # under a sanitizer build, the generated code runs under one too
@@ -80,9 +82,10 @@ for file in $files; do
     else
         build "$dir" "$file" || continue
     fi
-    # standalone: the C library's headers only, no allocation
+    # standalone: the C library's headers only (<complex.h> with laws of time
+    # beyond + - * sin cos: rt_law.h), no allocation
     others=$(grep '^#include' "$dir/gen.c" | grep -v -e '<float.h>' -e '<math.h>' \
-             -e '<string.h>' -e '"gen.h"')
+             -e '<string.h>' -e '<complex.h>' -e '"gen.h"')
     [ -z "$others" ] && pass || fail "$base: the generated source includes $others"
     grep -q -E '\b(malloc|calloc|realloc|free)\b' "$dir/gen.c" "$dir/gen.h" \
         && fail "$base: the generated code allocates" || pass

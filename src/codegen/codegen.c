@@ -155,7 +155,8 @@ static const char *line_clash(const codegen *g, const char *line, int *in_commen
 static const char *prefix_clash(const codegen *g, char *buf, size_t size)
 {
     const char *const *texts[] = {codegen_rt_base,   codegen_rt_blocklu, codegen_rt_newton,
-                                  codegen_rt_frame,  codegen_rt_forces,  codegen_rt_solver};
+                                  codegen_rt_frame,  codegen_rt_forces,  codegen_rt_law,
+                                  codegen_rt_solver};
     for (size_t t = 0; t < COUNT_OF(texts); t++) {
         int in_comment = 0;
         for (int l = 0; texts[t][l]; l++)
@@ -643,6 +644,10 @@ int codegen_emit_source(FILE *f, const void *ctx)
     emit_text(f, codegen_rt_frame);
     if (g->want_forces)
         emit_text(f, codegen_rt_forces);
+    if (g->sp.sys->ex.nfns > 0) {  /* laws of time beyond the DAG's operations */
+        emit_text(f, codegen_rt_law);
+        codegen_laws_emit(g, f);
+    }
     if (emit_pattern(g, f) < 0 || codegen_expr_emit(g, f) < 0)
         return -1;
     if (codegen_forces_emit(g, f) < 0 || codegen_kin_emit(g, f) < 0)

@@ -72,6 +72,9 @@ int codegen_emit_source(FILE *f, const void *ctx);
 int codegen_expr_plan(codegen *g, mech_diag *d);
 /* The functions eval_driver, eval_position, eval_velocity, eval_accel; 0 or -1. */
 int codegen_expr_emit(const codegen *g, FILE *f);
+/* codegen_expr.c: the tables and the call of each law of time the DAG holds as
+ * an opaque function (rt_law.h), before the phases that call them. */
+void codegen_laws_emit(const codegen *g, FILE *f);
 /* The function kinematics: link frames, output columns, branch values. */
 int codegen_kin_emit(const codegen *g, FILE *f);
 /* build/gen/rt_text.c (Makefile, tools/c_lines.awk): the text of the runtime
@@ -82,6 +85,7 @@ extern const char *const codegen_rt_blocklu[];
 extern const char *const codegen_rt_newton[];
 extern const char *const codegen_rt_frame[];
 extern const char *const codegen_rt_forces[];
+extern const char *const codegen_rt_law[];
 extern const char *const codegen_rt_solver[];
 
 /* ---- codegen_forces.c: the kinetostatics ---------------------------------- */

@@ -68,6 +68,94 @@ static int driver_only(codegen *g, ex e)
     return g->driver_only[e];
 }
 
+/* ---- laws of time beyond the DAG's operations (docs/motion-programs.md) --
+ * Each opaque law (an EX_CALL's function, law_expr) becomes its tables for
+ * rt_law.h - its nodes, its programs' segments, a segment's own f(u) - and
+ * cg_lawK_call(order, t), which the node calls: the interpreter's tape
+ * calls the same rt_law_call on the same numbers (law_fn_eval). */
+static void law_nodes(FILE *f, const char *name, const rt_law_node *nd, int n)
+{
+    fprintf(f, "static const rt_law_node %s[%d] = {\n", name, n);
+    for (int i = 0; i < n; i++) {
+        char k[40];
+        codegen_number(k, sizeof k, nd[i].k);
+        fprintf(f, "    {%d, %d, %d, %s},\n", nd[i].op, nd[i].a, nd[i].b, k);
+    }
+    fprintf(f, "};\n");
+}
+
+static void segment_row(FILE *f, const prog_segment *sg, const char *user)
+{
+    char v[6][40];
+    const double x[6] = {sg->x0, sg->span, sg->s0, sg->lift, 0, 0};
+    for (int i = 0; i < 4; i++)
+        codegen_number(v[i], sizeof v[i], x[i]);
+    fprintf(f, "    {%d, %d, %s, %s, %s, %s, {", sg->kind, sg->shape, v[0], v[1], v[2], v[3]);
+    for (int j = 0; j < 5; j++) {
+        const rt_piece *p = &sg->piece[j];
+        const double pv[7] = {p->u0, p->f0, p->f1, p->c0, p->c1, p->w, p->phi};
+        fprintf(f, "%s{", j ? ", " : "");
+        for (int c = 0; c < 7; c++) {
+            char num[40];
+            codegen_number(num, sizeof num, pv[c]);
+            fprintf(f, "%s%s", c ? ", " : "", num);
+        }
+        fprintf(f, "}");
+    }
+    if (user)
+        fprintf(f, "}, %d, {%s, %d, %d, NULL}, NULL, 0, 0},\n", sg->npieces, user, sg->user.n,
+                sg->user.root);
+    else
+        fprintf(f, "}, %d, {NULL, 0, -1, NULL}, NULL, 0, 0},\n", sg->npieces);
+}
+
+static void program_tables(FILE *f, int k, int j, const mech_program *p)
+{
+    char name[64];
+    for (int i = 0; i < p->n; i++)
+        if (p->seg[i].shape == SHAPE_USER) {
+            snprintf(name, sizeof name, "cg_law%d_p%d_u%d", k, j, i);
+            law_nodes(f, name, p->seg[i].user.nodes, p->seg[i].user.n);
+        }
+    fprintf(f, "static const rt_segment cg_law%d_p%d_seg[%d] = {\n", k, j, p->n);
+    for (int i = 0; i < p->n; i++) {
+        snprintf(name, sizeof name, "cg_law%d_p%d_u%d", k, j, i);
+        segment_row(f, &p->seg[i], p->seg[i].shape == SHAPE_USER ? name : NULL);
+    }
+    char v[3][40];
+    codegen_number(v[0], sizeof v[0], p->start);
+    codegen_number(v[1], sizeof v[1], p->period);
+    codegen_number(v[2], sizeof v[2], p->net);
+    fprintf(f, "};\nstatic const rt_program cg_law%d_p%d = {cg_law%d_p%d_seg, %d, %s, %s, %s};\n",
+            k, j, k, j, p->n, v[0], v[1], v[2]);
+}
+
+void codegen_laws_emit(const codegen *g, FILE *f)
+{
+    const expr_ctx *c = &g->sp.sys->ex;
+    for (int k = 0; k < c->nfns; k++) {
+        const struct mech_law *l = c->fns[k].data;
+        char name[64], progs[64] = "NULL";
+        fprintf(f, "/* %s: a law of time of the runtime (rt_law.h) */\n", c->fns[k].name);
+        for (int j = 0; j < l->nprogs; j++)
+            program_tables(f, k, j, l->progs[j]);
+        if (l->nprogs > 0) {
+            fprintf(f, "static const rt_program *const cg_law%d_progs[%d] = {", k, l->nprogs);
+            for (int j = 0; j < l->nprogs; j++)
+                fprintf(f, "%s&cg_law%d_p%d", j ? ", " : "", k, j);
+            fprintf(f, "};\n");
+            snprintf(progs, sizeof progs, "cg_law%d_progs", k);
+        }
+        snprintf(name, sizeof name, "cg_law%d_nodes", k);
+        law_nodes(f, name, l->nodes, l->n);
+        fprintf(f, "static const rt_law cg_law%d = {cg_law%d_nodes, %d, %d, %s};\n"
+                   "static inline double cg_law%d_call(int order, double t)\n{\n"
+                   "    double buf[4 * %d];\n"
+                   "    return rt_law_call(&cg_law%d, order, t, buf);\n}\n\n",
+                k, k, l->n, l->root, progs, k, l->n, k);
+    }
+}
+
 /* Give e (used by a node or root of phase `user`, under a root of phase
  * `root`) its phase, and a keep slot when a later phase uses it. */
 static int visit(codegen *g, ex e, int user, int root, mech_diag *d)
@@ -83,6 +171,8 @@ static int visit(codegen *g, ex e, int user, int root, mech_diag *d)
                           "codegen: an equation uses '%s', which is not solved",
                           g->sp.sys->names[nd->var]);
     case EX_ADD: case EX_MUL: case EX_NEG: case EX_SIN: case EX_COS:
+        break;
+    case EX_CALL:
         break;
     default:
         return diag_error(d, g->m->file, g->m->driver.mark,
@@ -172,6 +262,10 @@ static int emit_nodes(const codegen *g, FILE *f, int ph)
         case EX_NEG: fprintf(f, "    const double t%d = -%s;\n", e, a); break;
         case EX_SIN: fprintf(f, "    const double t%d = sin(%s);\n", e, a); break;
         case EX_COS: fprintf(f, "    const double t%d = cos(%s);\n", e, a); break;
+        case EX_CALL:
+            fprintf(f, "    const double t%d = cg_law%d_call(%d, %s);\n", e, nd->var, (int)nd->value,
+                    a);
+            break;
         default: return -1;  /* codegen_expr_plan has reported it */
         }
         if (g->keep[e] >= 0)

@@ -12,6 +12,7 @@
 #include "base.h"
 #include "symbolic.h"
 #include "rt_forces.h"
+#include "rt_law.h"
 
 /* ==== qparse ==== */
 /* qparse.c: the one parser of quantity expressions (docs/format.md,
@@ -282,19 +283,37 @@ int pexpr_point_gradient(const mech_model *m, int p, double *out);
  * unknowns. */
 enum { LAW_MAX_NODES = 2048 };  /* operations in one law (law_eval's buffer) */
 
-typedef enum { LAW_CONST, LAW_T, LAW_ADD, LAW_MUL, LAW_NEG, LAW_SIN, LAW_COS } law_op;
+/* ORDER LAW: law_eval (law_eval.c), law_expr and law_why switch on these.
+ * The operations up to LAW_COS are the DAG's (expr.c): a law made of them
+ * only enters the system as its expression, as the generated code does.
+ * A law with any later one (docs/motion-programs.md) enters as one opaque
+ * function of q (EX_CALL) whose value and derivatives law_eval gives. */
+typedef enum {
+    LAW_CONST, LAW_T, LAW_ADD, LAW_MUL, LAW_NEG, LAW_SIN, LAW_COS,
+    LAW_DIV, LAW_EXP, LAW_LOG, LAW_SQRT, LAW_TAN, LAW_TANH, LAW_ATAN2, LAW_ABS, LAW_MIN,
+    LAW_MAX, LAW_STEP, LAW_SIGN,
+    LAW_PROGRAM  /* progs[b] of the variable a (a motion program, programs.c) */
+} law_op;
+_Static_assert((int)LAW_PROGRAM == (int)RT_LAW_PROGRAM && (int)LAW_DIV == (int)RT_LAW_DIV,
+               "law_op and rt_law.h's RT_LAW_ in the same order");
 
-typedef struct law_node {
-    law_op op;
-    int a, b;    /* operands (node indices), -1 when unused */
-    double k;    /* LAW_CONST: the value, SI */
-} law_node;
+/* a node: op (law_op), operands a, b (-1 when unused; LAW_PROGRAM: b is the
+ * program), k (LAW_CONST: the value, SI); rt_law.h's, which evaluates it */
+typedef rt_law_node law_node;
+
+struct mech_program;
 
 struct mech_law {
     law_node *nodes;  /* [n] operands come before the node that uses them */
     int n, cap;
     int root;
     int nomem;        /* parsing ran out of memory */
+    char var;         /* the variable's name: 't' (a time), or 'u' (a program segment's
+                         normalised variable, a pure number) */
+    char name[72];    /* "p_crank": the law in printed equations and messages */
+    struct mech_program **progs;  /* [nprogs] owned */
+    const rt_program **rtprogs;   /* [nprogs] owned array: each program's rt view */
+    int nprogs;
 };
 
 /* Parse the law `text`, a quantity `want` (Q_ANGLE or Q_LENGTH) of the
@@ -307,8 +326,64 @@ void law_free(struct mech_law *l);
 /* The law's value at time t (SI), and its first and second time derivatives
  * (by forward differentiation of the tree, independent of expr.c). */
 double law_eval(const struct mech_law *l, double t, double *dt, double *dtt);
+/* law_eval.c: the same, with the third derivative (NULL: not wanted), into
+ * a caller's buffer buf[4 * l->n] (no allocation); NaN where the law or a
+ * derivative is not defined. */
+double law_eval3(const struct mech_law *l, double t, double *buf, double d[3]);
+/* Is the law (and its first two derivatives) defined at t? 1; else 0 with
+ * why it is not ("log of a negative number (-0.5)") in why. */
+int law_defined(const struct mech_law *l, double t, char *why, size_t size);
+/* Does the law use an operation the DAG does not have (LAW_DIV ...)? */
+int law_is_opaque(const struct mech_law *l);
+/* expr_fn's eval for an opaque law (data: the law): order 0, 1, 2, 3. */
+double law_fn_eval(const void *data, int order, double t);
 /* The law as an expression of the variable t in c. */
 ex law_expr(const struct mech_law *l, expr_ctx *c, ex t);
+/* Parse `text` as a law of the variable l->var into l (a new tree or one
+ * under way), one of the quantities wants[0..nwants-1]; *got: which.
+ * As law_parse otherwise. */
+int law_parse_into(const char *text, const quantity *wants, int nwants, const expr_env *env,
+                   struct mech_law *l, quantity *got, char *err, size_t errsize,
+                   size_t *err_pos);
+/* A new empty law of the variable var ('t' or 'u'), or NULL. */
+struct mech_law *law_new(char var);
+/* Append a node to l; its index, or -1 when out of memory or too long. */
+int law_add_node(struct mech_law *l, law_op op, int a, int b, double k);
+
+/* ---- programs.c: motion programs (docs/motion-programs.md) -------------
+ * A displacement program over one period of its variable x (a law of t):
+ * segments (dwell, rise, return) each over a span of x, with a standard
+ * law or a user's f(u), u in [0, 1]. Repeats: s(x + P) = s(x) + net. */
+typedef enum { PROG_DWELL, PROG_RISE, PROG_RETURN } prog_kind;
+typedef enum {
+    SHAPE_NONE = RT_SHAPE_NONE, SHAPE_CYCLOIDAL = RT_SHAPE_CYCLOIDAL,
+    SHAPE_HARMONIC = RT_SHAPE_HARMONIC, SHAPE_345 = RT_SHAPE_345, SHAPE_4567 = RT_SHAPE_4567,
+    SHAPE_MODTRAP = RT_SHAPE_MODTRAP, SHAPE_MODSINE = RT_SHAPE_MODSINE,
+    SHAPE_USER = RT_SHAPE_USER
+} prog_shape;
+enum { PROG_USER_MAX_NODES = RT_LAW_USER_MAX };  /* operations in a segment's f(u) */
+/* a segment (rt_law.h): kind, shape, x0, span (SI of x), s0 (s at its
+ * start), lift (signed), its pieces, its own law f(u) (user: the rt view;
+ * user_law: the struct mech_law, owned), line and col in the file */
+typedef rt_segment prog_segment;
+typedef struct mech_program {
+    prog_segment *seg;  /* [n] */
+    int n;
+    double start, period, net;  /* s at x = 0; the period; s(P) - s(0) */
+    int continuity;     /* checked at load: 0 displacement, 1 + velocity, 2 + acceleration */
+    double speed;       /* `speed:` dx/dt (x = speed * of), SI; 0 when not given */
+    rt_program rt;      /* the view rt_law.h evaluates (set when loaded) */
+} mech_program;
+/* The normalised law of segment kind `shape`: f, f', f'', f''' at u. */
+void prog_shape_eval(const prog_segment *sg, double u, double f[4]);
+/* Fill a segment's pieces (modified trapezoid and sine). */
+void prog_shape_init(prog_segment *sg);
+/* s(x) and its derivatives d[0..3] in x. */
+void program_eval(const mech_program *p, double x, double d[4]);
+void program_free(struct mech_program *p);
+/* A shape by its name in the file ("cycloidal", "3-4-5", ...), or SHAPE_NONE. */
+prog_shape prog_shape_by_name(const char *name);
+const char *prog_shape_name(prog_shape s);
 
 /* ---- the one model of drivers ------------------------------------------
  * Driver k holds its coordinate x_k (a link angle or a slider
@@ -340,6 +415,9 @@ ex drivers_row(const mech_model *m, int k, expr_ctx *c, const ex *link_angle, co
  * joint_var: the system's). */
 void drivers_guess(const mech_model *m, const int *link_var, const int *joint_var, double q,
                    double *guess);
+/* The first driver whose law (or its rate, or its second derivative) is
+ * not defined at q, why in why; -1 when all are (sweep.c, at every row). */
+int drivers_undefined(const mech_model *m, double q, char *why, size_t size);
 /* The name of driver k ("crank" or the slider's name). */
 const char *drivers_name(const mech_model *m, int k);
 /* The driver of link l's angle or of slider joint j, or -1. */
@@ -623,6 +701,10 @@ void load_driver(loader *ld, const ynode *map);
 void load_range(loader *ld, const ynode *n, quantity q, mech_driver *dr);
 /* load_drivers.c: 'sweep: {time: RANGE}' and 'drivers: [...]' (laws of time) */
 void load_sweep_drivers(loader *ld, const ynode *sweep, const ynode *drivers);
+/* load_programs.c: `program:` of a driver's law (q: Q_ANGLE or Q_LENGTH),
+ * into *out (the law of t, its last node the program). 1, or 0 reported. */
+int load_program(loader *ld, const ynode *map, quantity q, const char *driver,
+                 struct mech_law **out);
 void load_initial(loader *ld, const ynode *map);
 /* load.c: the whole file at path, at most max bytes, checked before and while
  * reading (NULL with *rc set and the problem recorded in d). */

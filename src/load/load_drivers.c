@@ -152,6 +152,26 @@ static void load_motion(loader *ld, const ynode *e, mech_motion *mo)
             mo->index = -1;
         return;
     }
+    const char *who = ln ? ln->text : sn->text;
+    if (law->kind == YNODE_MAP) {  /* {program: {...}} */
+        static const char *const pkeys[] = {"program"};
+        const ynode *pm = ymap_get(law, "program");
+        if (!load_check_keys(ld, law, pkeys, COUNT(pkeys), "a driver's law"))
+            return;
+        if (!pm)
+            return (void)load_err(ld, law, "a driver's law is an expression of t or "
+                                           "{program: {...}}");
+        if (!load_program(ld, pm, ln ? Q_ANGLE : Q_LENGTH, who, &mo->law))
+            return;
+        snprintf(mo->law->name, sizeof mo->law->name, "p_%s", who);
+        char text[160];
+        const ynode *of = ymap_get(pm, "of");
+        snprintf(text, sizeof text, "program of %s, %d segments", of ? of->text : "t",
+                 mo->law->progs[0]->n);
+        if (!(mo->text = xstrdup(text)))
+            load_nomem(ld, law);
+        return;
+    }
     if (!load_want_kind(ld, law, YNODE_SCALAR, "a driver's law"))
         return;
     char msg[256];
@@ -167,6 +187,7 @@ static void load_motion(loader *ld, const ynode *e, mech_motion *mo)
         diag_error(ld->d, ld->file, at, "driver '%s': %s", ln ? ln->text : sn->text, msg);
         return;
     }
+    snprintf(mo->law->name, sizeof mo->law->name, "p_%s", who);
     mo->text = xstrdup(law->text);
     if (!mo->text)
         load_nomem(ld, law);

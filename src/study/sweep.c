@@ -498,6 +498,20 @@ static int add_gap(mech_table *t, const mech_gap *g)
     return 0;
 }
 
+/* A law of time not defined at q (a log of a negative number, a division
+ * by zero, a corner of abs): an error at the driver, naming the time and
+ * why, not NaN rows (docs/motion-programs.md). */
+static int undefined_law(run *r, double q)
+{
+    const mech_model *m = r->a->m;
+    char why[160];
+    int k = drivers_undefined(m, q, why, sizeof why);
+    if (k < 0)
+        return MECH_OK;
+    return diag_error(r->d, m->file, m->drivers[k].mark, "driver '%s': its law is not defined "
+                      "at t = %.10g s: %s", drivers_name(m, k), q, why);
+}
+
 /* Every requested row that can be reached; the others as gaps. A failure
  * of the forces stops the sweep (its status returned). */
 static int sweep_rows(run *r, const double *q, int nq)
@@ -508,6 +522,8 @@ static int sweep_rows(run *r, const double *q, int nq)
     for (int row = 0; row < nq; row++) {
         if (o->progress && row > 0 && (row & 4095) == 0)
             o->progress(o->progress_ctx, row, nq);
+        if (undefined_law(r, q[row]) != MECH_OK)
+            return MECH_EINPUT;
         int rc = solve_row(r, q, row, &g, in_gap);
         if (rc == MECH_OK && row >= r->smp.next_row)
             assembly_take(&r->smp, row, q[row], r->c.sv.x);

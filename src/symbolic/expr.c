@@ -86,6 +86,7 @@ int expr_init(expr_ctx *c)
 
 void expr_free(expr_ctx *c)
 {
+    free(c->fns);
     free(c->nodes);
     free(c->table);
     memset(c, 0, sizeof *c);
@@ -205,6 +206,32 @@ ex expr_cos(expr_ctx *c, ex a)
     return intern(c, EX_COS, -1, a, -1, 0.0);
 }
 
+int expr_fn_add(expr_ctx *c, const expr_fn *fn)
+{
+    for (int k = 0; k < c->nfns; k++)
+        if (c->fns[k].eval == fn->eval && c->fns[k].data == fn->data)
+            return k;
+    expr_fn *more = xrealloc_array(c->fns, (size_t)c->nfns + 1, sizeof *more);
+    if (!more) {
+        c->failed = 1;
+        return -1;
+    }
+    c->fns = more;
+    c->fns[c->nfns] = *fn;
+    return c->nfns++;
+}
+
+/* Not folded when a is a constant: the value may be NaN (a law where it is
+ * not defined), which the caller must see where it is evaluated. */
+ex expr_call(expr_ctx *c, int fn, int order, ex a)
+{
+    if (fn < 0 || fn >= c->nfns) {
+        c->failed = 1;
+        return 0;
+    }
+    return intern(c, EX_CALL, fn, a, -1, (double)order);
+}
+
 /* ---- traversals ----------------------------------------------------- */
 
 static ex diff_rec(expr_ctx *c, ex e, int var)
@@ -237,6 +264,12 @@ static ex diff_rec(expr_ctx *c, ex e, int var)
     case EX_COS:
         r = expr_neg(c, expr_mul(c, diff_rec(c, n.a, var), expr_sin(c, n.a)));
         break;
+    case EX_CALL: {
+        ex da = diff_rec(c, n.a, var);
+        r = expr_is_const(c, da, 0.0) ? c->zero
+                                       : expr_mul(c, da, expr_call(c, n.var, (int)n.value + 1, n.a));
+        break;
+    }
     default:
         abort(); /* unknown op: a new op needs a rule here */
     }
@@ -288,6 +321,10 @@ static double eval_rec(const expr_ctx *c, ex e, const double *vars)
     case EX_NEG: return -eval_rec(c, n->a, vars);
     case EX_SIN: return sin(eval_rec(c, n->a, vars));
     case EX_COS: return cos(eval_rec(c, n->a, vars));
+    case EX_CALL: {
+        const expr_fn *f = &c->fns[n->var];
+        return f->eval(f->data, (int)n->value, eval_rec(c, n->a, vars));
+    }
     }
     abort(); /* unknown op */
 }
@@ -421,6 +458,25 @@ static void print_rec(const expr_ctx *c, ex e, const expr_names *nm, int latex, 
         print_rec(c, n->a, nm, latex, out, 0);
         fputs(latex ? "\\right)" : ")", out);
         break;
+    case EX_CALL: {  /* p_crank(t), p_crank'(t), p_crank''(t), p_crank^(3)(t) */
+        int k = (int)n->value;
+        if (latex) {  /* \mathrm{p\_crank}: a name's underscores are no subscripts */
+            fputs("\\mathrm{", out);
+            for (const char *ch = c->fns[n->var].name; *ch; ch++)
+                fputs(*ch == '_' ? "\\_" : (char[2]){*ch, 0}, out);
+            fputs("}", out);
+        } else {
+            fputs(c->fns[n->var].name, out);
+        }
+        if (k > 0 && k <= 2)
+            fputs(k == 1 ? "'" : "''", out);
+        else if (k > 2)
+            fprintf(out, latex ? "^{(%d)}" : "^(%d)", k);
+        fputs(latex ? "\\left(" : "(", out);
+        print_rec(c, n->a, nm, latex, out, 0);
+        fputs(latex ? "\\right)" : ")", out);
+        break;
+    }
     }
     if (paren)
         fputs(latex ? "\\right)" : ")", out);

@@ -18,8 +18,21 @@ typedef enum {
     EX_MUL,   /* a * b */
     EX_NEG,   /* -a */
     EX_SIN,   /* sin(a) */
-    EX_COS    /* cos(a) */
+    EX_COS,   /* cos(a) */
+    EX_CALL   /* fns[var].eval(data, order, a): the order-th derivative of an opaque
+                 function of one argument (value = order); a law of time that the
+                 DAG's operations cannot write (docs/motion-programs.md) */
 } expr_op;
+
+/* An opaque function of one argument known to a context: eval gives its
+ * value (order 0) and its derivatives (order 1, 2, ...), NaN where it is
+ * not defined. The DAG differentiates a call by the chain rule; the tape
+ * calls eval; the code generator refuses it (its name in the message). */
+typedef struct expr_fn {
+    double (*eval)(const void *data, int order, double x);
+    const void *data;
+    const char *name;
+} expr_fn;
 
 typedef int ex; /* a node: index into expr_ctx.nodes */
 
@@ -40,6 +53,8 @@ typedef struct expr_ctx {
     unsigned stamp;     /* traversal counter */
     int failed;         /* out of memory: every constructor then returns ex 0 */
     ex zero, one;
+    expr_fn *fns;       /* [nfns] the functions EX_CALL nodes name */
+    int nfns;
 } expr_ctx;
 
 int expr_init(expr_ctx *c);
@@ -53,6 +68,10 @@ ex expr_mul(expr_ctx *c, ex a, ex b);
 ex expr_neg(expr_ctx *c, ex a);
 ex expr_sin(expr_ctx *c, ex a);
 ex expr_cos(expr_ctx *c, ex a);
+/* The function fn of the context (expr_fn_add) or its order-th derivative, of a. */
+ex expr_call(expr_ctx *c, int fn, int order, ex a);
+/* The number of (eval, data) in c's table, added when new; -1 when out of memory. */
+int expr_fn_add(expr_ctx *c, const expr_fn *fn);
 
 static inline const expr_node *expr_at(const expr_ctx *c, ex e) { return &c->nodes[e]; }
 static inline int expr_is_const(const expr_ctx *c, ex e, double v)
@@ -92,6 +111,7 @@ typedef enum {
     TOP_SIN, /* r[d] = sin(r[a]) */
     TOP_COS, /* r[d] = cos(r[a]) */
     TOP_SINCOS, /* r[d] = sin(r[a]), r[b] = cos(r[a]): one sincos call */
+    TOP_CALL,   /* r[d] = fns[b].eval(data, c, r[a]) (b, c are no registers) */
     /* superinstructions (tape_compile fuses a MUL or ADD whose result has
        one use into its user; the same roundings in the same order) */
     TOP_MULADD, /* r[d] = r[a] * r[b] + r[c] */
@@ -131,6 +151,8 @@ typedef struct tape {
     int *node_reg;      /* [nnodes] register of a DAG node, -1 when not compiled (or,
                            after tape_fuse, computed inside a superinstruction) */
     size_t nnodes;
+    expr_fn *fns;       /* [nfns] a copy of the context's functions (TOP_CALL) */
+    int nfns;
 } tape;
 
 /* Compile phases of roots: roots[k][0..nroots[k]-1] for k < nphases. Nodes

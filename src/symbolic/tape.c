@@ -14,6 +14,7 @@ void tape_free(tape *t)
     free(t->ins);
     free(t->var_reg);
     free(t->node_reg);
+    free(t->fns);
     memset(t, 0, sizeof *t);
 }
 
@@ -25,6 +26,7 @@ static int op_of(expr_op op)
     case EX_NEG: return TOP_NEG;
     case EX_SIN: return TOP_SIN;
     case EX_COS: return TOP_COS;
+    case EX_CALL: return TOP_CALL;
     default: abort(); /* constants and variables are not instructions */
     }
 }
@@ -92,8 +94,11 @@ static int emit(tape *t, const expr_ctx *c, ex root, work_stack *st, size_t *cap
             *cap_ins = cap;
         }
         t->node_reg[e] = t->nreg++;
-        t->ins[t->nins++] = (tape_ins){op_of(n->op), t->node_reg[e], t->node_reg[n->a],
-                                       n->b >= 0 ? t->node_reg[n->b] : 0, 0};
+        t->ins[t->nins++] = n->op == EX_CALL
+                                ? (tape_ins){TOP_CALL, t->node_reg[e], t->node_reg[n->a], n->var,
+                                             (int)n->value}
+                                : (tape_ins){op_of(n->op), t->node_reg[e], t->node_reg[n->a],
+                                             n->b >= 0 ? t->node_reg[n->b] : 0, 0};
         st->n--;
     }
     return 0;
@@ -369,6 +374,12 @@ int tape_compile(tape *t, expr_ctx *c, int nvars, int nphases, const ex *const *
     work_stack stack = {0};
     if (!t->node_reg || !t->reg0 || !t->var_reg || nphases > TAPE_MAX_PHASES)
         goto fail;
+    if (c->nfns > 0) {
+        if (!(t->fns = xcalloc((size_t)c->nfns, sizeof *t->fns)))
+            goto fail;
+        memcpy(t->fns, c->fns, (size_t)c->nfns * sizeof *t->fns);
+        t->nfns = c->nfns;
+    }
     for (size_t i = 0; i < nodes; i++)
         t->node_reg[i] = -1;
     for (int v = 0; v < nvars; v++)
@@ -416,6 +427,11 @@ static void run_range(const tape *t, double *r, int from, int to)
         case TOP_MULADD: r[p->d] = r[p->a] * r[p->b] + r[p->c]; break;
         case TOP_MULMUL: r[p->d] = r[p->a] * r[p->b] * r[p->c]; break;
         case TOP_ADDADD: r[p->d] = r[p->a] + r[p->b] + r[p->c]; break;
+        case TOP_CALL: {
+            const expr_fn *f = &t->fns[p->b];
+            r[p->d] = f->eval(f->data, p->c, r[p->a]);
+            break;
+        }
         }
     }
 }
