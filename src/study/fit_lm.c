@@ -153,15 +153,20 @@ int fit_lm(fit_problem *fp, const double *lo, const double *hi, double *p, doubl
         wcon[j] = (f0 > 1e-6 ? f0 : 1e-6) / (1e-3 * size);
     }
     to_free(&c, n, p, u);
-    for (int round = 0; round < (nc ? 30 : 1); round++) {
+    /* one budget of evaluations for the start, whatever the rounds: with
+     * free timing n is large (60 targets: 69 unknowns) and 30 rounds of
+     * 200 (n + 1) each ran for hours */
+    int budget = 200 * (n + 1), used = 0;
+    for (int round = 0; round < (nc ? 30 : 1) && used < budget; round++) {
         /* tolerances: relative reduction of the sum of squares 1e-15,
          * relative step 1e-12 (lengths to about 1e-14 m on a 0.1 m
          * mechanism); gtol 0: the orthogonality test is left out (a
          * zero-residual problem ends by ftol or xtol). mode 1: MINPACK
          * scales by the Jacobian's columns. */
-        *info = lmder(lm_fcn, &c, m, n, u, fvec, fjac, m, 1e-15, 1e-12, 0.0, 200 * (n + 1), diag,
+        *info = lmder(lm_fcn, &c, m, n, u, fvec, fjac, m, 1e-15, 1e-12, 0.0, budget - used, diag,
                       1, 100.0, 0, &nfev, &njev, ipvt, qtf, wa, wa + nn, wa + 2 * nn,
                       wa + 3 * nn);
+        used += nfev;
         if (c.error != MECH_OK) {
             rc = c.error;
             goto done;
@@ -235,8 +240,12 @@ typedef struct fit_runs {
     const fit_problem *fp;
     const double *lo, *hi, *p0;
     int whole_range;
+    int n;                /* the starts */
     fit_start *st;
 } fit_runs;
+
+/* Tries for a start that assembles at every target (run_start). */
+enum { START_TRIES = 64 };
 
 /* Start i: the file's values (i = 0), else the Halton point i of the
  * bounds (an unbounded parameter keeps the file's value), with a seed
@@ -264,7 +273,21 @@ static void run_start(void *ctx, long i)
     fit_problem fp = *runs->fp;  /* this thread's: its own count of solves */
     fp.nsolves = 0;
     double *r = xcalloc((size_t)fit_nres(&fp), sizeof *r);
+    /* a start must assemble at every target (fit_lm rejects it otherwise):
+     * one that does not is replaced by the next point of this start's own
+     * subsequence of the Halton points, i + n, i + 2n, ... (disjoint from
+     * the other starts', whatever the threads), up to START_TRIES; each
+     * try is a solve */
     start_point(runs, i, st->p);
+    for (long k = 1; r && k < START_TRIES; k++) {
+        mech_diag d;
+        mech_diag_init(&d);
+        int ok = fit_eval(&fp, st->p, r, NULL, &d) == MECH_OK;
+        mech_diag_free(&d);
+        if (ok)
+            break;
+        start_point(runs, i + k * runs->n, st->p);
+    }
     st->objective = INFINITY;
     st->info = 0;
     st->rc = r ? fit_lm(&fp, runs->lo, runs->hi, st->p, r, &st->objective, &st->info)
@@ -292,7 +315,7 @@ int fit_run_starts(const fit_problem *fp, const double *lo, const double *hi, co
 {
     if (fit_nvars(fp) > FIT_MAX_VARS || fp->nfree > FIT_MAX_FREE)
         return MECH_EINPUT;
-    fit_runs runs = {fp, lo, hi, p0, whole_range, st};
+    fit_runs runs = {fp, lo, hi, p0, whole_range, n, st};
     parallel_run(n, jobs > 0 ? jobs : parallel_default_jobs(), run_start, &runs);
     for (int i = 0; i < n; i++)
         if (st[i].rc != MECH_OK && st[i].rc != MECH_ESOLVE)
