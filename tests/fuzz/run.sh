@@ -8,8 +8,10 @@
 # Environment: FUZZ_BUILD (default build/fuzz) holds the binary, the corpus
 # and any crash-* / leak-* / timeout-* / oom-* artifacts; FUZZ_SECONDS;
 # FUZZ_JOBS (parallel fuzzing processes, default 1); CC_FUZZ (default clang);
-# FUZZ_LIBS, libraries the library sources need beyond libyaml and KLU (the
-# Makefile passes SUNDIALS's, for src/study/simulate.c).
+# FUZZ_LIBS, libraries the library sources need beyond libyaml and KLU, and
+# FUZZ_CFLAGS their headers (the Makefile passes SUNDIALS's for
+# src/study/simulate.c, HDF5's for src/output/output_h5.c, MINPACK's for
+# src/study/fit_lm.c).
 # Exits non-zero when the target crashes, leaks, times out or runs out of
 # memory on some input (libFuzzer writes it to FUZZ_BUILD/artifacts/).
 # Run from the repository root; needs clang with libFuzzer (Debian: clang).
@@ -31,7 +33,7 @@ src_inc=$(for d in src/*/; do printf ' -I%s' "${d%/}"; done)
 # -fno-sanitize-recover: an UBSan report stops the run and counts as a crash.
 $cc -g -O1 -std=c11 -D_POSIX_C_SOURCE=200809L -pthread \
     -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all \
-    -Iinclude $src_inc -I/usr/include/suitesparse \
+    -Iinclude $src_inc -I/usr/include/suitesparse ${FUZZ_CFLAGS:-} \
     $lib_src "$out/rt_text.c" tests/fuzz/fuzz_load.c -o "$bin" \
     -lyaml -lklu -lbtf -lamd -lcolamd -lsuitesparseconfig ${FUZZ_LIBS:-} -lm -pthread
 
