@@ -327,40 +327,18 @@ static qv l_powi(qparse *p, qv a, int e, const char *at)
     return r;
 }
 
-static const qparse_ops law_ops = {
-    .constant = l_constant,
-    .unit = l_unit,
-    .word = l_word,
-    .call = l_call,
-    .neg = l_neg,
-    .scale = scaled,
-    .add = l_add,
-    .mul = l_mul,
-    .powi = l_powi,
-    .unknown_name = " (not the time t, a function, or a parameter defined under 'parameters')",
-    .unit_alone = 1,
-    .strict_exponent = 0,
-    .checked_dims = 0,
-    .after = "law",
-};
-
-/* the same for a program segment's f(u) */
-static const qparse_ops law_u_ops = {
-    .constant = l_constant,
-    .unit = l_unit,
-    .word = l_word,
-    .call = l_call,
-    .neg = l_neg,
-    .scale = scaled,
-    .add = l_add,
-    .mul = l_mul,
-    .powi = l_powi,
-    .unknown_name = " (not u, a function, or a parameter defined under 'parameters')",
-    .unit_alone = 1,
-    .strict_exponent = 0,
-    .checked_dims = 0,
-    .after = "law",
-};
+/* The backend, for a law of t and for a program segment's f(u): they
+ * differ only in the name the message offers. */
+#define LAW_OPS(unknown_)                                                                      \
+    {                                                                                          \
+        .constant = l_constant, .unit = l_unit, .word = l_word, .call = l_call, .neg = l_neg,   \
+        .scale = scaled, .add = l_add, .mul = l_mul, .powi = l_powi, .unknown_name = unknown_,  \
+        .unit_alone = 1, .strict_exponent = 0, .checked_dims = 0, .after = "law",               \
+    }
+static const qparse_ops law_ops =
+    LAW_OPS(" (not the time t, a function, or a parameter defined under 'parameters')");
+static const qparse_ops law_u_ops =
+    LAW_OPS(" (not u, a function, or a parameter defined under 'parameters')");
 
 int law_parse_into(const char *text, const quantity *wants, int nwants, const expr_env *env,
                    struct mech_law *l, quantity *got, char *err, size_t errsize,

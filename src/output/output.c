@@ -199,48 +199,40 @@ static int write_through(const char *path, int (*emit)(FILE *, const void *), co
     return e ? io_error(d, path, "cannot write the output", e) : MECH_OK;
 }
 
-/* A regular file `target` (which may not exist yet; not a symbolic link):
- * a temporary file beside it, renamed over it when complete. Messages name
- * `path`, the name the user gave. */
-static int write_replacing(const char *path, const char *target,
-                           int (*emit)(FILE *, const void *), const void *ctx, mech_diag *d)
+/* The temporary file fd (named tmp) filled: by emit through a stream, or
+ * by emit_path, a writer that opens the file by its name (HDF5), then
+ * synced here; fd is closed either way. 0 or an errno. */
+static int fill_temporary(int fd, const char *tmp, int (*emit)(FILE *, const void *),
+                          int (*emit_path)(const char *, const void *), const void *ctx)
 {
-    size_t n = strlen(target) + sizeof ".tmpXXXXXX";
-    char *tmp = malloc(n);
-    if (!tmp)
-        return diag_nomem(d, path, (mech_mark){0, 0});
-    snprintf(tmp, n, "%s.tmpXXXXXX", target);
-    pthread_once(&mask_once, read_umask);
-    int slot = -1;
-    int fd = create_registered(tmp, &slot);
-    if (fd < 0) {
-        int e = errno;
-        free(tmp);
-        return io_error(d, path, "cannot create the output file", e);
+    int e = fchmod(fd, 0666 & ~file_mask) != 0 ? errno : 0;  /* as fopen would create it */
+    if (emit_path) {
+        if (!e && emit_path(tmp, ctx) != 0)
+            e = errno ? errno : EIO;
+        if (!e && fsync(fd) != 0)  /* the same file: the writer reopened it by name */
+            e = errno;
+        if (close(fd) != 0 && !e)
+            e = errno;
+        return e;
     }
     FILE *f = NULL;
-    int e = fchmod(fd, 0666 & ~file_mask) != 0 ? errno : 0;  /* as fopen would create it */
     if (!e && !(f = fdopen(fd, "w")))
         e = errno;
-    if (!f)
+    if (!f) {
         close(fd);
-    else
-        e = emit_close(f, emit, ctx, 1);
-    if (!e && rename(tmp, target) != 0)
-        e = errno;
-    if (e)
-        unlink(tmp);
-    live_remove(slot);
-    free(tmp);
-    return e ? io_error(d, path, "cannot write the output file", e) : MECH_OK;
+        return e;
+    }
+    return emit_close(f, emit, ctx, 1);
 }
 
-/* The same for a writer that needs a file name (a library that opens the
- * file itself, as HDF5 does): `emit_path` writes the temporary file by its
- * name; it is then synced and renamed over `target`. */
-static int write_replacing_by_name(const char *path, const char *target,
-                                   int (*emit_path)(const char *, const void *),
-                                   const void *ctx, mech_diag *d)
+/* A regular file `target` (which may not exist yet; not a symbolic link):
+ * a temporary file beside it, filled by emit or emit_path (fill_temporary)
+ * and renamed over it when complete. Messages name `path`, the name the
+ * user gave. */
+static int write_replacing(const char *path, const char *target,
+                           int (*emit)(FILE *, const void *),
+                           int (*emit_path)(const char *, const void *), const void *ctx,
+                           mech_diag *d)
 {
     size_t n = strlen(target) + sizeof ".tmpXXXXXX";
     char *tmp = malloc(n);
@@ -255,13 +247,7 @@ static int write_replacing_by_name(const char *path, const char *target,
         free(tmp);
         return io_error(d, path, "cannot create the output file", e);
     }
-    int e = fchmod(fd, 0666 & ~file_mask) != 0 ? errno : 0;
-    if (!e && emit_path(tmp, ctx) != 0)
-        e = errno ? errno : EIO;
-    if (!e && fsync(fd) != 0)  /* the same file: the writer reopened it by name */
-        e = errno;
-    if (close(fd) != 0 && !e)
-        e = errno;
+    int e = fill_temporary(fd, tmp, emit, emit_path, ctx);
     if (!e && rename(tmp, target) != 0)
         e = errno;
     if (e)
@@ -298,7 +284,7 @@ int write_file_whole(const char *path, int (*emit)(FILE *, const void *), const 
     if (lstat(path, &st) != 0) {
         if (errno != ENOENT)
             return io_error(d, path, "cannot write the output", errno);
-        return write_replacing(path, path, emit, ctx, d);  /* a new file */
+        return write_replacing(path, path, emit, NULL, ctx, d);  /* a new file */
     }
     char *target = NULL;
     if (S_ISLNK(st.st_mode)) {  /* its target is written; the link stays */
@@ -312,7 +298,7 @@ int write_file_whole(const char *path, int (*emit)(FILE *, const void *), const 
     }
     int rc;
     if (S_ISREG(st.st_mode))
-        rc = write_replacing(path, target ? target : path, emit, ctx, d);
+        rc = write_replacing(path, target ? target : path, emit, NULL, ctx, d);
     else if (S_ISFIFO(st.st_mode) || S_ISCHR(st.st_mode))
         rc = write_through(path, emit, ctx, d);
     else {
@@ -332,11 +318,11 @@ int write_file_whole_by_name(const char *path, int (*emit_path)(const char *, co
     if (lstat(path, &st) != 0) {
         if (errno != ENOENT)
             return io_error(d, path, "cannot write the output", errno);
-        return write_replacing_by_name(path, path, emit_path, ctx, d);  /* a new file */
+        return write_replacing(path, path, NULL, emit_path, ctx, d);  /* a new file */
     }
     if (!S_ISREG(st.st_mode))  /* a symbolic link, a FIFO, a device: through emit */
         return write_file_whole(path, emit, ctx, d);
-    return write_replacing_by_name(path, path, emit_path, ctx, d);
+    return write_replacing(path, path, NULL, emit_path, ctx, d);
 }
 
 static int emit_csv(FILE *f, const void *t) { return write_rows(t, f); }
