@@ -353,6 +353,7 @@ check_plot() {
 import csv, math, sys
 import xml.dom.minidom
 svg, targets, ncols = sys.argv[1], sys.argv[2], int(sys.argv[3])
+ncurves = int(sys.argv[4]) if len(sys.argv) > 4 else 2
 try:
     doc = xml.dom.minidom.parse(svg)
 except Exception as e:
@@ -376,8 +377,21 @@ if worst > 0.01:
     bad.append(f"a target marker {worst:.3f} px from its target")
 curves = [p for p in doc.getElementsByTagName("path") if p.getAttribute("stroke")
           and p.getAttribute("d").startswith("M") and p.parentNode.getAttribute("clip-path")]
-if len(curves) != 2 or not curves[1].getAttribute("stroke-dasharray"):
-    bad.append(f"{len(curves)} curves, expected the fitted one and the start's dashed")
+if len(curves) != ncurves or (ncurves == 2 and not curves[1].getAttribute("stroke-dasharray")):
+    bad.append(f"{len(curves)} curves, expected the fitted one and the start's dashed"
+               if ncurves == 2 else f"{len(curves)} curves, expected the file's one")
+if ncurves == 1 and ncols == 2:  # the file's own curve meets every target (an exact fit)
+    import re
+    pts = [tuple(map(float, m)) for m in re.findall(r"(-?[0-9.]+),(-?[0-9.]+)",
+                                                     curves[0].getAttribute("d"))]
+    def seg(a, p, q):  # the distance from a to the segment pq
+        dx, dy = q[0] - p[0], q[1] - p[1]
+        t = ((a[0] - p[0]) * dx + (a[1] - p[1]) * dy) / (dx * dx + dy * dy or 1)
+        t = min(1, max(0, t))
+        return math.hypot(a[0] - p[0] - t * dx, a[1] - p[1] - t * dy)
+    far = max(min(seg(a, p, q) for p, q in zip(pts, pts[1:])) for a in want)
+    if far > 0.6:
+        bad.append(f"a target {far:.2f} px from the file's curve")
 title = doc.getElementsByTagName("title")[0].firstChild.data
 if f"{len(rows)} targets" not in title:
     bad.append(f"title '{title}' does not count the targets")
@@ -395,6 +409,32 @@ if run "plot: function" 0 "$MECH" fit "$tmp/moved.yaml" --free r,l,b --target "$
     check_plot "$tmp/fn.svg" "$tmp/function.csv" 1 && pass || fail "plot: function: the figure"
     [ -s "$tmp/fn2.yaml" ] && pass || fail "plot: function: -o not written with --plot"
 fi
+# mech plot and mech report of a file with a fit: section: its own curve
+# against the section's targets (STEM-fit.svg, a figure of the page). The
+# fitted file's curve meets every target; the unfitted one's misses some
+# (the same check, so it can fail); targets that cannot be read leave the
+# figure out with a warning, the other figures written.
+if run "plot: fitted file" 0 "$MECH" plot "$tmp/sbest.yaml" --out "$tmp/figs"; then
+    has_line "$tmp/out" "^$tmp/figs/sbest-fit.svg\$" "plot: fitted file: said"
+    check_plot "$tmp/figs/sbest-fit.svg" "$tmp/path.csv" 2 1 && pass || fail "plot: fitted file: the figure"
+fi
+if run "plot: unfitted file" 0 "$MECH" plot "$tmp/section.yaml" --out "$tmp/figs"; then
+    check_plot "$tmp/figs/section-fit.svg" "$tmp/path.csv" 2 1 >"$tmp/check" &&
+        fail "plot: unfitted file: its curve meets the targets" ||
+        has_line "$tmp/check" "px from the file's curve" "plot: unfitted file: the miss found"
+fi
+if run "report: fitted file" 0 "$MECH" report "$tmp/sbest.yaml" -o "$tmp/fit.html"; then
+    has_line "$tmp/fit.html" "<title[^>]*>Fit: the path of P through 12 targets</title>" "report: the fit's figure"
+fi
+mkdir -p "$tmp/lone"
+cp "$tmp/section.yaml" "$tmp/lone/section.yaml"
+if run "plot: targets missing" 0 "$MECH" plot "$tmp/lone/section.yaml" --out "$tmp/lone"; then
+    has_line "$tmp/err" "lone/path.csv: warning: the fit: section's figure is left out: cannot open" "plot: targets missing: warning"
+    [ ! -e "$tmp/lone/section-fit.svg" ] && [ -s "$tmp/lone/section-path-P.svg" ] && pass ||
+        fail "plot: targets missing: the fit figure written or the others not"
+fi
+run "report: targets missing" 0 "$MECH" report "$tmp/lone/section.yaml" -o "$tmp/lone.html" &&
+    has_line "$tmp/lone.html" "figure is left out" "report: targets missing: said on the page"
 cp "$tmp/moved.yaml" "$tmp/keep.yaml"
 run "plot over the input" 2 "$MECH" fit "$tmp/moved.yaml" --free r --target "$tmp/path.csv" --plot "$tmp/moved.yaml" &&
     has_line "$tmp/err" "is the input file" "plot over the input: message"

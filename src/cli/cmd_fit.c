@@ -442,198 +442,36 @@ static int write_best(const fit_setup *s, const mech_model *m, const double *p, 
 
 /* ---- the plot of the fit (--plot) ---------------------------------------- */
 
-/* What the figure draws: up to PLOT_ITEMS points' paths (a point whose x and
- * y are both targets), else up to PLOT_ITEMS target columns of the first
- * one's unit against the driver; each as three series: the best solution's
- * curve, the start's (dashed), the targets (points). */
-enum { PLOT_ITEMS = 2 };
-
-typedef struct fit_plot {
-    int path;                 /* 1: paths (y against x), 0: against the driver */
-    int n;                    /* items */
-    int cx[PLOT_ITEMS], cy[PLOT_ITEMS];  /* target columns: x (or the column), y */
-    char name[PLOT_ITEMS][64];
-} fit_plot;
-
-static void plot_items(const fit_setup *s, fit_plot *pl)
-{
-    memset(pl, 0, sizeof *pl);
-    for (int j = 0; j < s->fp.ncols && pl->n < PLOT_ITEMS; j++) {
-        const char *c = s->cols[j], *dot = strrchr(c, '.');
-        if (strcmp(dot, ".x") != 0)
-            continue;
-        for (int k = 0; k < s->fp.ncols; k++) {
-            const char *d = s->cols[k];
-            if (strncmp(d, c, (size_t)(dot - c)) == 0 && strcmp(d + (dot - c), ".y") == 0) {
-                pl->cx[pl->n] = j;
-                pl->cy[pl->n] = k;
-                snprintf(pl->name[pl->n++], sizeof pl->name[0], "%.*s", (int)(dot - c), c);
-                break;
-            }
-        }
-    }
-    pl->path = pl->n > 0;
-    for (int j = 0; !pl->path && j < s->fp.ncols && pl->n < PLOT_ITEMS; j++)
-        if (strcmp(s->col_unit[j], s->col_unit[0]) == 0) {
-            pl->cx[pl->n] = pl->cy[pl->n] = j;
-            snprintf(pl->name[pl->n++], sizeof pl->name[0], "%s", s->cols[j]);
-        }
-}
-
-/* The rows of a solved sweep into the plot's table from row *at: column
- * `to + c` gets t's column cols[c]; a row of NaN (a break of the curves)
- * where the sweep has a gap and after the sweep. */
-static void put_sweep(double *v, int ncol, int *at, const mech_table *t, const int *cols,
-                      int ncols, int to)
-{
-    int skipped = 0, g = 0;
-    for (int r = 0; r < t->nrows; r++) {
-        int brk = 0;
-        while (g < t->ngaps && t->gaps[g].first_row <= r + skipped) {
-            skipped += t->gaps[g].last_row - t->gaps[g].first_row + 1;
-            g++;
-            brk = r > 0;
-        }
-        if (brk)
-            (*at)++;  /* a row of NaN */
-        double *row = v + (size_t)(*at)++ * (size_t)ncol;
-        row[0] = mech_table_get(t, r, 0);
-        for (int c = 0; c < ncols; c++)
-            row[to + c] = cols[c] < 0 ? NAN : mech_table_get(t, r, cols[c]);
-    }
-    (*at)++;
-}
-
-static const char *display(const char *si, double *scale)
-{
-    *scale = strcmp(si, "m") == 0 ? 1e3 : strcmp(si, "rad") == 0 ? 180.0 / 3.14159265358979323846 : 1.0;
-    return strcmp(si, "m") == 0 ? "mm" : strcmp(si, "rad") == 0 ? "deg" : si;
-}
-
-/* --plot: the best solution p and the start p0 solved over the file's driver
- * range, the targets as points, one SVG (plot_figure_write: whole or
+/* --plot: the best solution p and the start solved over the file's driver
+ * range, the targets as points, one SVG (fit_figure_write: whole or
  * nothing). -1, or an exit status. */
 static int write_plot(fit_setup *s, const mech_model *m, const double *p, const char *path)
 {
-    fit_plot pl;
-    plot_items(s, &pl);
     mech_table tf = {0}, ts = {0};
     mech_diag d;
     mech_diag_init(&d);
     int rc = fit_sweep(&s->fp, p, &tf, &d);
     if (rc == MECH_OK || rc == MECH_ESOLVE)
         rc = fit_sweep(&s->fp, s->p0, &ts, &d);
-    int code = -1;
     if (rc != MECH_OK && rc != MECH_ESOLVE) {
         mech_diag_print(&d, stderr);
         fprintf(stderr, "mech fit: --plot: the file cannot be solved over its range; no plot "
                 "written\n");
-        code = cmd_exit_status(rc);
-        goto done;
-    }
-    /* columns: q, then per item its series (fitted, start, targets), each
-     * x and y for a path, one column against the driver */
-    int per = pl.path ? 2 : 1, ncol = 1 + 3 * per * pl.n;
-    int nrows = 2 * (tf.nrows + tf.ngaps + 1) + ts.nrows + ts.ngaps + 1 + s->fp.nq + 1;
-    mech_table t = {0};
-    t.columns = xcalloc((size_t)ncol, sizeof *t.columns);
-    t.values = xcalloc((size_t)nrows * (size_t)ncol, sizeof *t.values);
-    if (!t.columns || !t.values) {
-        free(t.columns);
-        free(t.values);
-        code = MECH_EXIT_IO;
-        goto done;
-    }
-    t.ncolumns = ncol;
-    for (size_t i = 0; i < (size_t)nrows * (size_t)ncol; i++)
-        t.values[i] = NAN;
-    plot_figure fg;
-    memset(&fg, 0, sizeof fg);
-    int cf[2 * PLOT_ITEMS], cs[2 * PLOT_ITEMS], nc = 0;
-    for (int it = 0; it < pl.n; it++)
-        for (int xy = 0; xy < per; xy++) {
-            const char *col = s->cols[xy ? pl.cy[it] : pl.cx[it]];
-            cf[nc] = mech_table_column(&tf, col);
-            cs[nc++] = mech_table_column(&ts, col);
-        }
-    int at = 0;
-    /* the series of item it: columns 1 + 3 per it + per k (k 0 fitted,
-     * 1 start, 2 targets); the sweeps put their columns one item after the
-     * other, so each item's fitted columns are written separately */
-    for (int it = 0; it < pl.n; it++) {
-        int start = at;
-        put_sweep(t.values, ncol, &at, &tf, cf + per * it, per, 1 + 3 * per * it);
-        if (it + 1 < pl.n)
-            at = start;  /* the same rows for every item */
-    }
-    for (int it = 0; it < pl.n; it++) {
-        int start = at;
-        put_sweep(t.values, ncol, &at, &ts, cs + per * it, per, 1 + 3 * per * it + per);
-        if (it + 1 < pl.n)
-            at = start;
-    }
-    int ndots = 0;
-    for (int i = 0; i < s->fp.nq; i++, at++) {
-        double *row = t.values + (size_t)at * (size_t)ncol;
-        row[0] = s->fp.free_timing ? p[s->fp.nfree + i] : s->q[i];
-        for (int it = 0; it < pl.n; it++)
-            for (int xy = 0; xy < per; xy++) {
-                int j = xy ? pl.cy[it] : pl.cx[it];
-                double y0 = s->target[(size_t)i * s->fp.ncols + j];
-                row[1 + 3 * per * it + 2 * per + xy] = y0;
-            }
-    }
-    t.nrows = at;
-    for (int it = 0; it < pl.n; it++)
-        for (int k = 0; k < 3; k++) {
-            int sr = 3 * it + k, c = 1 + 3 * per * it + per * k;
-            fg.col[sr] = c;
-            fg.ycol[sr] = c + 1;
-            fg.dots[sr] = k == 2;
-            snprintf(fg.label[sr], sizeof fg.label[sr], "%.36s%s%s", pl.n > 1 ? pl.name[it] : "",
-                     pl.n > 1 ? " " : "", k == 0 ? "fitted" : k == 1 ? "start" : "targets");
-        }
-    fg.nseries = 3 * pl.n;
-    for (int i = 0; i < s->fp.nq; i++)
-        for (int it = 0; it < pl.n; it++) {
-            double x = s->target[(size_t)i * s->fp.ncols + pl.cx[it]];
-            double y = s->target[(size_t)i * s->fp.ncols + pl.cy[it]];
-            ndots += !isnan(x) && !isnan(y);
-        }
-    snprintf(fg.name, sizeof fg.name, "fit");
-    if (pl.path) {
-        fg.kind = PLOT_PATH;
-        snprintf(fg.title, sizeof fg.title, "Fit: the path%s of %.40s%s%.40s through %d target%s",
-                 pl.n > 1 ? "s" : "", pl.name[0], pl.n > 1 ? ", " : "", pl.n > 1 ? pl.name[1] : "",
-                 ndots, ndots == 1 ? "" : "s");
-        snprintf(fg.ylabel, sizeof fg.ylabel, "y");
-        snprintf(fg.yunit, sizeof fg.yunit, "mm");
-        fg.yscale = 1e3;
     } else {
-        double scale;
-        const char *u = display(s->col_unit[pl.cx[0]], &scale);
-        snprintf(fg.title, sizeof fg.title, "Fit: %.40s%s%.40s against the driver, %d target%s",
-                 pl.name[0], pl.n > 1 ? ", " : "", pl.n > 1 ? pl.name[1] : "", ndots,
-                 ndots == 1 ? "" : "s");
-        snprintf(fg.ylabel, sizeof fg.ylabel, "%.40s", pl.n > 1 ? "value" : pl.name[0]);
-        snprintf(fg.yunit, sizeof fg.yunit, "%s", u);
-        fg.yscale = scale;
+        char subtitle[160];
+        snprintf(subtitle, sizeof subtitle, "%.80s: fitted (solid), start (dashed), targets "
+                 "(points)", m->name ? m->name : s->fp.path);
+        fit_curves c = {.curve = &tf, .curve_label = "fitted", .start = &ts,
+                        .timing = s->fp.free_timing ? p + s->fp.nfree : NULL};
+        mech_diag_free(&d);
+        mech_diag_init(&d);
+        rc = fit_figure_write(s, m, &c, subtitle, path, &d);
+        mech_diag_print(&d, stderr);
     }
-    char subtitle[160];
-    snprintf(subtitle, sizeof subtitle, "%.80s: fitted (solid), start (dashed), targets (points)",
-             m->name ? m->name : s->fp.path);
-    mech_diag_free(&d);
-    mech_diag_init(&d);
-    rc = plot_figure_write(m, &t, &fg, subtitle, path, &d);
-    mech_diag_print(&d, stderr);
-    code = rc == MECH_OK ? -1 : cmd_exit_status(rc);
-    free(t.columns);
-    free(t.values);
-done:
     mech_diag_free(&d);
     mech_table_free(&tf);
     mech_table_free(&ts);
-    return code;
+    return rc == MECH_OK ? -1 : cmd_exit_status(rc);
 }
 
 /* ---- the command -------------------------------------------------------- */

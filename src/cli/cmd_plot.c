@@ -65,10 +65,12 @@ const cmd_spec cmd_plot_spec = {
              "(the legend names the link the force acts on) and the driver torque, with\n"
              "and without friction when the file has friction. Then the path of every\n"
              "output point that moves (path-P: y against x in mm on equal axes, a start\n"
-             "marker, arrows in the direction of motion). The figures follow the file's\n"
-             "outputs. Units: mm, deg, m/s, m/s^2, rad/s, rad/s^2, N, N*m. Files are\n"
-             "DIR/STEM-GROUP.svg, STEM the file's name without .yaml; each written path\n"
-             "is printed on standard output. Long sweeps are thinned to within 0.25 px.\n",
+             "marker, arrows in the direction of motion). A file with a fit: section also\n"
+             "gets STEM-fit.svg: its curve against the section's targets (mech fit). The\n"
+             "figures follow the file's outputs. Units: mm, deg, m/s, m/s^2, rad/s,\n"
+             "rad/s^2, N, N*m. Files are DIR/STEM-GROUP.svg, STEM the file's name\n"
+             "without .yaml; each written path is printed on standard output. Long sweeps\n"
+             "are thinned to within 0.25 px.\n",
     .opts = plot_options,
     .column = 22,
     .exits = EXITS,
@@ -175,6 +177,35 @@ static void figure_paths(const char *dir, const char *stem, const plot_figure *f
     }
 }
 
+/* A file with a fit: section: DIR/STEM-fit.svg, its curve against the
+ * section's targets; left out with a warning when the targets cannot be
+ * read or the mechanism assembles nowhere. */
+static int write_fit_figure(const plot_args *a, const mech_model *m, const char *dir,
+                            const char *stem)
+{
+    size_t len = strlen(dir) + strlen(stem) + 16;
+    char *path = malloc(len);
+    if (!path) {
+        fprintf(stderr, "mech plot: out of memory\n");
+        return MECH_EXIT_IO;
+    }
+    snprintf(path, len, "%s/%s-fit.svg", dir, stem);
+    int code = cmd_refuse_input("plot", path, &a->file, 1) >= 0 ? MECH_EXIT_INPUT : MECH_EXIT_OK;
+    if (code == MECH_EXIT_OK) {
+        mech_diag d;
+        mech_diag_init(&d);
+        int rc = fit_figure_of_model(m, path, &d);
+        mech_diag_print(&d, stderr);
+        mech_diag_free(&d);
+        if (rc == MECH_OK)
+            printf("%s\n", path);
+        else if (rc != MECH_EINPUT)
+            code = MECH_EXIT_IO;
+    }
+    free(path);
+    return code;
+}
+
 static int write_figures(const plot_args *a, const mech_model *m, const mech_table *t)
 {
     enum { MAXFIG = 4096 };
@@ -216,6 +247,8 @@ static int write_figures(const plot_args *a, const mech_model *m, const mech_tab
         free(paths[k]);
     free(paths);
     free(figs);
+    if (code == MECH_EXIT_OK && m->fit)
+        code = write_fit_figure(a, m, dir, stem);
     return code;
 }
 

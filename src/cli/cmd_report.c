@@ -236,6 +236,8 @@ static int write_page(report_run *r)
         rc = report_figures(&r->view, &gt, &r->figures, &r->nfigures, &wd);
     else
         fprintf(stderr, "mech report: out of memory\n");
+    for (size_t i = 0; rc == MECH_OK && i < wd.count; i++)
+        diag_copy(&r->d, &wd.entries[i]);  /* a figure left out: said on the page too */
     free(gt.values);
     report_input in = {
         .m = r->m, .summary = &r->summary, .equations = r->equations, .t = &r->t,

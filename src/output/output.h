@@ -539,6 +539,29 @@ int fit_setup_read(fit_setup *s, const fit_request *rq, const mech_model *m, mec
 int fit_setup_starts(const fit_setup *s, const mech_model *m, int asked, int *n, mech_diag *d);
 void fit_setup_free(fit_setup *s);
 
+/* fit_plot.c: the figure of a fit (docs/synthesis.md, "The figure"). */
+typedef struct fit_curves {
+    const mech_table *curve;    /* the target columns' objects solved over the driver's range */
+    const char *curve_label;    /* its legend: "fitted", "this file" */
+    const mech_table *start;    /* the start's curve, drawn dashed; NULL: none */
+    const double *timing;       /* [nq] the target rows' driver positions (free timing's
+                                   fitted ones); NULL: the targets' CSV's */
+} fit_curves;
+/* The figure of s's targets and the curves c into path (one SVG, whole or
+ * nothing, plot_figure_write): the paths of up to two points whose x and y
+ * are targets, else up to two target columns against the driver. */
+int fit_figure_write(const fit_setup *s, const mech_model *m, const fit_curves *c,
+                     const char *subtitle, const char *path, mech_diag *d);
+
 #endif /* MECH_STUDY_STAGE_H */
+
+/* The figure of the loaded, checked model m whose file has a fit: section
+ * (m->fit): m's own curve (its --set values included) against the
+ * section's targets, into path ("STEM-fit.svg" of mech plot, a figure of
+ * mech report). MECH_OK: written. MECH_EINPUT: left out, the reasons (the
+ * targets unreadable, the section incomplete, the mechanism assembling
+ * nowhere) as warnings in d, so that the command's other figures go on.
+ * Otherwise (no memory, the SVG not written) the error in d. */
+int fit_figure_of_model(const mech_model *m, const char *path, mech_diag *d);
 
 #endif

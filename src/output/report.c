@@ -106,6 +106,15 @@ int report_figures(const mech_model *m, const mech_table *t, char ***svgs, int *
         if (rc == MECH_OK)
             rc = scratch_take(&s, &out[k], d);
     }
+    if (rc == MECH_OK && m->fit && nf < MAXFIG) {
+        /* the fit: section's figure last, as mech plot writes it; left
+           out (the reasons as warnings in d) when it cannot be drawn */
+        rc = fit_figure_of_model(m, s.path, d);
+        if (rc == MECH_OK && (rc = scratch_take(&s, &out[k], d)) == MECH_OK)
+            nf = ++k;
+        else if (rc == MECH_EINPUT)
+            rc = MECH_OK;
+    }
     scratch_close(&s);
     free(figs);
     if (rc != MECH_OK) {

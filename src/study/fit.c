@@ -421,14 +421,11 @@ int fit_objective(fit_problem *fp, const double *p, double *r, double *objective
     return rc;
 }
 
-int fit_sweep(const fit_problem *fp, const double *p, mech_table *t, mech_diag *d)
+int fit_sweep_model(const fit_problem *fp, const mech_model *m, mech_table *t, mech_diag *d)
 {
-    mech_model *m = NULL;
     mech_outputs outs = {0};
-    int rc = load_values(fp, p, &m, d, d);
     mech_solve_options o;
-    if (rc == MECH_OK)
-        rc = eval_options(fp, m, &outs, &o, d);
+    int rc = eval_options(fp, m, &outs, &o, d);
     if (rc == MECH_OK) {
         o.want = MECH_WANT_POSITION;
         mech_diag quiet;  /* the gaps are in t->gaps */
@@ -439,6 +436,15 @@ int fit_sweep(const fit_problem *fp, const double *p, mech_table *t, mech_diag *
         mech_diag_free(&quiet);
     }
     mech_outputs_free(&outs);
+    return rc;
+}
+
+int fit_sweep(const fit_problem *fp, const double *p, mech_table *t, mech_diag *d)
+{
+    mech_model *m = NULL;
+    int rc = load_values(fp, p, &m, d, d);
+    if (rc == MECH_OK)
+        rc = fit_sweep_model(fp, m, t, d);
     mech_model_free(&m);
     return rc;
 }

@@ -322,6 +322,9 @@ int fit_check_range(fit_problem *fp, const double *p, mech_diag *d);
  * lists the missing ones) when it does not assemble everywhere; an error
  * in d (nothing in *t) when the file does not load. Not a counted solve. */
 int fit_sweep(const fit_problem *fp, const double *p, mech_table *t, mech_diag *d);
+/* The same sweep of the loaded, checked model m as it is (mech plot's and
+ * mech report's figure of a file with a fit: section: its own curve). */
+int fit_sweep_model(const fit_problem *fp, const mech_model *m, mech_table *t, mech_diag *d);
 /* The objective F(p) = sum r^2 of the residuals fit_eval computes (r[nq
  * ncols] the workspace): MECH_OK, MECH_ESOLVE when the mechanism does not
  * assemble at every target, MECH_ENOMEM. For minimisers without gradients
