@@ -353,6 +353,8 @@ typedef struct mech_model {
     struct free_drivers *free_drivers; /* owned: the drivers of `drivers:` marked
                                  `free: true` (docs/dynamics.md; src/load/load.h), moved by
                                  their loads in `mech simulate`; NULL when none is */
+    struct model_cams *cams; /* owned: the file's `cams:` (cam-follower pairs,
+                                docs/cams.md; src/load/load.h); NULL when none */
 } mech_model;
 
 /* Read and validate a mechanism file. On success *out is the model and the
@@ -389,10 +391,12 @@ typedef struct mech_summary {
     int npin_in_slot;     /* free sliders: 1 constraint each */
     int nunknowns;        /* link angles + slider displacements, driver excluded */
     int nloops;           /* independent loops = joints - links + 1 */
-    int nequations;       /* 2 * nloops + ngears */
-    int mobility;         /* 3 (n - 1) - 2 j_full - j_half - ngears */
+    int nequations;       /* 2 * nloops + ngears + ncams */
+    int mobility;         /* 3 (n - 1) - 2 j_full - j_half - ngears - ncams */
     int ndrivers;
     int ngears;           /* gear pairs and racks: higher pairs, 1 constraint each (in
+                             mobility and nequations) */
+    int ncams;            /* cam-follower pairs: higher pairs, 1 constraint each (in
                              mobility and nequations) */
 } mech_summary;
 

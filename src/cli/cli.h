@@ -250,6 +250,9 @@ typedef struct cmd_draw_options {
 } cmd_draw_options;
 void cmd_draw_options_default(cmd_draw_options *o);
 extern const cmd_spec cmd_draw_spec;
+/* `mech cam FILE` (cmd_cam.c, docs/cams.md): a cam's profile and design. */
+extern const cmd_spec cmd_cam_spec;
+int cmd_cam(int argc, char **argv);
 int cmd_draw(int argc, char **argv);
 /* Returns an exit status; cmd names the command in messages. */
 int cmd_draw_model(const char *cmd, const mech_model *m, const cmd_draw_options *o);

@@ -23,7 +23,7 @@ static const command commands[] = {
     {&cmd_report_spec, cmd_report},   {&cmd_watch_spec, cmd_watch},
     {&cmd_codegen_spec, cmd_codegen}, {&cmd_convert_spec, cmd_convert},
     {&cmd_fit_spec, cmd_fit},
-    {&cmd_simulate_spec, cmd_simulate},
+    {&cmd_simulate_spec, cmd_simulate}, {&cmd_cam_spec, cmd_cam},
 };
 #define NCOMMANDS (sizeof commands / sizeof commands[0])
 

@@ -273,6 +273,9 @@ static int check_model(const mech_model *m, mech_summary *s, mech_diag *d)
     for (int g = 0; g < m->ngears; g++)  /* a mesh holds a gear as a joint does */
         for (int k = 0; k < 2; k++)
             njoints_of[m->gears[g].link[k]]++;
+    s->ncams = model_ncams(m);
+    for (int c = 0; c < s->ncams; c++)  /* and a cam's contact its cam and follower */
+        njoints_of[m->cams->cam[c].cam]++, njoints_of[m->cams->cam[c].follower]++;
     int joints = m->njoints;
     int nangles = m->nlinks - 1 - s->nprismatic;
     int nsliders = s->nprismatic + s->npin_in_slot;
@@ -282,9 +285,9 @@ static int check_model(const mech_model *m, mech_summary *s, mech_diag *d)
        unknowns), not as its row */
     int rows[ROW_KINDS];
     rows_count(m, s->nloops, rows);
-    s->nequations = rows[ROW_LOOP_X] + rows[ROW_LOOP_Y] + rows[ROW_GEAR];
+    s->nequations = rows[ROW_LOOP_X] + rows[ROW_LOOP_Y] + rows[ROW_GEAR] + rows[ROW_CAM];
     s->mobility = 3 * (m->nlinks - 1) - 2 * (s->nrevolute + s->nprismatic) - s->npin_in_slot -
-                  m->ngears;
+                  m->ngears - s->ncams;
     size_t before = d->nerrors, first = d->count;
     int connected = check_connected(m, work, d);
     int dangling = report_dangling(m, njoints_of, d);
@@ -298,9 +301,12 @@ static int check_model(const mech_model *m, mech_summary *s, mech_diag *d)
         mech_mark at = m->has_driver ? m->driver.mark : (mech_mark){0, 0};
         int excess = s->mobility - s->ndrivers, abs_excess = excess < 0 ? -excess : excess;
         char gruebler[192];
-        char mesh[32] = "";
+        char mesh[64] = "";
         if (m->ngears)
             snprintf(mesh, sizeof mesh, " - %d gear%s", m->ngears, m->ngears == 1 ? "" : "s");
+        if (s->ncams)
+            snprintf(mesh + strlen(mesh), sizeof mesh - strlen(mesh), " - %d cam%s", s->ncams,
+                     s->ncams == 1 ? "" : "s");
         snprintf(gruebler, sizeof gruebler, "%d degree%s of freedom (Gruebler: 3*(%d-1) - 2*%d "
                  "- %d%s = %d) but %d driver%s, so %d unknown%s for %d loop equations",
                  s->mobility, s->mobility == 1 || s->mobility == -1 ? "" : "s", m->nlinks,

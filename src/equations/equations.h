@@ -33,27 +33,28 @@ void span_tree_free(span_tree *t);
 /* rows.c: the one description of the equation system's rows, as
  * columns.h describes the table's columns.
  *
- * Each row is a loop's x or y closure, a gear pair's rolling condition or
- * a driver's law, in that order; its descriptor says which, whose (the
+ * Each row is a loop's x or y closure, a gear pair's rolling condition, a
+ * cam pair's lift or a driver's law, in that order; its descriptor says which, whose (the
  * loop, gear or driver) and where that is in the file. The system
  * (system.c) is built from the descriptors; `mech equations` (print.c),
  * the diagnostics (diagnose.c), the drivers' structure check (drivers.c)
  * and the structure counts (model.c) read them, and the force analysis
  * (forces.c) names its gear and driver columns with the same words, so
  * nothing else derives the row layout. */
-typedef enum { ROW_LOOP_X, ROW_LOOP_Y, ROW_GEAR, ROW_DRIVER } row_kind;
-enum { ROW_KINDS = 4 };
+typedef enum { ROW_LOOP_X, ROW_LOOP_Y, ROW_GEAR, ROW_CAM, ROW_DRIVER } row_kind;
+enum { ROW_KINDS = 5 };
 
 typedef struct row_desc {
     row_kind kind;
     int owner;       /* LOOP_X, LOOP_Y: the loop (of the system's loop set); GEAR: the
-                        gear pair (m->gears); DRIVER: the driver (m->drivers) */
+                        gear pair (m->gears); CAM: the cam pair (m->cams); DRIVER:
+                        the driver (m->drivers) */
     mech_mark mark;  /* the owner's place in the file ({0, 0}: a loop found
                         automatically) */
 } row_desc;
 
 /* The rows of model m with nloops loops, per kind into count[] (may be
- * NULL): 2 per loop, 1 per gear pair, 1 per driver that is not the sweep
+ * NULL): 2 per loop, 1 per gear pair, 1 per cam, 1 per driver that is not the sweep
  * variable itself (drivers.h). Returns the total. */
 int rows_count(const mech_model *m, int nloops, int *count);
 /* The descriptors in row order ([rows_count] entries, at least one
@@ -242,6 +243,19 @@ void gears_rt(const mech_model *m, int i, rt_gear *out);
 
 /* Gear pair i in words, as mech check shows it. */
 void gears_describe(const mech_model *m, int i, char *buf, size_t size);
+
+/* ==== cams ==== */
+/* cams.c: cam-follower pairs (higher pairs, docs/cams.md): the row of cam
+ * i after the gear rows,
+ *   coordinate - c0 - rise s(x),  x = sense (th_cam - th_arm - start),
+ * the coordinate the follower's slider displacement (m) or its angle on
+ * the arm (rad); s the program (an opaque call, law_expr: its derivatives
+ * exact, the generated code's the runtime's rt_law.h). */
+ex cams_row(mech_system *s, int i);
+/* Cam pair i in words, as mech check shows it. */
+void cams_describe(const mech_model *m, int i, char *buf, size_t size);
+/* Its design quantities (the worst of each and where), as mech check shows them. */
+void cams_design(const mech_model *m, int i, char *buf, size_t size);
 
 /* ==== driver_checks ==== */
 /* The drivers against the structure (driver_checks.c). check.c: the error

@@ -7,11 +7,11 @@
 
 int rows_count(const mech_model *m, int nloops, int *count)
 {
-    int n[ROW_KINDS] = {nloops, nloops, m->ngears, drivers_rows(m)};
+    int n[ROW_KINDS] = {nloops, nloops, m->ngears, model_ncams(m), drivers_rows(m)};
     if (count)
         for (int k = 0; k < ROW_KINDS; k++)
             count[k] = n[k];
-    return 2 * nloops + m->ngears + n[ROW_DRIVER];
+    return 2 * nloops + m->ngears + n[ROW_CAM] + n[ROW_DRIVER];
 }
 
 row_desc *rows_build(const mech_model *m, int nloops, int loops_listed)
@@ -27,6 +27,8 @@ row_desc *rows_build(const mech_model *m, int nloops, int loops_listed)
     }
     for (int g = 0; g < m->ngears; g++)
         rows[r++] = (row_desc){ROW_GEAR, g, m->gears[g].mark};
+    for (int c = 0; c < model_ncams(m); c++)
+        rows[r++] = (row_desc){ROW_CAM, c, m->cams->cam[c].mark};
     for (int k = 0; k < m->ndrivers; k++)  /* the sweep's own driver has no row */
         if (!drivers_is_sweep(m, k))
             rows[r++] = (row_desc){ROW_DRIVER, k, m->drivers[k].mark};
@@ -38,6 +40,8 @@ const char *rows_constraint(const mech_model *m, row_kind kind, int owner, char 
 {
     if (kind == ROW_GEAR)
         snprintf(buf, size, "gear pair '%s'", m->gears[owner].name);
+    else if (kind == ROW_CAM)
+        snprintf(buf, size, "cam '%s'", m->cams->cam[owner].name);
     else
         snprintf(buf, size, "driver '%s'", drivers_name(m, owner));
     return buf;

@@ -400,6 +400,7 @@ static int build_residual(mech_system *s, mech_diag *d)
             s->f[r] = rd->kind == ROW_LOOP_X ? loop_x : loop_y;
             break;
         case ROW_GEAR: s->f[r] = gears_row(s, rd->owner); break;
+        case ROW_CAM: s->f[r] = cams_row(s, rd->owner); break;
         case ROW_DRIVER:
             s->f[r] = drivers_row(m, rd->owner, &s->ex, s->link_angle, s->slide, q);
             break;

@@ -287,6 +287,10 @@ int forces_plan_init(forces_plan *fp, const solver_plan *sp, int friction, mech_
     const mech_model *m = sp->m;
     memset(fp, 0, sizeof *fp);
     fp->m = m;
+    if (model_ncams(m) > 0)  /* the contact force along the common normal: issue 30, point 4 */
+        return diag_error(d, m->file, m->cams->cam[0].mark, "cam '%s': forces through a cam "
+                          "pair are not computed yet (docs/cams.md, Limits); solve the "
+                          "kinematics without --forces", m->cams->cam[0].name);
     fp->nrows = 3 * (m->nlinks - 1);
     size_t nc = 2 * (size_t)m->njoints + (size_t)m->ngears + 1 + (size_t)m->ndrivers;
     fp->kind = xcalloc(nc, sizeof *fp->kind);

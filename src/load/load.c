@@ -23,6 +23,8 @@
  *           | {at: JOINT, name, stiffness, free_angle, preload, damping}]   (load_springs.c)
  *   gears: [{gear, with, teeth, module, radii, internal, arm, pressure_angle, offset, name}
  *          | {pinion, rack, radius, teeth, module, offset, rack_offset, ...}] (load_gears.c)
+ *   cams: [{cam, follower, contact, base_radius, roller_radius, at, turning, start,
+ *           program, name}] (load_cams.c)
  *   outputs: {points: [...], links: [...], sliders: [...], forces: bool}
  *
  * Every problem is recorded with its file:line:column and loading goes on,
@@ -50,7 +52,7 @@ static void load_document(loader *ld, const ynode *root)
 {
     static const char *const keys[] = {"name", "description", "units", "parameters", "gravity",
                                        "ground", "links", "joints", "driver", "initial",
-                                       "branch", "loops", "loads", "springs", "gears",
+                                       "branch", "loops", "loads", "springs", "gears", "cams",
                                        "outputs", "sweep", "drivers", "drawing", "fit"};
     mech_model *m = ld->m;
     size_t errors = ld->d->nerrors;
@@ -96,6 +98,8 @@ static void load_document(loader *ld, const ynode *root)
     load_add_implicit_revolutes(ld);
     if ((v = ymap_get(root, "gears")))  /* before the points check: a gear may have one */
         load_gears(ld, v);
+    if ((v = ymap_get(root, "cams")))  /* likewise: a cam may have its pivot alone */
+        load_cams(ld, v);
     load_check_link_points(ld);
     load_warn_point_typos(ld, ymap_get(root, "outputs"));
     const ynode *dv = ymap_get(root, "drivers"), *sw = ymap_get(root, "sweep");
@@ -113,6 +117,8 @@ static void load_document(loader *ld, const ynode *root)
         load_branches(ld, v);
     if (ld->d->nerrors == errors)
         load_guesses_from_points(ld);
+    if (ld->d->nerrors == errors)
+        load_cams_place(ld);  /* an oscillating follower's base: the one nearest its guess */
     if ((v = ymap_get(root, "loops")))
         load_loops(ld, v);
     if ((v = ymap_get(root, "loads")))

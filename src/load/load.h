@@ -705,6 +705,10 @@ void load_sweep_drivers(loader *ld, const ynode *sweep, const ynode *drivers);
  * into *out (the law of t, its last node the program). 1, or 0 reported. */
 int load_program(loader *ld, const ynode *map, quantity q, const char *driver,
                  struct mech_law **out);
+/* The same; of_cam: a cam's program (load_cams.c), whose variable is the
+ * law's own, the cam angle (no 'of' or 'speed'). */
+int load_program_as(loader *ld, const ynode *map, quantity q, const char *who, int of_cam,
+                    struct mech_law **out);
 void load_initial(loader *ld, const ynode *map);
 /* load.c: the whole file at path, at most max bytes, checked before and while
  * reading (NULL with *rc set and the problem recorded in d). */
@@ -744,5 +748,73 @@ void load_springs(loader *ld, const ynode *seq);
 
 /* ---- load_gears.c: gear pairs and racks. */
 void load_gears(loader *ld, const ynode *seq);
+/* The pin where link g turns on link c (a revolute joint joining them, or a
+ * point they share where g has one): the point indices in g and c; 0 when
+ * there is none. */
+int load_find_pivot(const loader *ld, int g, int c, int *pg, int *pc);
+
+/* ---- load_cams.c: cam-follower pairs (docs/cams.md) ----------------------
+ * A disc cam on link `cam`, turning on the `arm` (a revolute joint), and a
+ * follower that the arm guides: translating (a locked slider of the
+ * follower on the arm) or oscillating (a revolute joint of the follower on
+ * the arm). The follower's coordinate (the slider's displacement, or the
+ * follower's angle relative to the arm) is the program's lift at the cam's
+ * angle: one row, coordinate - c0 - rise (s(x)) = 0, x = sense (th_cam -
+ * th_arm - start) (src/equations/cams.c). */
+typedef enum { CAM_TRANSLATING, CAM_OSCILLATING } cam_motion;
+typedef enum { CAM_ROLLER, CAM_KNIFE_EDGE, CAM_FLAT_FACED } cam_contact;
+typedef struct mech_cam {
+    char *name;          /* owned */
+    int cam, arm, follower;  /* links */
+    int slider;          /* translating: the follower's slider joint; else -1 */
+    int cam_pivot[2];    /* the cam's pivot: its point in the cam, in the arm */
+    int follower_pivot[2]; /* oscillating: the follower's pivot in it and in the arm */
+    int at;              /* oscillating roller or knife-edge: the follower's point at the
+                            roller's centre or the knife's tip; else -1 */
+    cam_motion motion;
+    cam_contact contact;
+    int sense;           /* +1: x grows as the cam turns counterclockwise on the arm */
+    double start;        /* the cam's angle on the arm where x = 0, rad */
+    double base, roller; /* the base circle's radius, the roller's (0: none), m */
+    double offset;       /* translating: the signed distance of the follower's line from
+                            the cam's centre (+: the line passes to the centre's left,
+                            looking along the line's direction), m */
+    double c0;           /* the follower's coordinate at zero lift (m or rad) */
+    int rise;            /* +1 or -1: the coordinate's change as the lift grows */
+    struct mech_law *program; /* the lift s(x), a law of x: owned */
+    mech_mark mark;
+    /* the design quantities over the period (load_cams_place; docs/cams.md 3),
+       each with its x where it is worst */
+    double pressure_max, pressure_at;   /* the largest |pressure angle| */
+    double rho_pitch_min, rho_pitch_at; /* the least radius of the pitch curve where
+                                           convex (INFINITY: nowhere) */
+    double rho_profile_min, rho_profile_at; /* the profile's least (signed) */
+    double face_lo, face_hi;            /* flat-faced: the contact's extent on the face */
+} mech_cam;
+typedef struct model_cams {
+    mech_cam *cam;       /* [n] */
+    int n;
+} model_cams;
+static inline int model_ncams(const mech_model *m) { return m->cams ? m->cams->n : 0; }
+void load_cams(loader *ld, const ynode *seq);
+
+/* cam_geometry.c: cam c at the program's x (docs/cams.md 3). */
+typedef struct cam_point {
+    double x;            /* the program's variable: the cam's angle from 'start', rad */
+    double s[3];         /* the lift and its first two derivatives in x */
+    double pitch[2];     /* the trace point (roller's centre, knife's tip, flat face's foot
+                            on its line) in the cam's own frame, m */
+    double profile[2];   /* the contact point on the profile, in the cam's frame, m */
+    double pressure;     /* the angle from the trace point's motion to the common
+                            normal, rad (0 for a flat face) */
+    double rho_pitch;    /* the pitch curve's radius of curvature, m: + convex */
+    double rho_profile;  /* the profile's */
+    double face;         /* flat-faced: the contact's distance along the face from the
+                            follower's line, m; else 0 */
+} cam_point;
+void cam_geometry(const mech_model *m, const mech_cam *c, double x, cam_point *g);
+/* The base positions that need the follower's guess (after the guesses). */
+void load_cams_place(loader *ld);
+void model_cams_free(model_cams *c);
 
 #endif

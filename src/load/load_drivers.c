@@ -161,7 +161,9 @@ static void load_motion(loader *ld, const ynode *e, mech_motion *mo)
         if (!pm)
             return (void)load_err(ld, law, "a driver's law is an expression of t or "
                                            "{program: {...}}");
-        if (!load_program(ld, pm, ln ? Q_ANGLE : Q_LENGTH, who, &mo->law))
+        char whom[MAX_NAME + 16];
+        snprintf(whom, sizeof whom, "driver '%s'", who);
+        if (!load_program(ld, pm, ln ? Q_ANGLE : Q_LENGTH, whom, &mo->law))
             return;
         snprintf(mo->law->name, sizeof mo->law->name, "p_%s", who);
         char text[160];

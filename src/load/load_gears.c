@@ -23,10 +23,7 @@ enum { MAX_GEARS = 100000 };
 
 static const double PI = 3.14159265358979323846;
 
-/* Point of link c at the pin where link g turns on c: a revolute joint
- * joining g and c, or a point name g and c share where g has a revolute
- * joint. Sets the point indices in g and c; 0 when there is none. */
-static int find_pivot(const loader *ld, int g, int c, int *pg, int *pc)
+int load_find_pivot(const loader *ld, int g, int c, int *pg, int *pc)
 {
     const mech_model *m = ld->m;
     for (int j = 0; j < m->njoints; j++) {
@@ -119,7 +116,7 @@ static int pair_arm(loader *ld, const ynode *map, mech_gear *g)
         if (g->link[k] == g->arm)
             return load_err(ld, where, "gear '%s' is the arm '%s' itself: a gear turns on its "
                             "arm", ld->m->links[g->link[k]].name, ld->m->links[g->arm].name), 0;
-        if (!find_pivot(ld, g->link[k], g->arm, &g->pivot[k], &g->arm_pivot[k]))
+        if (!load_find_pivot(ld, g->link[k], g->arm, &g->pivot[k], &g->arm_pivot[k]))
             return load_err(ld, where, "gear '%s' has no pivot on %s '%s' (no revolute joint "
                             "joins them)%s", ld->m->links[g->link[k]].name,
                             arm ? "the arm" : "the", ld->m->links[g->arm].name,
@@ -261,7 +258,7 @@ static int load_rack(loader *ld, const ynode *map, mech_gear *g)
     if (g->link[0] == g->link[1] || g->link[0] == g->arm)
         return load_err(ld, p, "the pinion '%s' is the rack's own %s", m->links[g->link[0]].name,
                         g->link[0] == g->arm ? "guide" : "link"), 0;
-    if (!find_pivot(ld, g->link[0], g->arm, &g->pivot[0], &g->arm_pivot[0]))
+    if (!load_find_pivot(ld, g->link[0], g->arm, &g->pivot[0], &g->arm_pivot[0]))
         return load_err(ld, p, "pinion '%s' has no pivot on the rack's guide '%s' (no revolute "
                         "joint joins them)", m->links[g->link[0]].name, m->links[g->arm].name), 0;
     g->pivot[1] = g->arm_pivot[1] = -1;

@@ -22,7 +22,7 @@ static void law_error(loader *ld, const ynode *n, size_t pos, const char *who, c
     mech_mark at = n->mark;
     if (!strchr(n->text, '\n'))
         at.col += (int)pos + (n->quoted ? 1 : 0);
-    diag_error(ld->d, ld->file, at, "driver '%s': %s", who, msg);
+    diag_error(ld->d, ld->file, at, "%s: %s", who, msg);
 }
 
 /* A user's law f(u) of a segment: 1, or 0 reported. */
@@ -53,7 +53,7 @@ static int user_law(loader *ld, const ynode *n, const char *who, prog_segment *s
     for (int end = 0; end <= 1; end++) {
         double f = law_eval3(ul, end, buf, d);
         if (!(fabs(f - end) <= 1e-9))
-            return load_err(ld, n, "driver '%s': a segment's law f(u) must go from f(0) = 0 to "
+            return load_err(ld, n, "%s: a segment's law f(u) must go from f(0) = 0 to "
                             "f(1) = 1 (the lift scales it); f(%d) = %.10g", who, end, f), 0;
     }
     return 1;
@@ -98,7 +98,7 @@ static int load_segment(loader *ld, const ynode *e, quantity q, quantity xq, con
         if (!(h > 0)) {
             char su[24];
             double ss = unit_of(ld, q, su, sizeof su);
-            return load_err(ld, ri ? ri : re, "driver '%s': a lift must be positive (a %s of "
+            return load_err(ld, ri ? ri : re, "%s: a lift must be positive (a %s of "
                             "%.10g %s goes the other way: write '%s')", who, kind_name(sg->kind),
                             h / ss, su, ri ? "return" : "rise"), 0;
         }
@@ -173,7 +173,7 @@ static int check_boundaries(loader *ld, const mech_program *p, quantity q, quant
                 snprintf(in_time, sizeof in_time, " = %.6g %s/s%s in time", jump / ss *
                          pow(p->speed, k), su, k == 2 ? "^2" : "");
             diag_error(ld->d, ld->file, (mech_mark){p->seg[i].line, p->seg[i].col},
-                       "driver '%s': %s jump of %.6g %s (d%ss/dx%s%s) at %.10g %s between %s and "
+                       "%s: %s jump of %.6g %s (d%ss/dx%s%s) at %.10g %s between %s and "
                        "%s%s", who, what[k], shown, unit, k == 2 ? "2" : "", k == 2 ? "2" : "",
                        in_time, p->seg[i].x0 > 0 ? p->seg[i].x0 / xs : p->period / xs, xu, l1, l2,
                        k == 2 ? ": use laws whose accelerations meet, or 'continuity: velocity'"
@@ -199,11 +199,11 @@ static int load_speed(loader *ld, const ynode *sp, const char *who, double *out,
     else if (quantity_eval(sp->text, Q_SPEED, &ld->env, out, msg, sizeof msg, &pos) == 0)
         *xq = Q_LENGTH;
     else
-        return load_err(ld, sp, "driver '%s': 'speed' is the rate of the program's variable: "
+        return load_err(ld, sp, "%s: 'speed' is the rate of the program's variable: "
                         "an angular speed (60 rpm) or a speed (m/s), not '%s'", who,
                         sp->text), 0;
     if (!(*out != 0) || !isfinite(*out))
-        return load_err(ld, sp, "driver '%s': 'speed' must not be 0", who), 0;
+        return load_err(ld, sp, "%s: 'speed' must not be 0", who), 0;
     return 1;
 }
 
@@ -247,7 +247,7 @@ static int load_continuity(loader *ld, const ynode *n, const char *who, int *out
     for (int k = 0; k < 3; k++)
         if (strcmp(n->text, names[k]) == 0)
             return *out = k, 1;
-    return load_err(ld, n, "driver '%s': 'continuity' is displacement, velocity or "
+    return load_err(ld, n, "%s: 'continuity' is displacement, velocity or "
                            "acceleration (checked at every boundary up to it), not '%s'", who,
                     n->text), 0;
 }
@@ -288,14 +288,28 @@ static int check_period(loader *ld, const ynode *pn, quantity xq, const char *wh
         return 1;
     char xu[24];
     double xs = unit_of(ld, xq, xu, sizeof xu);
-    return load_err(ld, pn, "driver '%s': the segments cover %.10g %s, not the period %.10g %s: "
+    return load_err(ld, pn, "%s: the segments cover %.10g %s, not the period %.10g %s: "
                     "%s of %.10g %s after segment %d", who, p->period / xs, xu, period / xs, xu,
                     p->period < period ? "a gap" : "an overlap", fabs(period - p->period) / xs,
                     xu, p->n), 0;
 }
 
+/* A cam's program: its variable is the law's own (the cam angle, x = t),
+ * an angle; 'of' and 'speed' do not apply. */
+static int cam_variable(struct mech_law *l, quantity *xq)
+{
+    *xq = Q_ANGLE;
+    return (l->root = law_add_node(l, LAW_T, -1, -1, 0.0)) >= 0;
+}
+
 int load_program(loader *ld, const ynode *map, quantity q, const char *who,
                  struct mech_law **out)
+{
+    return load_program_as(ld, map, q, who, 0, out);
+}
+
+int load_program_as(loader *ld, const ynode *map, quantity q, const char *who, int of_cam,
+                    struct mech_law **out)
 {
     static const char *const keys[] = {"of", "speed", "period", "start", "continuity",
                                        "segments"};
@@ -303,6 +317,12 @@ int load_program(loader *ld, const ynode *map, quantity q, const char *who,
     if (!load_want_kind(ld, map, YNODE_MAP, "'program'") ||
         !load_check_keys(ld, map, keys, COUNT(keys), "program"))
         return 0;
+    for (int k = 0; k < 2 && of_cam; k++) {
+        const ynode *key = load_key_of(map, keys[k]);
+        if (key)
+            return load_err(ld, key, "a cam's program has no '%s': its variable is the cam's "
+                            "angle (turned from 'start')", keys[k]), 0;
+    }
     const ynode *seq = ymap_get(map, "segments"), *st = ymap_get(map, "start");
     if (!seq)
         return load_err(ld, map, "a program needs 'segments: [...]' ({rise: LIFT, over: SPAN, "
@@ -329,7 +349,8 @@ int load_program(loader *ld, const ynode *map, quantity q, const char *who,
     l->rtprogs = rslot;
     l->nprogs = 1;
     quantity xq = Q_TIME;
-    int ok = load_variable(ld, map, who, l, p, &xq) &&
+    int ok = (of_cam ? cam_variable(l, &xq) || (load_nomem(ld, map), 0)
+                     : load_variable(ld, map, who, l, p, &xq)) &&
              load_continuity(ld, ymap_get(map, "continuity"), who, &p->continuity) &&
              (!st || load_get_quantity(ld, st, q, "the start", &p->start)) &&
              load_segments(ld, seq, q, xq, who, p) &&

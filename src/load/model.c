@@ -90,6 +90,7 @@ void mech_model_free(mech_model **pm)
     for (int i = 0; i < m->ngears; i++)
         free(m->gears[i].name);
     free(m->gears);
+    model_cams_free(m->cams);
     free(m->outputs.points);
     free(m->outputs.links);
     free(m->outputs.sliders);

@@ -1,6 +1,7 @@
 /* src/output/describe.c: a checked model's summary lines (describe.h), shared by
  * `mech check` and `mech report`. */
 #include <stdio.h>
+#include <string.h>
 
 #include "output.h"
 #include "load.h"
@@ -57,9 +58,12 @@ void model_describe(const mech_model *m, const mech_summary *s, describe_emit em
     snprintf(b, sizeof b, "%d independent%s, %d equations", s->nloops,
              m->nloops ? " (listed in the file)" : " (found automatically)", s->nequations);
     emit(ctx, "loops", b);
-    char mesh[32] = "";  /* each gear pair or rack removes one freedom (gears.c) */
+    char mesh[64] = "";  /* each gear pair, rack or cam removes one freedom (gears.c) */
     if (s->ngears)
         snprintf(mesh, sizeof mesh, " - %d gear%s", s->ngears, s->ngears == 1 ? "" : "s");
+    if (s->ncams)
+        snprintf(mesh + strlen(mesh), sizeof mesh - strlen(mesh), " - %d cam%s", s->ncams,
+                 s->ncams == 1 ? "" : "s");
     snprintf(b, sizeof b, "%d = 3*(%d-1) - 2*%d - %d%s, drivers %d", s->mobility, s->nlinks,
              s->nrevolute + s->nprismatic, s->npin_in_slot, mesh, s->ndrivers);
     emit(ctx, "mobility", b);
@@ -78,5 +82,11 @@ void model_describe(const mech_model *m, const mech_summary *s, describe_emit em
     for (int i = 0; i < m->ngears; i++) {
         gears_describe(m, i, b, sizeof b);
         emit(ctx, "gears", b);
+    }
+    for (int i = 0; i < model_ncams(m); i++) {
+        cams_describe(m, i, b, sizeof b);
+        emit(ctx, "cam", b);
+        cams_design(m, i, b, sizeof b);
+        emit(ctx, "cam design", b);
     }
 }

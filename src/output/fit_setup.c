@@ -63,7 +63,7 @@ static int split_free(fit_setup *s, const char *file, const char *list, mech_dia
 
 /* A quantity "15mm", "0.5 rad", "15" (in the file's unit of `si_unit`) in
  * SI; 0, or -1 when it is not one of si_unit's dimension. */
-static int parse_quantity(const mech_model *m, const char *text, const char *si_unit, double *v)
+int output_parse_quantity(const mech_model *m, const char *text, const char *si_unit, double *v)
 {
     char *end;
     double x = strtod(text, &end);
@@ -103,7 +103,7 @@ static int read_bounds(fit_setup *s, const mech_model *m, mech_diag *d)
         if (!s->bound_text[k][0])
             continue;
         for (int b = 0; b < 2; b++)
-            if (parse_quantity(m, s->bound_text[k][b], s->unit[k], b ? &s->hi[k] : &s->lo[k]))
+            if (output_parse_quantity(m, s->bound_text[k][b], s->unit[k], b ? &s->hi[k] : &s->lo[k]))
                 return diag_error(d, m->file, none, "--free: the bound '%s' of '%s' is not a "
                                   "quantity in %s (the parameter's unit)", s->bound_text[k][b],
                                   s->names[k], s->unit[k][0] ? s->unit[k] : "a bare number");
@@ -268,7 +268,7 @@ static int transmission(fit_setup *s, const mech_model *m, const char *text, mec
     double v = NAN;
     if (!c1 || !c2 || strchr(c2 + 1, ',') || c1 == text || c2 == c1 + 1 ||
         c1 - text >= (long)sizeof s->fp.trans_a || c2 - c1 - 1 >= (long)sizeof s->fp.trans_b ||
-        parse_quantity(m, c2 + 1, "rad", &v) < 0)
+        output_parse_quantity(m, c2 + 1, "rad", &v) < 0)
         return diag_error(d, m->file, (mech_mark){0, 0}, "--transmission needs LINK,LINK,MIN "
                           "(two moving links and the least angle, e.g. coupler,rocker,30deg), "
                           "not '%s'", text);

@@ -564,4 +564,29 @@ int fit_figure_write(const fit_setup *s, const mech_model *m, const fit_curves *
  * Otherwise (no memory, the SVG not written) the error in d. */
 int fit_figure_of_model(const mech_model *m, const char *path, mech_diag *d);
 
+/* fit_setup.c: a quantity "15mm", "0.5 rad", "15" (a bare number in the
+ * file's unit of si_unit) in SI into *v; 0, or -1 when it is not of
+ * si_unit's dimension. */
+int output_parse_quantity(const mech_model *m, const char *text, const char *si_unit, double *v);
+
+/* ==== cam_profile ==== */
+/* cam_profile.c: what mech cam writes (docs/cams.md 5). The cam called
+ * name (NULL: the file's only one): its index, or -1 with why in err. */
+int cam_find(const mech_model *m, const char *name, char *err, size_t size);
+/* Cam i at n evenly spaced angles over its program's period into *t
+ * (zeroed first; mech_table_free): x, s, ds, dds, pitch.x, pitch.y,
+ * profile.x, profile.y, pressure_angle, rho_pitch, rho_profile, face (SI;
+ * positions in the cam's own frame). MECH_OK or MECH_ENOMEM. */
+int cam_profile_table(const mech_model *m, int i, int n, mech_table *t);
+/* The outline of that table (profile, pitch curve, base circle, centre) in
+ * mm, written whole: SVG, or DXF R12 (layers PROFILE, PITCH, BASE). */
+int cam_outline_svg(const mech_model *m, int i, const mech_table *t, const char *path,
+                    mech_diag *d);
+int cam_outline_dxf(const mech_model *m, int i, const mech_table *t, const char *path,
+                    mech_diag *d);
+/* The number of angles at most `step` apart over cam i's period (3 to 1e7),
+ * and the default step (1 deg). */
+int cam_steps(const mech_model *m, int i, double step);
+double cam_default_step(void);
+
 #endif

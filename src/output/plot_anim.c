@@ -13,6 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "load.h"
 #include "output.h"
 
 void plot_anim_options_default(plot_anim_options *o)
@@ -339,6 +340,34 @@ static void place_gears(const anim_ctx *c, box *b)
     }
 }
 
+/* A cam's profile (docs/cams.md 5): drawn about its pivot in the cam's
+ * frame, CAM_SEGMENTS points of cam_geometry; the box holds its farthest. */
+enum { CAM_SEGMENTS = 180 };
+
+static void place_cams(const anim_ctx *c, box *b)
+{
+    for (int w = 0; w < model_ncams(c->m); w++) {
+        const mech_cam *cm = &c->m->cams->cam[w];
+        const mech_point *oc = &c->m->links[cm->cam].points[cm->cam_pivot[0]];
+        int p = oc->id;
+        double rad = 0.0, period = cm->program->progs[0]->period;
+        for (int k = 0; k < CAM_SEGMENTS; k++) {
+            cam_point g;
+            cam_geometry(c->m, cm, period * k / CAM_SEGMENTS, &g);
+            rad = fmax(rad, hypot(g.profile[0] - oc->x, g.profile[1] - oc->y));
+        }
+        for (int r = 0; r < c->nrows; r++) {
+            double x = c->X[(size_t)r * c->np + p], y = c->Y[(size_t)r * c->np + p];
+            if (isfinite(x) && isfinite(y)) {
+                b->xmin = fmin(b->xmin, x - rad);
+                b->xmax = fmax(b->xmax, x + rad);
+                b->ymin = fmin(b->ymin, y - rad);
+                b->ymax = fmax(b->ymax, y + rad);
+            }
+        }
+    }
+}
+
 /* The scale (the larger side of box b is ANIM_DRAW px; pads leave room for
  * symbols), the page size, and X, Y from metres to screen px. */
 static void set_scale(anim_ctx *c, const box *b)
@@ -421,6 +450,7 @@ static int anim_prepare(anim_ctx *c, mech_diag *d)
     double size = fmax(fmax(b.xmax - b.xmin, b.ymax - b.ymin), 1e-9);
     place_guides(c, &b, 0.08 * size);
     place_gears(c, &b);
+    place_cams(c, &b);
     set_scale(c, &b);
     rc = choose_frames(c, d);
     if (rc == MECH_OK)
@@ -493,6 +523,40 @@ static int gear_shape(const anim_ctx *c, int which, int r, double *xs, double *y
         ys[k + 1] = y - pr * sin(t);  /* screen y points down */
     }
     return GEAR_SEGMENTS + 2;
+}
+
+static int cam_shape(const anim_ctx *c, int which, int r, double *xs, double *ys)
+{
+    const mech_cam *cm = &c->m->cams->cam[which];
+    const mech_point *oc = &c->m->links[cm->cam].points[cm->cam_pivot[0]];
+    double x = c->X[(size_t)r * c->np + oc->id], y = c->Y[(size_t)r * c->np + oc->id];
+    double a = c->ang[(size_t)r * c->m->nlinks + cm->cam], ca = cos(a), sa = sin(a);
+    double period = cm->program->progs[0]->period;
+    for (int k = 0; k < CAM_SEGMENTS; k++) {
+        cam_point g;
+        cam_geometry(c->m, cm, period * k / CAM_SEGMENTS, &g);
+        double dx = g.profile[0] - oc->x, dy = g.profile[1] - oc->y;
+        xs[k] = x + c->s * (ca * dx - sa * dy);
+        ys[k] = y - c->s * (sa * dx + ca * dy);  /* screen y points down */
+    }
+    return CAM_SEGMENTS;
+}
+
+/* A roller follower's roller: a circle about its centre (the slider's
+ * point, or 'at'). */
+static int roller_shape(const anim_ctx *c, int which, int r, double *xs, double *ys)
+{
+    const mech_cam *cm = &c->m->cams->cam[which];
+    const mech_joint *jt = cm->slider >= 0 ? &c->m->joints[cm->slider] : NULL;
+    const mech_link *fl = &c->m->links[cm->follower];
+    int p = (jt ? fl->points[jt->point[0]] : fl->points[cm->at]).id;
+    double x = c->X[(size_t)r * c->np + p], y = c->Y[(size_t)r * c->np + p], pr = c->s * cm->roller;
+    for (int k = 0; k < GEAR_SEGMENTS; k++) {
+        double t = 2.0 * 3.14159265358979323846 * k / GEAR_SEGMENTS;
+        xs[k] = x + pr * cos(t);
+        ys[k] = y - pr * sin(t);
+    }
+    return GEAR_SEGMENTS;
 }
 
 static void put_vertices(FILE *f, const double *xs, const double *ys, int n)
@@ -862,7 +926,7 @@ static int emit_animation(FILE *f, const void *vctx)
     const anim_ctx *c = vctx;
     const mech_model *m = c->m;
     char b3[32];
-    int maxv = m->ngears ? GEAR_SEGMENTS + 2 : 4;
+    int maxv = model_ncams(m) ? CAM_SEGMENTS + 2 : m->ngears ? GEAR_SEGMENTS + 2 : 4;
     for (int i = 0; i < m->nlinks; i++)
         if (c->nhull[i] > maxv)
             maxv = c->nhull[i];
@@ -888,6 +952,17 @@ static int emit_animation(FILE *f, const void *vctx)
                  "stroke-dasharray=\"6 3\"", c->o->test_colours ? "#8a8a8a"
                                                   : l ? link_stroke[l % 6] : "#555");
         put_shape(f, c, "polyline", attrs, gear_shape, w, 1, xs, ys);
+    }
+    for (int w = 0; w < model_ncams(m); w++) {  /* each cam's profile, turning with it */
+        int l = m->cams->cam[w].cam;
+        char attrs[128];
+        snprintf(attrs, sizeof attrs, "class=\"cam\" fill=\"%s\" fill-opacity=\"0.6\" "
+                 "stroke=\"%s\" stroke-width=\"2\"", c->o->test_colours ? "#c8c8c8"
+                 : link_fill[l % 6], c->o->test_colours ? "#8a8a8a" : link_stroke[l % 6]);
+        put_shape(f, c, "polygon", attrs, cam_shape, w, 1, xs, ys);
+        if (m->cams->cam[w].contact == CAM_ROLLER)
+            put_shape(f, c, "polygon", "class=\"roller\" fill=\"white\" stroke=\"#444\" "
+                      "stroke-width=\"2\"", roller_shape, w, 1, xs, ys);
     }
     for (int p = 0; p < c->np; p++)
         put_point(f, c, p, dur);

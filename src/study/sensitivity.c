@@ -229,6 +229,10 @@ void sens_plan_free(sens_plan *sp)
  * without that term: refused. */
 static int refuse_unsupported(const mech_model *m, int p, mech_diag *d)
 {
+    if (model_ncams(m) > 0)  /* the cams' numbers and programs are folded (docs/cams.md) */
+        return diag_error(d, m->file, m->cams->cam[0].mark, "parameter '%s': sensitivities of "
+                          "a mechanism with a cam pair ('%s') are not computed yet",
+                          m->params[p].name, m->cams->cam[0].name);
     const param_exprs *pe = m->pexpr;
     double *dv = pe ? xcalloc((size_t)pe->n + 1, sizeof *dv) : NULL;
     if (!pe)

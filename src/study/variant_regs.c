@@ -214,7 +214,8 @@ static int same_structure(const mech_model *a, const mech_model *v)
            SAME(nguesses) && SAME(nbranches) && SAME(nloops) && SAME(nloads) &&
            SAME(nsprings) && SAME(ngears) && same_links(a, v) && same_lists(a, v) &&
            same_gears(a, v) &&
-           !a->state_loads && !v->state_loads;  /* see docs/batch.md */
+           !a->state_loads && !v->state_loads &&  /* see docs/batch.md */
+           !a->cams && !v->cams;  /* a cam's numbers and program: each variant its own */
 }
 
 /* ---- a variant ------------------------------------------------------------ */

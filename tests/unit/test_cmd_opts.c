@@ -245,7 +245,7 @@ static const cmd_spec *const specs[] = {
     &cmd_check_spec, &cmd_equations_spec, &cmd_solve_spec,   &cmd_compare_spec,
     &cmd_batch_spec, &cmd_sweep_spec,     &cmd_merge_spec,   &cmd_plot_spec,
     &cmd_animate_spec, &cmd_draw_spec,    &cmd_report_spec, &cmd_watch_spec,
-    &cmd_codegen_spec, &cmd_fit_spec, &cmd_simulate_spec};
+    &cmd_codegen_spec, &cmd_fit_spec, &cmd_simulate_spec, &cmd_cam_spec};
 
 /* Every spelling of a command's table, in order, into names[]. */
 static int spellings(const cmd_spec *spec, char names[][48], int max)

@@ -1,0 +1,228 @@
+#!/bin/sh
+# tests/cams.sh: cam-follower pairs (docs/cams.md) against closed forms and
+# the geometry they stand for: tests/cams/translating.yaml (an offset
+# roller follower: cycloidal rise, 3-4-5 return), oscillating.yaml (a
+# roller follower turned clockwise, driving a four-bar: 4-5-6-7 rise,
+# cycloidal return), flat.yaml (a flat-faced follower, harmonic laws) and
+# arm.yaml (a cam and its follower on a swinging arm).
+# The follower's motion against the laws written out here; the base
+# position against the base circle (the roller's centre base + roller from
+# the cam's centre); rates against differences of positions; the profile
+# of mech cam against the envelope it must be (the roller touches it and
+# never cuts it; a flat face is tangent to it), its curvature against
+# three-point circles of its own points, its pressure angle against the
+# normal of the pitch curve's differences; load-time errors with
+# file:line:column; --jit bit for bit.
+# Run from the repository root:  MECH=build/mech sh tests/cams.sh
+NAME=cams . tests/lib.sh
+D=tests/cams
+
+if run "check translating" 0 "$MECH" check "$D/translating.yaml"; then
+    has_line "$tmp/out" "^  mobility   1 = 3\*(3-1) - 2\*2 - 0 - 1 cam, drivers 1\$" "check: the cam in the mobility"
+    has_line "$tmp/out" "^  cam        disc: cam 'cam' on 'ground' turning ccw, roller follower slider 'y_R' at 48.9898 mm + s, offset -10 mm" "check: the cam's line"
+    has_line "$tmp/out" "^  cam design disc: pressure angle at most" "check: the design line"
+fi
+
+# the laws of the programs, in awk: s, s', s'' of a rise or return at u
+LAWS='function cyc(u, k) { return k == 0 ? u - sin(2 * PI * u) / (2 * PI) : k == 1 ? 1 - cos(2 * PI * u) : 2 * PI * sin(2 * PI * u) }
+function p345(u, k) { return k == 0 ? 10 * u^3 - 15 * u^4 + 6 * u^5 : k == 1 ? 30 * u^2 - 60 * u^3 + 30 * u^4 : 60 * u - 180 * u^2 + 120 * u^3 }
+function p4567(u, k) { return k == 0 ? 35 * u^4 - 84 * u^5 + 70 * u^6 - 20 * u^7 : k == 1 ? 140 * u^3 - 420 * u^4 + 420 * u^5 - 140 * u^6 : 420 * u^2 - 1680 * u^3 + 2100 * u^4 - 840 * u^5 }
+function harm(u, k) { return k == 0 ? (1 - cos(PI * u)) / 2 : k == 1 ? PI * sin(PI * u) / 2 : PI * PI * cos(PI * u) / 2 }'
+
+# 1. translating roller, offset 10 mm: R = (10, sqrt(50^2 - 10^2) + s) mm,
+# vy = s' w, ay = s'' w^2 (w = 60 rpm); rise 20 mm cycloidal over 120 deg,
+# dwell 60, return 3-4-5 over 120, dwell 60
+if run "solve translating" 0 "$MECH" solve "$D/translating.yaml" -o "$tmp/t.csv"; then
+    awk -F, "$LAWS"'
+        function lift(x, k,   b, u) { b = 120 * D
+            if (x < b) { u = x / b; return h * cyc(u, k) / b^k }
+            if (x < 180 * D) return k == 0 ? h : 0
+            if (x < 300 * D) { u = (x - 180 * D) / b; return k == 0 ? h - h * p345(u, 0) : -h * p345(u, k) / b^k }
+            return 0 }
+        BEGIN { PI = atan2(0, -1); D = PI / 180; h = 0.020; w = 2 * PI; worst = 0; d0 = sqrt(0.05^2 - 0.01^2) }
+        NR > 1 { x = $1; if (x >= 2 * PI - 1e-12) x = 0
+            e[1] = ($2 - 0.010) / h; e[2] = ($3 - d0 - lift(x, 0)) / h
+            e[3] = ($5 - lift(x, 1) * w) / (h * w); e[4] = ($7 - lift(x, 2) * w * w) / (h * w * w)
+            for (k = 1; k <= 4; k++) { a = e[k] < 0 ? -e[k] : e[k]; if (a > worst) worst = a } }
+        END { printf "%.3g\n", worst; exit !(worst < 1e-12) }' "$tmp/t.csv" >"$tmp/w" &&
+        pass || fail "translating against the closed form: worst relative error $(cat "$tmp/w")"
+fi
+
+# 2. oscillating roller (cw cam) driving a four-bar: the follower's angle
+# less its base angle is the lift at x = -q (4-5-6-7 rise of 15 deg over
+# 150, dwell 30, cycloidal return over 150, dwell 30); at zero lift the
+# roller's centre R is base + roller = 40 mm from the cam's centre O (the
+# base position, found by the loader), and it moves away as the lift grows
+if run "solve oscillating" 0 "$MECH" solve "$D/oscillating.yaml" --outputs R,follower,rocker -o "$tmp/o.csv"; then
+    awk -F, "$LAWS"'
+        function lift(x, k,   b, u) { b = 150 * D
+            if (x < b) { u = x / b; return h * p4567(u, k) / b^k }
+            if (x < 180 * D) return k == 0 ? h : 0
+            if (x < 330 * D) { u = (x - 180 * D) / b; return k == 0 ? h - h * cyc(u, 0) : -h * cyc(u, k) / b^k }
+            return 0 }
+        BEGIN { PI = atan2(0, -1); D = PI / 180; h = 15 * D; worst = 0; base = 0 }
+        NR == 2 { base = $8 }
+        NR > 1 { x = -$1; if (x >= 2 * PI - 1e-12) x = 0
+            e = ($8 - base - lift(x, 0)) / h; if (e < 0) e = -e; if (e > worst) worst = e
+            r = sqrt($2^2 + $3^2)
+            if (lift(x, 0) == 0) { e = (r - 0.040) / 0.040; if (e < 0) e = -e; if (e > worst) worst = e }
+            if (lift(x, 0) > 0 && r <= 0.040) worst = 1 }
+        END { printf "%.3g\n", worst; exit !(worst < 1e-12) }' "$tmp/o.csv" >"$tmp/w" &&
+        pass || fail "oscillating against the closed form and the base circle: worst $(cat "$tmp/w")"
+    # the rocker's rate against central differences of its angle over a
+    # finer sweep (the four-bar driven through the cam): 0.5 deg, O(h^2)
+    "$MECH" solve "$D/oscillating.yaml" --outputs rocker,cam --steps 720 -o "$tmp/r.csv" 2>/dev/null
+    awk -F, 'NR > 1 { q[NR] = $1; a[NR] = $2; om[NR] = $3; w[NR] = $6; n = NR }
+        END { worst = 0; big = 0
+            for (i = 3; i < n; i++) { d = (a[i + 1] - a[i - 1]) / (q[i + 1] - q[i - 1]) * w[i]
+                e = d - om[i]; if (e < 0) e = -e; if (e > worst) worst = e; if (om[i] > big) big = om[i]; if (-om[i] > big) big = -om[i] }
+            printf "%.3g\n", worst / big; exit !(big > 0 && worst / big < 1e-3) }' "$tmp/r.csv" >"$tmp/w" &&
+        pass || fail "oscillating: the rocker's omega against differences: $(cat "$tmp/w")"
+fi
+
+# 2b. a cam and its follower on a swinging arm (tests/cams/arm.yaml: the
+# arm 30 deg sin(2 pi t / 1 s), the cam 360 deg/s t, both laws of time):
+# the lift is the program's at the cam's angle on the arm, its rate s'
+# times the difference of their rates, its acceleration the chain rule's
+if run "solve arm" 0 "$MECH" solve "$D/arm.yaml" -o "$tmp/a.csv"; then
+    awk -F, "$LAWS"'
+        function lift(x, k,   b, u) { b = 120 * D
+            if (x < b) { u = x / b; return h * cyc(u, k) / b^k }
+            if (x < 180 * D) return k == 0 ? h : 0
+            if (x < 300 * D) { u = (x - 180 * D) / b; return k == 0 ? h - h * p345(u, 0) : -h * p345(u, k) / b^k }
+            return 0 }
+        BEGIN { PI = atan2(0, -1); D = PI / 180; h = 0.020; worst = 0; d0 = sqrt(0.05^2 - 0.01^2) }
+        NR > 1 { x = $11 - $8; w = $12 - $9; al = $13 - $10; x -= 2 * PI * int(x / (2 * PI)); if (x < 0) x += 2 * PI
+            e[1] = ($14 - d0 - lift(x, 0)) / h; e[2] = ($15 - lift(x, 1) * w) / (h * 2 * PI)
+            e[3] = ($16 - lift(x, 2) * w * w - lift(x, 1) * al) / (h * 40 * PI * PI)
+            for (k = 1; k <= 3; k++) { a = e[k] < 0 ? -e[k] : e[k]; if (a > worst) worst = a } }
+        END { printf "%.3g\n", worst; exit !(worst < 1e-12) }' "$tmp/a.csv" >"$tmp/w" &&
+        pass || fail "arm: the lift against the program at the cam's angle on the arm: $(cat "$tmp/w")"
+fi
+
+# 3. the profile of mech cam: the roller's circle about each pitch point
+# touches the profile (its own contact point is rr away) and no profile
+# point is nearer (no cut); the pitch curve's radius against the circle
+# through three neighbouring points (0.1 deg apart); the pressure angle
+# against the normal of the pitch curve's central differences and the
+# follower's line turned into the cam's frame
+if run "cam translating" 0 "$MECH" cam "$D/translating.yaml" --step 0.1 -o "$tmp/p.csv" \
+    --svg "$tmp/p.svg" --dxf "$tmp/p.dxf"; then
+    has_line "$tmp/out" "^points       3600, 0.1 deg apart\$" "cam: the points"
+    python3 - "$tmp/p.csv" <<'EOF' && pass || fail "cam translating: the profile's geometry"
+import csv, math, sys
+rows = [[float(v) for v in r] for r in list(csv.reader(open(sys.argv[1])))[1:]]
+rr, n, bad = 0.010, len(rows), []
+worst = max(abs(math.hypot(r[4] - r[6], r[5] - r[7]) - rr) for r in rows)
+if worst > 1e-15: bad.append(f"contact {worst:.3g} m off the roller's circle")
+# the contact is on the cam's side of the roller (the centre O at the origin)
+outer = sum((r[4] - r[6]) * r[4] + (r[5] - r[7]) * r[5] <= 0 for r in rows)
+if outer: bad.append(f"{outer} contacts on the far side of the roller from the cam")
+cut = 0.0
+for r in rows[::7]:  # every pitch point against every profile point
+    d = min(math.hypot(r[4] - q[6], r[5] - q[7]) for q in rows)
+    cut = max(cut, rr - d)
+if cut > 1e-9: bad.append(f"the roller cuts the profile by {cut:.3g} m")
+rho = press = 0.0
+edges = (0, 120, 180, 300)  # the segments' ends: the jerk jumps, the three-point circle across one is O(h)
+for k in range(1, n - 1):
+    if min(abs(math.degrees(rows[k][0]) - e) for e in edges) < 1e-6:
+        continue
+    (x0, y0), (x1, y1), (x2, y2) = [(rows[j][4], rows[j][5]) for j in (k - 1, k, k + 1)]
+    a, b, c = math.hypot(x1 - x0, y1 - y0), math.hypot(x2 - x1, y2 - y1), math.hypot(x2 - x0, y2 - y0)
+    area = abs((x1 - x0) * (y2 - y0) - (x2 - x0) * (y1 - y0)) / 2
+    if area > 0:
+        rho = max(rho, abs(a * b * c / (4 * area) - rows[k][9]) / abs(rows[k][9]))
+    # the normal of the pitch curve, outwards, and the follower's direction
+    # (the line at 90 deg on the ground) seen from the cam turned by x
+    tx, ty = x2 - x0, y2 - y0
+    nx, ny = -ty, tx  # the curve runs clockwise (the cam turns ccw): outward is left
+    th = rows[k][0]
+    ux, uy = math.cos(math.pi / 2 - th), math.sin(math.pi / 2 - th)
+    phi = math.atan2(ux * ny - uy * nx, ux * nx + uy * ny)
+    press = max(press, abs(phi - rows[k][8]))
+if rho > 1e-5: bad.append(f"radius of curvature {rho:.3g} from three-point circles")
+if press > 1e-5: bad.append(f"pressure angle {press:.3g} rad from the pitch curve's normal")
+for b in bad: print("FAIL:", b)
+sys.exit(1 if bad else 0)
+EOF
+    # the pitch curve is where mech solve puts the roller's centre: R(q)
+    # turned back by the cam's angle q (the cam's centre at the origin)
+    awk -F, 'FNR == 1 { f++ } f == 1 && FNR > 1 { px[FNR] = $5; py[FNR] = $6 }
+        f == 2 && FNR > 1 && $1 < 6.28 { k = int($1 * 1800 / atan2(0, -1) + 0.5) + 2
+            c = cos($1); s = sin($1); x = c * $2 + s * $3; y = -s * $2 + c * $3
+            e = (x - px[k]) ^ 2 + (y - py[k]) ^ 2; if (e > worst) worst = e }
+        END { printf "%.3g\n", sqrt(worst); exit !(sqrt(worst) < 1e-15) }' "$tmp/p.csv" "$tmp/t.csv" >"$tmp/w" &&
+        pass || fail "cam translating: the pitch curve is not the solved roller's path: $(cat "$tmp/w") m"
+    python3 -c "import sys, xml.dom.minidom as X; d = X.parse(sys.argv[1]); sys.exit(len(d.getElementsByTagName('polygon')) != 2)" "$tmp/p.svg" &&
+        pass || fail "cam: the SVG outline is not well-formed or lacks its two curves"
+    [ "$(grep -c '^POLYLINE$' "$tmp/p.dxf")" -eq 2 ] && [ "$(grep -c '^VERTEX$' "$tmp/p.dxf")" -eq 7200 ] &&
+        [ "$(tail -n 1 "$tmp/p.dxf")" = EOF ] && pass || fail "cam: the DXF outline"
+fi
+
+# 4. flat-faced: the contact point lies on the face (base + s along the
+# follower's line from the centre, turned into the cam's frame) and the
+# profile's own tangent there is the face's direction; its radius of
+# curvature base + s + s'' against the harmonic laws written out
+if run "cam flat" 0 "$MECH" cam "$D/flat.yaml" --step 0.1 -o "$tmp/f.csv"; then
+    has_line "$tmp/out" "^design       cam_y_F: face from -16.8 to 4.8 mm of the follower's line (width at least 21.6 mm)" "cam flat: the face"
+    python3 - "$tmp/f.csv" <<'EOF' && pass || fail "cam flat: the profile's geometry"
+import csv, math, sys
+rows = [[float(v) for v in r] for r in list(csv.reader(open(sys.argv[1])))[1:]]
+n, bad, on, tang, rho = len(rows), [], 0.0, 0.0, 0.0
+h, b, rb = 0.018, 150 * math.pi / 180, 0.035
+for k in range(n):
+    x, px, py = rows[k][0], rows[k][6], rows[k][7]
+    th = x + math.radians(30)  # start 30 deg
+    ux, uy = math.cos(math.pi / 2 - th), math.sin(math.pi / 2 - th)
+    if x < b: u = x / b; s, dds = h * (1 - math.cos(math.pi * u)) / 2, h * math.pi ** 2 * math.cos(math.pi * u) / (2 * b * b)
+    elif x < math.radians(180): s, dds = h, 0.0
+    elif x < math.radians(330): u = (x - math.radians(180)) / b; s, dds = h - h * (1 - math.cos(math.pi * u)) / 2, -h * math.pi ** 2 * math.cos(math.pi * u) / (2 * b * b)
+    else: s, dds = 0.0, 0.0
+    on = max(on, abs(px * ux + py * uy - (rb + s)))
+    rho = max(rho, abs(rows[k][10] - (rb + s + dds)))
+    if 0 < k < n - 1 and min(abs(math.degrees(x) - e) for e in (0, 150, 180, 330)) > 1e-6:
+        tx, ty = rows[k + 1][6] - rows[k - 1][6], rows[k + 1][7] - rows[k - 1][7]
+        tang = max(tang, abs(tx * ux + ty * uy) / math.hypot(tx, ty))
+if on > 1e-15: bad.append(f"contact {on:.3g} m off the face")
+if tang > 1e-6: bad.append(f"the profile's tangent {tang:.3g} off the face's direction")
+if rho > 1e-12: bad.append(f"radius of curvature {rho:.3g} m off base + s + s''")
+for b in bad: print("FAIL:", b)
+sys.exit(1 if bad else 0)
+EOF
+fi
+
+# 5. the generated code: bit for bit
+if run "jit translating" 0 "$MECH" solve "$D/translating.yaml" --jit -o "$tmp/tj.csv"; then
+    cmp -s "$tmp/t.csv" "$tmp/tj.csv" && pass || fail "jit translating: not bit for bit"
+fi
+run "jit oscillating" 0 "$MECH" solve "$D/oscillating.yaml" --outputs R,follower,rocker --jit -o "$tmp/oj.csv" &&
+    { cmp -s "$tmp/o.csv" "$tmp/oj.csv" && pass || fail "jit oscillating: not bit for bit"; }
+
+# 6. what is refused, where
+bad() {  # bad LABEL STATUS PATTERN SED-SCRIPT [FILE]: the file edited, then mech check
+    sed "$4" "$D/${5:-translating.yaml}" >"$tmp/bad.yaml"
+    run "$1" "$2" "$MECH" check "$tmp/bad.yaml" && has_line "$tmp/err" "$3" "$1: message"
+}
+bad "offset too large" 2 "bad.yaml:24:15: error: the follower's line (slider 'y_R') passes 60 mm from the cam's centre O, not inside the base circle plus the roller (50 mm)" 's/^  T: \[10, 0\]/  T: [60, 0]/'
+bad "undercut" 2 "bad.yaml:22:5: error: cam 'disc': the profile is undercut at [0-9.]* deg of the cam: the pitch curve's radius of curvature there, [0-9.]* mm, is below the roller's 20 mm" 's/^    roller_radius: 10 mm/    roller_radius: 20 mm/; s/^    base_radius: 40 mm/    base_radius: 5 mm/; s/^  T: \[10, 0\]/  T: [0, 0]/; s/over: 120 deg, law: cycloidal/over: 60 deg, law: cycloidal/; 0,/dwell: 60 deg/ s//dwell: 120 deg/'
+bad "flat undercut" 2 "bad.yaml:22:5: error: cam 'cam_y_F': the profile is undercut at [0-9.]* deg of the cam: its radius of curvature base + s + s'' there is -[0-9.]* mm" 's/^    base_radius: 35 mm/    base_radius: 3 mm/; s/rise: 18 mm, over: 150 deg/rise: 18 mm, over: 60 deg/; 0,/dwell: 30 deg/ s//dwell: 120 deg/' flat.yaml
+bad "unknown contact" 2 "bad.yaml:25:14: error: 'contact' is roller, knife-edge or flat-faced, not 'ball'" 's/^    contact: roller/    contact: ball/'
+bad "at on a slider" 2 "bad.yaml:[0-9]*:5: error: a translating follower touches the cam at its slider's point: 'at' does not apply" 's/^    follower: y_R/    follower: y_R\n    at: R/'
+bad "program of" 2 "bad.yaml:[0-9]*:7: error: a cam's program has no 'of': its variable is the cam's angle" 's/^    program:/    program:\n      of: t/'
+bad "oscillating flat" 2 "error: an oscillating flat-faced follower is not supported yet" 's/^    contact: roller/    contact: flat-faced/; /roller_radius/d' oscillating.yaml
+bad "out of reach" 2 "bad.yaml:[0-9]*:5: error: cam 'disc': the follower's point R (80 mm from its pivot, which is 100 mm from the cam's centre) cannot reach the base circle plus the roller (10.5 mm)" 's/^    base_radius: 30 mm/    base_radius: 0.5 mm/' oscillating.yaml
+bad "jump in the program" 2 "error: cam 'disc': an acceleration jump of [-0-9.]* mm/deg^2 (d2s/dx2) at 180 deg" 's/law: 3-4-5/law: harmonic/'
+run "forces refused" 2 "$MECH" solve "$D/translating.yaml" --forces -o "$tmp/x.csv" &&
+    has_line "$tmp/err" "translating.yaml:22:5: error: cam 'disc': forces through a cam pair are not computed yet" "forces refused: message"
+printf 'parameters:\n  rb: 40 mm\n' >"$tmp/par.yaml"
+sed 's/^    base_radius: 40 mm/    base_radius: rb/' "$D/translating.yaml" >>"$tmp/par.yaml"
+run "sensitivity refused" 2 "$MECH" solve "$tmp/par.yaml" --sensitivity rb -o "$tmp/x.csv" &&
+    has_line "$tmp/err" "error: parameter 'rb': sensitivities of a mechanism with a cam pair ('disc') are not computed yet" "sensitivity refused: message"
+run "cam: output over the input" 2 "$MECH" cam "$D/translating.yaml" -o "$D/translating.yaml"
+run "cam: no such cam" 2 "$MECH" cam "$D/translating.yaml" --cam nope &&
+    has_line "$tmp/err" "no cam 'nope' in the file" "no such cam: message"
+run "cam: no cams" 2 "$MECH" cam mechanisms/fourbar.yaml &&
+    has_line "$tmp/err" "the file has no 'cams:'" "no cams: message"
+
+summary
