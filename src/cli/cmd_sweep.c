@@ -364,6 +364,7 @@ static int run_variants(sweep_args *a, int argc, char **argv)
     free(head);
     if (code >= 0)
         return code;
+    o.rows.input = a->file;
     o.done = o.rows.ndone;
     cmd_progress_init(&o.progress, "sweep", "variants", a->quiet);
     mech_sweep_sink sink = {put_row, row_done, &o};
