@@ -9,6 +9,7 @@
  * (manifest, header, rows, digest line) is made on it. */
 #include <errno.h>
 #include <inttypes.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -17,10 +18,16 @@
 #include "output.h"
 
 /* x as the shortest "%.Ng" that reads back as x (as mech sweep writes a
- * parameter; nan and inf as printf spells them) into buf: its length */
+ * parameter; nan and inf as printf spells them), a whole number below
+ * 10^15 with all its digits (an index: 10, not 1e+01), into buf: its
+ * length */
 static size_t put_number(char *buf, size_t size, double x)
 {
     int n = 0;
+    if (x == floor(x) && fabs(x) < 1e15) {
+        n = snprintf(buf, size, "%.0f", x);
+        return n > 0 && (size_t)n < size ? (size_t)n : 0;
+    }
     for (int p = 1; p <= 17; p++) {
         n = snprintf(buf, size, "%.*g", p, x);
         if (strtod(buf, NULL) == x)
