@@ -588,7 +588,8 @@ static const cmd_opt options[] = {
      .label = "-o, --output TABLE",
      .help = "write the table to TABLE (whole, when all are done;\n"
              "meanwhile each row goes to TABLE.partial as its file\n"
-             "finishes); default: standard output"},
+             "finishes); default: standard output; TABLE.h5 or\n"
+             ".hdf5: HDF5 (not with --shard)"},
     {.names = "--files-from", .kind = CMD_OPT_TEXT, .at = AT(files_from), .flags = CMD_RUN_ONLY,
      .label = "--files-from LIST",
      .help = "also the files named in LIST, one path per line ('-':\n"

@@ -34,7 +34,8 @@ typedef struct merge_args {
 
 static const cmd_opt options[] = {
     {.names = "-o", .kind = CMD_OPT_TEXT, .at = offsetof(merge_args, out), .label = "-o FILE",
-     .help = "the merged file (required; '-' for standard output)"},
+     .help = "the merged file (required; '-' for standard output);\n"
+             "OUT.h5 or .hdf5: HDF5 (shards may be CSV or HDF5)"},
     {.names = "--study", .kind = CMD_OPT_TEXT, .at = offsetof(merge_args, study),
      .label = "--study FILE", .help = "the ranges of a study split with --index-offset"},
     CMD_HELP_ENTRY,
