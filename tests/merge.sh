@@ -264,6 +264,65 @@ if run "a whole study" 0 "$MECH" merge --study "$tmp/study2" -o "$tmp/g.csv" "$t
 fi
 refused "a study's first range missing" "study2:1: range 0..17 (--index-offset 0, 18 variants) missing" -- --study "$tmp/study2" "$tmp/g2.csv"
 
+# ---- HDF5 (docs/cli.md, "HDF5 output"): a sweep written as .h5 holds the
+# CSV's numbers and words exactly; its shards, as .h5 (and mixed with CSV
+# shards), merge to the unsharded run, as CSV or .h5; mismatched shards are
+# refused as CSV ones are; an output that is an input (exit 2) and a missing
+# directory (exit 3) write nothing. (tests/unit/test_output_h5.c opens a
+# sweep's .h5 with the HDF5 library: the attributes.)
+h5m="--metric range:E.x --metric transmission:coupler,tray"
+"$MECH" sweep $file $sub $h5m -j 1 -q -o "$tmp/h5ref.csv" 2>/dev/null
+if run "sweep -o OUT.h5" 0 "$MECH" sweep $file $sub $h5m -j 1 -q -o "$tmp/h5ref.h5"; then
+    run "sweep: HDF5 against the CSV, exactly" 0 "$MECH" compare --rtol 0 --atol 0 "$tmp/h5ref.h5" "$tmp/h5ref.csv" &&
+        has_line "$tmp/out" "^compare: 7 columns, 30 rows: all within" "sweep HDF5: every column (status too) and row"
+    [ -e "$tmp/h5ref.h5.partial" ] && fail "sweep -o OUT.h5 left OUT.h5.partial" || pass
+    ls "$tmp"/h5ref.h5.tmp* >/dev/null 2>&1 && fail "a temporary file was left beside h5ref.h5" || pass
+    [ "$(head -c 4 "$tmp/h5ref.h5" | od -An -c | tr -d ' ')" = "211HDF" ] && pass || fail "h5ref.h5 has no HDF5 signature"
+fi
+for k in 0 1 2; do
+    "$MECH" sweep $file $sub $h5m -j 1 -q --shard $k/3 -o "$tmp/h5s.$k.h5" 2>/dev/null
+done
+"$MECH" sweep $file $sub $h5m -j 1 -q --shard 1/3 -o "$tmp/h5s.1.csv" 2>/dev/null
+for out in csv h5; do
+    if run "merge HDF5 shards -o OUT.$out" 0 "$MECH" merge -o "$tmp/h5m.$out" "$tmp"/h5s.*.h5; then
+        run "merged HDF5 shards ($out) equal the unsharded run" 0 "$MECH" compare --rtol 0 --atol 0 "$tmp/h5m.$out" "$tmp/h5ref.csv" &&
+            has_line "$tmp/out" "^compare: 7 columns, 30 rows: all within" "merged HDF5 shards: every row"
+    fi
+done
+if run "merge HDF5 and CSV shards" 0 "$MECH" merge -o "$tmp/h5mix.h5" "$tmp/h5s.0.h5" "$tmp/h5s.1.csv" "$tmp/h5s.2.h5"; then
+    run "mixed shards equal the unsharded run" 0 "$MECH" compare --rtol 0 --atol 0 "$tmp/h5mix.h5" "$tmp/h5ref.h5"
+fi
+"$MECH" sweep $file $sub --metric range:E.x -j 1 -q --shard 2/3 -o "$tmp/h5other.2.h5" 2>/dev/null
+refused "HDF5 shards of two runs" "is not from the same run as .*: its arguments differ" -- \
+    "$tmp/h5s.0.h5" "$tmp/h5s.1.h5" "$tmp/h5other.2.h5"
+refused "an HDF5 shard missing" "shard 2/3 missing" 1 -- "$tmp/h5s.0.h5" "$tmp/h5s.1.h5"
+refused "an unsharded .h5 is no shard" "no '# mech-manifest' line" -- "$tmp/h5ref.h5" "$tmp/h5s.1.h5"
+cp "$tmp/h5s.0.h5" "$tmp/h5in.h5"
+if run "merge -o SHARD.h5" 2 "$MECH" merge -o "$tmp/h5in.h5" "$tmp/h5in.h5" "$tmp/h5s.1.h5" "$tmp/h5s.2.h5"; then
+    cmp -s "$tmp/h5in.h5" "$tmp/h5s.0.h5" && pass || fail "merge -o SHARD.h5 changed the shard"
+fi
+if run "merge -o MISSING/OUT.h5" 3 "$MECH" merge -o "$tmp/nodir/m.h5" "$tmp"/h5s.*.h5; then
+    [ -e "$tmp/nodir" ] && fail "merge -o MISSING/OUT.h5 made something" || pass
+fi
+if run "sweep -o MISSING/OUT.h5" 3 "$MECH" sweep $file $sub $h5m -j 1 -q -o "$tmp/nodir/s.h5"; then
+    [ -e "$tmp/nodir" ] && fail "sweep -o MISSING/OUT.h5 made something" || pass
+fi
+cp $file "$tmp/in.h5"
+run "sweep: the output is the input" 2 "$MECH" sweep "$tmp/in.h5" $sub -q -o "$tmp/in.h5" &&
+    cmp -s "$tmp/in.h5" $file && pass
+# --resume with OUT.h5: OUT.h5.partial holds CSV rows as for a CSV
+if run "sweep --resume -o OUT.h5 with nothing to resume" 0 "$MECH" sweep $file $sub $h5m -j 1 -q --resume -o "$tmp/h5res.h5"; then
+    run "resumed .h5: the same numbers" 0 "$MECH" compare --rtol 0 --atol 0 "$tmp/h5res.h5" "$tmp/h5ref.csv"
+fi
+# batch -o TABLE.h5: the summary (text and numbers); --shard with it refused
+if run "batch -o TABLE.h5" 0 "$MECH" batch -q mechanisms/fourbar.yaml mechanisms/slider-crank.yaml -o "$tmp/b.h5"; then
+    run "batch TABLE.h5 read back" 0 "$MECH" compare --rtol 0 --atol 0 "$tmp/b.h5" "$tmp/b.h5" &&
+        has_line "$tmp/out" "^compare: 6 columns, 2 rows: all within" "batch TABLE.h5: 6 columns, 2 rows"
+    [ -e "$tmp/b.h5.partial" ] && fail "batch -o TABLE.h5 left TABLE.h5.partial" || pass
+fi
+run "batch --shard -o TABLE.h5" 2 "$MECH" batch -q mechanisms/fourbar.yaml --shard 0/2 -o "$tmp/bs.h5" &&
+    has_line "$tmp/err" "a shard's table is text" "batch --shard -o TABLE.h5: why it is refused"
+
 # point 8: merge streams: its peak memory at 2 x 10^5 rows is that at
 # 2 x 10^4 (made-up shards, tests/merge_forge.py gen; the old merge held
 # every row: about 10 MB more; MECH_QUICK=1: 10^5 rows, 5 MB more)

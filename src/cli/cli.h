@@ -149,6 +149,28 @@ static inline int cmd_exit_status(int rc)
  * digest), else CSV. MECH_OK or a failure in d. */
 int cmd_write_table(const mech_table *t, const char *out, const char *command,
                     const char *input, mech_diag *d);
+
+/* ==== cmd_h5 ==== */
+/* cmd_h5.c: HDF5 for the tables that are text first (mech sweep's rows,
+ * mech merge's output; docs/cli.md, "HDF5 output"). */
+typedef struct h5_head {
+    const char *command;   /* "sweep", "merge": for messages, and the attribute */
+    const char *manifest;  /* the run's manifest line (no newline), or NULL */
+    const char *header;    /* the CSV header line (no newline) */
+    const char *input;     /* the input file, or NULL */
+    int shard;             /* 1: a shard's (the manifest's fields and lines, and
+                              the digest line of the canonical text, for merge) */
+} h5_head;
+/* The CSV text emit(f, ctx) writes (comment lines skipped), read back and
+ * written to OUT as HDF5, whole or not at all, with h's root attributes.
+ * Returns the exit status (the problem printed). */
+int cmd_h5_write_text(const h5_head *h, const char *out, int (*emit)(FILE *, const void *),
+                      const void *ctx);
+/* The HDF5 shard at path as the lines of its CSV form (its manifest and
+ * header attributes, its rows with each number in the shortest form that
+ * reads back as it, its digest attribute): a temporary file at its start,
+ * or NULL (the problem printed). */
+FILE *cmd_h5_shard_text(const char *path);
 /* cmd_common.c: "mech COMMAND: MESSAGE (see 'mech COMMAND --help')" on
  * stderr; returns MECH_EXIT_INPUT. fmt has one %s for arg. */
 int cmd_usage_error(const char *command, const char *fmt, const char *arg);
@@ -459,6 +481,7 @@ typedef struct rowfile {
     off_t end;
     char *path;            /* OUT.partial (owned), NULL for the temporary file */
     const char *command;   /* "sweep", for messages */
+    const char *input;     /* the input file (an HDF5 OUT's attribute), or NULL */
     char *head;            /* the manifest line and the header line, owned */
     size_t head_len;
     line_digest head_digest;  /* of the head: where each block's digest starts */
@@ -499,8 +522,9 @@ int rows_done(const rowfile *rf, long i);
  * under the same lock so the blocks of two rows do not mix. */
 void rows_put(rowfile *rf, long i, const char *line, const char *messages);
 /* Writes OUT whole: the manifest line when with_manifest, the header, the
- * rows in index order and (with the manifest) the digest line; then
- * removes OUT.partial. *nok: the rows whose field `status_field` (0-based)
+ * rows in index order and (with the manifest) the digest line; for an OUT
+ * named .h5 or .hdf5 that text as HDF5 (cmd_h5_write_text); then removes
+ * OUT.partial. *nok: the rows whose field `status_field` (0-based)
  * is "ok". Returns the exit status. */
 int rows_finish(rowfile *rf, const char *out, int with_manifest, int status_field, long *nok);
 /* Closes the file and frees rf (OUT.partial stays unless finished). */

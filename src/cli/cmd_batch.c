@@ -467,6 +467,60 @@ static int open_partial(batch *b, const char *table, const char *head)
     return -1;
 }
 
+/* The summary as a table of columns (text cells for the file, the status
+ * and the golden), the numbers unrounded; MECH_OK or MECH_ENOMEM. */
+static int summary_columns(const batch *b, compare_table *t)
+{
+    static const char *const names[] = {"file", "status", "steps", "worst_residual",
+                                        "us_per_step", "golden"};
+    static const char *const units[] = {"-", "-", "-", "m", "us", "-"};
+    static const char *const words[] = {"ok", "FAILED", "INPUT", "IO"};
+    size_t nc = 6, nr = (size_t)b->njobs;
+    memset(t, 0, sizeof *t);
+    t->names = calloc(nc, sizeof *t->names);
+    t->units = calloc(nc, sizeof *t->units);
+    t->values = malloc((nr * nc + 1) * sizeof *t->values);
+    t->word = malloc((nr * nc + 1) * sizeof *t->word);
+    char *name = malloc(65536);
+    int bad = !t->names || !t->units || !t->values || !t->word || !name;
+    t->ncols = bad ? 0 : nc;
+    for (size_t c = 0; c < t->ncols; c++)
+        bad |= !(t->names[c] = strdup(names[c])) || !(t->units[c] = strdup(units[c]));
+    for (size_t i = 0; !bad && i < nr; i++, t->nrows++) {
+        const job *jb = &b->jobs[i];
+        int *w = t->word + i * nc;
+        double *v = t->values + i * nc;
+        snprintf(name, 65536, "%.*s", jb->name_len, jb->name);
+        w[0] = compare_table_intern(t, name);
+        w[1] = compare_table_intern(t, jb->kept ? "kept" : jb->code >= 0 && jb->code <= 3
+                                                            ? words[jb->code] : "?");
+        w[5] = compare_table_intern(t, jb->golden ? jb->golden : "-");
+        w[2] = w[3] = w[4] = -1;
+        v[0] = v[1] = v[5] = NAN;
+        v[2] = jb->steps;
+        v[3] = jb->worst_residual;
+        v[4] = jb->us_per_step;
+        bad = w[0] < 0 || w[1] < 0 || w[5] < 0;
+    }
+    free(name);
+    return bad ? MECH_ENOMEM : MECH_OK;
+}
+
+/* -o TABLE.h5: the summary as HDF5 (output_write_h5_table); MECH_OK, or
+ * an error status with d. */
+static int write_table_h5(const batch *b, const char *table, mech_diag *d)
+{
+    compare_table t;
+    int rc = summary_columns(b, &t);
+    const char *keys[] = {"mech_version", "command"}, *values[] = {MECH_VERSION, "batch"};
+    if (rc == MECH_OK)
+        rc = output_write_h5_table(&t, table, keys, values, 2, d);
+    else
+        diag_nomem(d, table, (mech_mark){0, 0});
+    compare_table_free(&t);
+    return rc;
+}
+
 /* The table written whole to TABLE (or standard output), then TABLE.partial
  * removed; MECH_EXIT_OK or MECH_EXIT_IO. */
 static int write_table(batch *b, const char *table)
@@ -477,7 +531,8 @@ static int write_table(batch *b, const char *table)
                 b->partial_path);
     mech_diag d;
     mech_diag_init(&d);
-    int rc = write_file_whole(table ? table : "-", emit_table, b, &d);
+    int rc = table && output_is_h5_name(table) ? write_table_h5(b, table, &d)
+             : write_file_whole(table ? table : "-", emit_table, b, &d);
     mech_diag_print(&d, stderr);
     mech_diag_free(&d);
     if (rc == MECH_OK && b->partial_path)
@@ -533,7 +588,8 @@ static const cmd_opt options[] = {
      .label = "-o, --output TABLE",
      .help = "write the table to TABLE (whole, when all are done;\n"
              "meanwhile each row goes to TABLE.partial as its file\n"
-             "finishes); default: standard output"},
+             "finishes); default: standard output; TABLE.h5 or\n"
+             ".hdf5: HDF5 (not with --shard)"},
     {.names = "--files-from", .kind = CMD_OPT_TEXT, .at = AT(files_from), .flags = CMD_RUN_ONLY,
      .label = "--files-from LIST",
      .help = "also the files named in LIST, one path per line ('-':\n"
@@ -603,6 +659,10 @@ static int parse_batch_args(int argc, char **argv, batch *b, batch_opts *bo)
         return cmd_usage_error("batch", "%s", "no files given (usage: mech batch FILE... [-j N])");
     if (bo->skip_existing && !bo->out_dir)
         return cmd_usage_error("batch", "%s", "--skip-existing needs --out-dir DIR");
+    if (bo->shard.given && bo->table && output_is_h5_name(bo->table))
+        return cmd_usage_error("batch", "%s", "--shard with -o TABLE.h5: a shard's table is "
+                               "text, for mech merge (its rows are checked as text); write "
+                               "-o TABLE and mech merge -o OUT");
     b->out_dir = bo->out_dir;
     b->golden_dir = bo->golden_dir;
     b->cmp.rtol = bo->rtol;

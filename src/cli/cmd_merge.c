@@ -34,7 +34,8 @@ typedef struct merge_args {
 
 static const cmd_opt options[] = {
     {.names = "-o", .kind = CMD_OPT_TEXT, .at = offsetof(merge_args, out), .label = "-o FILE",
-     .help = "the merged file (required; '-' for standard output)"},
+     .help = "the merged file (required; '-' for standard output);\n"
+             "OUT.h5 or .hdf5: HDF5 (shards may be CSV or HDF5)"},
     {.names = "--study", .kind = CMD_OPT_TEXT, .at = offsetof(merge_args, study),
      .label = "--study FILE", .help = "the ranges of a study split with --index-offset"},
     CMD_HELP_ENTRY,
@@ -79,6 +80,7 @@ typedef struct shard {
     char *partial;      /* SHARD.partial (owned) when that was read */
     manifest man;
     int run;            /* its run in merge.runs; -1 when not merged (foreign) */
+    FILE *text;         /* an HDF5 shard's lines (cmd_h5_shard_text), made once */
     FILE *f;            /* pass 2 */
     line_digest d;      /* pass 2: its lines so far */
     long nrows;         /* pass 2: rows read */
@@ -168,6 +170,29 @@ static FILE *open_regular(const char *path, const char **kind)
     return f;
 }
 
+/* f, shard s's file, when it is HDF5: its lines as its CSV would hold them
+ * (made once, then read again from the start: each open has its own FILE
+ * on a dup of the descriptor; shards are read one at a time but in pass
+ * 2, where each is opened once). NULL, with the problem named. */
+static FILE *h5_lines(merge *g, shard *s, FILE *f)
+{
+    fclose(f);
+    if (!s->text && !(s->text = cmd_h5_shard_text(s->path))) {
+        complain(g, "%s: an HDF5 file that is not a shard mech wrote (see the message above)",
+                 s->path);
+        return NULL;
+    }
+    int fd = dup(fileno(s->text));
+    FILE *t = fd >= 0 ? fdopen(fd, "r") : NULL;
+    if (!t && fd >= 0)
+        close(fd);
+    if (t)
+        rewind(t);
+    else
+        fprintf(stderr, "mech merge: cannot read %s again: %s\n", s->path, strerror(errno));
+    return t;
+}
+
 /* The file of shard s: SHARD, or when it is not there but SHARD.partial
  * is (a run killed before its end), that one, so the shard is named as
  * unfinished rather than unreadable. NULL with the problem printed (an
@@ -193,6 +218,8 @@ static FILE *open_shard(merge *g, shard *s)
                  "mech batch); not read", s->path, kind);
     else if (!f)
         fprintf(stderr, "mech merge: cannot read %s: %s\n", s->path, strerror(errno));
+    else if (output_file_is_h5(s->path))
+        f = h5_lines(g, s, f);
     return f;
 }
 
@@ -926,6 +953,35 @@ static int problems(const merge *g)
     return MECH_EXIT_INPUT;
 }
 
+/* OUT.h5: the merged CSV text as HDF5 (cmd_h5.c), with the first merged
+ * run's version, command and input digest; no manifest, as the CSV. */
+static int write_h5(merge *g, const char *out)
+{
+    if (g->batch) {
+        fprintf(stderr, "mech merge: %s: the summary tables of mech batch --shard merge into "
+                "text only (their rows are checked as text); write -o TABLE without .h5, "
+                "nothing written\n", out);
+        return MECH_EXIT_INPUT;
+    }
+    const run *u = g->runs;
+    while (!u->accepted)
+        u++;
+    char *mline = NULL;
+    size_t size = 0;
+    FILE *m = open_memstream(&mline, &size);
+    if (!m)
+        return oom();
+    manifest_write(&g->shards[u->ref].man, m);
+    if (fclose(m) != 0)
+        return free(mline), oom();
+    if (size && mline[size - 1] == '\n')
+        mline[size - 1] = '\0';
+    h5_head h = {"merge", mline, g->header, NULL, 0};
+    int code = cmd_h5_write_text(&h, out, emit_merged, g);
+    free(mline);
+    return code;
+}
+
 static int merge_shards(merge *g, const char *out)
 {
     int code = read_manifests(g);
@@ -956,6 +1012,8 @@ static int merge_shards(merge *g, const char *out)
         return problems(g);
     if ((code = open_all(g)) >= 0)
         return code;
+    if (output_is_h5_name(out))
+        return write_h5(g, out);
     mech_diag d;
     mech_diag_init(&d);
     int rc = write_file_whole(out, emit_merged, g, &d);
@@ -990,6 +1048,8 @@ int cmd_merge(int argc, char **argv)
     for (int i = 0; i < g.n; i++) {
         if (g.shards[i].f)
             fclose(g.shards[i].f);
+        if (g.shards[i].text)
+            fclose(g.shards[i].text);
         free(g.shards[i].partial);
     }
     for (int r = 0; r < g.nruns; r++) {

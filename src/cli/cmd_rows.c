@@ -600,6 +600,25 @@ static int emit_ordered(FILE *f, const void *ctx)
     return ferror(f) ? -1 : 0;
 }
 
+/* OUT.h5: the ordered CSV text as HDF5 (cmd_h5.c), the head's manifest
+ * line and header as attributes. The exit status. */
+static int write_h5(const ordered *o, const char *out)
+{
+    const rowfile *rf = o->rf;
+    size_t p = 0, next;
+    long n1 = line_at(rf->head, rf->head_len, p, &next);
+    char *mline = n1 >= 0 ? strndup(rf->head, (size_t)n1) : NULL;
+    long n2 = mline ? line_at(rf->head, rf->head_len, next, &p) : -1;
+    char *header = n2 >= 0 ? strndup(rf->head + next, (size_t)n2) : NULL;
+    int code = header ? -1 : oom(rf);
+    h5_head h = {rf->command, mline, header, rf->input, o->with_manifest};
+    if (code < 0)
+        code = cmd_h5_write_text(&h, out, emit_ordered, o);
+    free(mline);
+    free(header);
+    return code;
+}
+
 int rows_finish(rowfile *rf, const char *out, int with_manifest, int status_field, long *nok)
 {
     stop_timer(rf);
@@ -628,7 +647,9 @@ int rows_finish(rowfile *rf, const char *out, int with_manifest, int status_fiel
                 rf->command, o.found, rf->count, file_name(rf));
     else
         code = MECH_EXIT_OK;
-    if (code == MECH_EXIT_OK) {
+    if (code == MECH_EXIT_OK && out && output_is_h5_name(out)) {
+        code = write_h5(&o, out);
+    } else if (code == MECH_EXIT_OK) {
         mech_diag d;
         mech_diag_init(&d);
         int rc = write_file_whole(out ? out : "-", emit_ordered, &o, &d);

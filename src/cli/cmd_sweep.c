@@ -113,7 +113,10 @@ static const cmd_opt options[] = {
              "driver range, one full turn; needs --forces)\n"
              "(default: the number of rows solved)"},
     {.names = "-o", .kind = CMD_OPT_TEXT, .at = AT(out), .flags = CMD_RUN_ONLY,
-     .label = "-o FILE", .help = "write the summary CSV to FILE (default: standard output)"},
+     .label = "-o FILE",
+     .help = "write the summary CSV to FILE (default: standard output);\n"
+             "a FILE ending in .h5 or .hdf5: HDF5, the same columns and\n"
+             "the manifest as attributes (OUT.partial stays CSV)"},
     CMD_JOBS_ENTRY(AT(opt.nthreads)),
     {.names = "--shard", .kind = CMD_OPT_CALL, .at = AT(shard), .call = cmd_read_shard,
      .flags = CMD_RUN_ONLY, .label = "--shard K/M",
@@ -364,6 +367,7 @@ static int run_variants(sweep_args *a, int argc, char **argv)
     free(head);
     if (code >= 0)
         return code;
+    o.rows.input = a->file;
     o.done = o.rows.ndone;
     cmd_progress_init(&o.progress, "sweep", "variants", a->quiet);
     mech_sweep_sink sink = {put_row, row_done, &o};

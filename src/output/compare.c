@@ -5,10 +5,14 @@
  *   file    = { skipped } header { row | skipped }
  *   skipped = a blank line, or a comment: first non-blank character '#'
  *   header  = field { ',' field }       field = NAME [blanks] '[' UNIT ']'
- *   row     = number { ',' number }      as many fields as the header
+ *   row     = cell { ',' cell }          as many fields as the header
+ *   cell    = number, or in a column of unit '-' a word (mech sweep's status)
  *   number  = a finite decimal number: [sign] digits [. digits] [e [sign] digits]
  *             (digits before or after the point), as %.17g writes it; or
  *             nan, -nan, inf, -inf, spelled as printf writes them
+ *   word    = a letter, then letters, digits, '.', '_' or '-' (compared as text)
+ * A field may be quoted as RFC 4180 says ("a,b [-]", "" for a quote): mech
+ * sweep quotes a metric's name that holds a comma (transmission:a,b).
  * Fields may have blanks around them; lines end with \n or \r\n. There is no
  * limit on the length of a line or the number of columns (getline grows its
  * buffer). Both files are read whole, then compared column by column. */
@@ -133,9 +137,26 @@ static int push_field(csv_reader *r, char *start, size_t offset)
     return MECH_OK;
 }
 
+/* A quoted field at s ('"' first): unquoted in place ("" is one quote);
+ * *end is set after its text, and the position after the closing quote
+ * returned (the line's end when there is none). */
+static char *unquote(char *s, char **end)
+{
+    char *w = s;
+    for (s++; *s; s++) {
+        if (*s == '"' && s[1] != '"')
+            break;
+        s += *s == '"';  /* "" */
+        *w++ = *s;
+    }
+    *end = w;
+    return *s ? s + 1 : s;
+}
+
 /* Cut the current line in place at its commas into r->fields, each without
- * the blanks around it; r->cols[i] is the column of field i's first
- * non-blank character. Returns MECH_OK or MECH_ENOMEM. */
+ * the blanks around it (and a quoted field without its quotes); r->cols[i]
+ * is the column of field i's first non-blank character. Returns MECH_OK or
+ * MECH_ENOMEM. */
 static int split_fields(csv_reader *r)
 {
     r->nfields = 0;
@@ -143,10 +164,23 @@ static int split_fields(csv_reader *r)
     for (;;) {
         while (is_blank(*s))
             s++;
-        char *start = s;
+        char *start = s, *end;
+        if (*s == '"') {
+            s = unquote(s, &end);
+            while (*s && *s != ',')
+                s++;
+            int more = *s == ',';
+            *end = '\0';
+            if (push_field(r, start, (size_t)(start - r->line)) != MECH_OK)
+                return MECH_ENOMEM;
+            if (!more)
+                return MECH_OK;
+            s++;
+            continue;
+        }
         while (*s && *s != ',')
             s++;
-        char *end = s;
+        end = s;
         while (end > start && is_blank(end[-1]))
             end--;
         int more = *s == ',';
@@ -250,7 +284,63 @@ static int reserve_row(csv_reader *r, compare_table *t)
     if (!v)
         return MECH_ENOMEM;
     t->values = v;
+    if (t->word) {
+        int *w = xrealloc_array(t->word, cap * t->ncols, sizeof *w);
+        if (!w)
+            return MECH_ENOMEM;
+        t->word = w;
+    }
     r->rows_cap = cap;
+    return MECH_OK;
+}
+
+int compare_table_intern(compare_table *t, const char *w)
+{
+    for (size_t i = 0; i < t->nwords; i++)
+        if (strcmp(t->words[i], w) == 0)
+            return (int)i;
+    if (t->nwords >= INT_MAX)
+        return -1;
+    char **grown = xrealloc_array(t->words, t->nwords + 1, sizeof *grown);
+    if (!grown)
+        return -1;
+    t->words = grown;
+    if (!(t->words[t->nwords] = xstrdup(w)))
+        return -1;
+    return (int)t->nwords++;
+}
+
+const char *compare_cell_text(const compare_table *t, size_t row, size_t col)
+{
+    int w = t->word ? t->word[row * t->ncols + col] : -1;
+    return w >= 0 ? t->words[w] : NULL;
+}
+
+/* 1 when s is a word: a letter, then letters, digits, '.', '_' or '-'. */
+static int is_word(const char *s)
+{
+    if (!((*s >= 'a' && *s <= 'z') || (*s >= 'A' && *s <= 'Z')))
+        return 0;
+    return s[strspn(s, "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789._-")] ==
+           '\0';
+}
+
+/* Cell `cell` (0-based) of the table a text cell holding w: the word array
+ * made on the first (every cell -1 before). MECH_OK or MECH_ENOMEM. */
+static int put_word(csv_reader *r, compare_table *t, size_t cell, const char *w)
+{
+    if (!t->word) {
+        t->word = xrealloc_array(NULL, r->rows_cap * t->ncols, sizeof *t->word);
+        if (!t->word)
+            return MECH_ENOMEM;
+        for (size_t i = 0; i < r->rows_cap * t->ncols; i++)
+            t->word[i] = -1;
+    }
+    int k = compare_table_intern(t, w);
+    if (k < 0)
+        return MECH_ENOMEM;
+    t->word[cell] = k;
+    t->values[cell] = NAN;
     return MECH_OK;
 }
 
@@ -311,12 +401,20 @@ static int parse_row(csv_reader *r, compare_table *t)
         return MECH_ENOMEM;
     if (check_field_count(r, t) != 0)
         return MECH_EINPUT;
-    double *row = t->values + t->nrows * t->ncols;
+    size_t at = t->nrows * t->ncols;
+    double *row = t->values + at;
     for (size_t i = 0; i < t->ncols; i++) {
         if (r->fields[i][0] == '\0')
             return error_at(r, r->cols[i], "empty field in column '%s' (expected a number)",
                             t->names[i]);
         int ok = parse_cell(r->fields[i], &row[i]);
+        if (ok == 1 && t->word)
+            t->word[at + i] = -1;
+        if (ok == 0 && strcmp(t->units[i], "-") == 0 && is_word(r->fields[i])) {
+            if (put_word(r, t, at + i, r->fields[i]) != MECH_OK)
+                return MECH_ENOMEM;
+            continue;
+        }
         if (ok == 0)
             return error_at(r, r->cols[i], "'%.40s' in column '%s' is not a number",
                             r->fields[i], t->names[i]);
@@ -356,9 +454,13 @@ void compare_table_free(compare_table *t)
         if (t->units)
             free(t->units[i]);
     }
+    for (size_t i = 0; i < t->nwords; i++)
+        free(t->words[i]);
     free(t->names);
     free(t->units);
     free(t->values);
+    free(t->word);
+    free(t->words);
     memset(t, 0, sizeof *t);
 }
 
@@ -367,19 +469,26 @@ int compare_read_csv(const char *path, compare_table *t, mech_diag *d)
     if (output_file_is_h5(path))  /* mech's HDF5 output (output_h5.c) */
         return compare_read_h5(path, t, d);
     memset(t, 0, sizeof *t);
-    csv_reader r = {.path = path, .d = d};
-    r.f = fopen(path, "rb");
-    if (!r.f) {
+    FILE *f = fopen(path, "rb");
+    if (!f) {
         char ebuf[128];
         return diag_fail(d, MECH_FAIL_IO, path, (mech_mark){0, 0}, "cannot open: %s",
                          diag_strerror(errno, ebuf, sizeof ebuf));
     }
+    int rc = compare_read_csv_stream(f, path, t, d);
+    fclose(f);
+    return rc;
+}
+
+int compare_read_csv_stream(FILE *f, const char *path, compare_table *t, mech_diag *d)
+{
+    memset(t, 0, sizeof *t);
+    csv_reader r = {.path = path, .d = d, .f = f};
     int rc = read_header(&r, t);
     if (rc == MECH_OK)
         rc = read_rows(&r, t);
     if (rc == MECH_ENOMEM)
         diag_nomem(d, path, (mech_mark){0, 0});
-    fclose(r.f);
     free(r.line);
     free(r.fields);
     free(r.cols);
@@ -446,6 +555,15 @@ static void compare_column(col_result *c, const compare_table *out, const compar
     for (size_t row = 0; row < nrows; row++) {
         double x = out->values[row * out->ncols + (size_t)c->o];
         double y = golden->values[row * golden->ncols + c->g];
+        const char *tx = compare_cell_text(out, row, (size_t)c->o);
+        const char *ty = compare_cell_text(golden, row, c->g);
+        if (tx || ty) {  /* text: equal or not at all */
+            int same = tx && ty && strcmp(tx, ty) == 0;
+            add_error(c, 0.0, same ? 0.0 : INFINITY);
+            if (c->first_bad == NO_ROW && !same)
+                c->first_bad = row;
+            continue;
+        }
         add_error(c, x, y);
         if (c->first_bad == NO_ROW && !compare_values_match(x, y, o->rtol, o->atol))
             c->first_bad = row;
@@ -618,9 +736,13 @@ static void print_first(const cmp *c, FILE *f)
     if (best) {
         char x[32], y[32];
         size_t row = best->first_bad;
+        const char *tx = compare_cell_text(c->out, row, (size_t)best->o);
+        const char *ty = compare_cell_text(c->golden, row, best->g);
         fprintf(f, " (first: %s at row %zu: %s vs %s)", c->golden->names[best->g], row + 1,
-                shortest(c->out->values[row * c->out->ncols + (size_t)best->o], x, sizeof x),
-                shortest(c->golden->values[row * c->golden->ncols + best->g], y, sizeof y));
+                tx ? tx : shortest(c->out->values[row * c->out->ncols + (size_t)best->o], x,
+                                   sizeof x),
+                ty ? ty : shortest(c->golden->values[row * c->golden->ncols + best->g], y,
+                                   sizeof y));
         return;
     }
     for (size_t i = 0; i < c->ncols; i++) {

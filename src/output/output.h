@@ -109,18 +109,40 @@ typedef struct compare_table {
     char **names;    /* [ncols] column names (text before " ["), owned */
     char **units;    /* [ncols] units (text inside the brackets), owned */
     size_t ncols;
-    double *values;  /* [nrows * ncols] row-major, owned */
+    double *values;  /* [nrows * ncols] row-major, owned (NaN in a text cell) */
     size_t nrows;    /* data rows */
+    int *word;       /* [nrows * ncols] a text cell's word in words[], -1 for a number;
+                        NULL when no cell is text (owned) */
+    char **words;    /* [nwords] the distinct words of the text cells, owned */
+    size_t nwords;
 } compare_table;
 
 /* Read the CSV at `path` into *t (overwritten). Returns MECH_OK; or
  * MECH_EINPUT with every malformed line in d (FILE:LINE:COLUMN), MECH_EIO
  * (cannot open or read) or MECH_ENOMEM, and then *t is empty. */
 int compare_read_csv(const char *path, compare_table *t, mech_diag *d);
+/* The same from an open stream f (read from where it is), named `name` in
+ * messages; f is not closed. A cell that is a word ([A-Za-z][A-Za-z0-9._-]*,
+ * not nan or inf) in a column of unit '-' is a text cell (mech sweep's
+ * status): NaN in values, the word in word[]/words[]. */
+int compare_read_csv_stream(FILE *f, const char *name, compare_table *t, mech_diag *d);
+/* The index of word w in t->words, added when new; -1 out of memory. */
+int compare_table_intern(compare_table *t, const char *w);
+/* The text of cell (row, col), or NULL when it is a number. */
+const char *compare_cell_text(const compare_table *t, size_t row, size_t col);
 /* The same for mech's HDF5 output (output_h5.c); compare_read_csv calls it
  * for a file with HDF5's signature. */
 int compare_read_h5(const char *path, compare_table *t, mech_diag *d);
 void compare_table_free(compare_table *t);  /* accepts an empty table */
+/* output_h5.c: a table read back (or made from text, mech sweep's) as
+ * HDF5, as output_write_h5 writes a solver's; a column with a text cell
+ * is a dataset of strings (numbers in it as %.17g). */
+int output_write_h5_table(const compare_table *t, const char *path, const char *const *keys,
+                          const char *const *values, int nattrs, mech_diag *d);
+/* The root attributes names[0..n) of the HDF5 file at path, each a string
+ * (owned by the caller) or NULL when it has none (or not one string): 0,
+ * or -1 when the file cannot be opened. */
+int output_h5_attrs(const char *path, const char *const *names, char **values, int n);
 
 /* 1 when `out` passes against `golden`: both NaN; equal infinities; or both
  * finite with |out - golden| <= atol + rtol * |golden|. */

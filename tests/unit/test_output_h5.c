@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include "output.h"
+#include "cli.h"
 
 static char path[256];
 
@@ -128,4 +129,65 @@ Test(output_h5, an_hdf5_file_without_the_layout_is_an_error)
     cr_assert(strstr(text, "without mech's layout"), "%s", text);
     free(text);
     mech_diag_free(&d);
+}
+
+/* mech sweep --shard 1/2 -o OUT.h5, run in this process (cmd_sweep), read
+ * with the HDF5 library: the status a string dataset, the parameter and
+ * index float64, and the shard's manifest as root attributes (the manifest
+ * line and the digest line that mech merge reads back). */
+Test(output_h5, a_sweep_shard_as_hdf5_with_its_manifest)
+{
+    char out[300];
+    snprintf(out, sizeof out, "%s.h5", path);
+    char *argv[] = {"sweep", "mechanisms/conveyor.yaml", "--vary", "l1=50mm:64mm:5", "--metric",
+                    "range:E.x", "--shard", "1/2", "-q", "-j", "1", "-o", out, NULL};
+    cr_assert_eq(cmd_sweep(13, argv), 0);
+    hid_t f = H5Fopen(out, H5F_ACC_RDONLY, H5P_DEFAULT);
+    cr_assert(f >= 0);
+    static const char *const want[][2] = {
+        {"command", "sweep"}, {"input", "mechanisms/conveyor.yaml"}, {"shard", "1/2"},
+        {"total", "5"}, {"offset", "0"}, {"rows", "2"}, {"tol", "-"},
+        {"args", "--vary l1=50mm:64mm:5 --metric range:E.x"},
+        {"csv_header", "variant [-],l1 [m],status [-],rows [-],range:E.x [m]"}};
+    for (size_t i = 0; i < sizeof want / sizeof want[0]; i++) {
+        char *v = attr_string(f, want[i][0], 0);
+        cr_assert_str_eq(v, want[i][1], "attribute %s", want[i][0]);
+        free(v);
+    }
+    static const char *const present[] = {"mech_version", "input_digest", "grid", "manifest",
+                                          "digest"};
+    for (size_t i = 0; i < sizeof present / sizeof present[0]; i++) {
+        char *v = attr_string(f, present[i], 0);
+        cr_assert(strlen(v) > 0, "attribute %s", present[i]);
+        free(v);
+    }
+    char *m = attr_string(f, "manifest", 0), *dg = attr_string(f, "digest", 0);
+    cr_assert(strncmp(m, "# mech-manifest version=", 24) == 0, "%s", m);
+    cr_assert(strncmp(dg, "# mech-digest rows=2 fnv1a64=", 29) == 0, "%s", dg);
+    free(m);
+    free(dg);
+    char *c4 = attr_string(f, "columns", 4);
+    cr_assert_str_eq(c4, "range:E.x");
+    free(c4);
+    hid_t st = H5Dopen2(f, "status", H5P_DEFAULT);
+    cr_assert(st >= 0);
+    hid_t type = H5Dget_type(st);
+    cr_assert_eq(H5Tget_class(type), H5T_STRING);
+    H5Tclose(type);
+    char *unit = attr_string(st, "unit", 0);
+    cr_assert_str_eq(unit, "-");
+    free(unit);
+    H5Dclose(st);
+    hid_t ds = H5Dopen2(f, "variant", H5P_DEFAULT);
+    double idx[2];
+    cr_assert(H5Dread(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, idx) >= 0);
+    cr_assert(idx[0] == 1 && idx[1] == 3, "the shard's variants: %g %g", idx[0], idx[1]);
+    H5Dclose(ds);
+    hid_t l1 = H5Dopen2(f, "l1", H5P_DEFAULT);
+    double v[2];
+    cr_assert(H5Dread(l1, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v) >= 0);
+    cr_assert(v[0] == 0.0535 && v[1] == 0.0605, "l1: %.17g %.17g", v[0], v[1]);
+    H5Dclose(l1);
+    H5Fclose(f);
+    unlink(out);
 }
