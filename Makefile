@@ -366,6 +366,12 @@ golden: all
 	    echo "$(BUILD)/mech solve $$f -o tests/golden/$$n.csv"; \
 	    $(BUILD)/mech solve $$f -o tests/golden/$$n.csv || exit 1; \
 	done
+	@for f in mechanisms/cams/*.yaml; do \
+	    n=$$(basename $$f .yaml); \
+	    echo "$(BUILD)/mech solve $$f -o tests/golden/cams/$$n.csv; mech cam $$f -o tests/golden/cams/$$n.profile.csv"; \
+	    $(BUILD)/mech solve $$f -o tests/golden/cams/$$n.csv || exit 1; \
+	    $(BUILD)/mech cam $$f -o tests/golden/cams/$$n.profile.csv >/dev/null || exit 1; \
+	done
 	@for f in mechanisms/dynamics/*.yaml; do \
 	    n=$$(basename $$f .yaml); \
 	    echo "$(BUILD)/mech simulate $$f --rtol 1e-12 --atol 1e-14 -o tests/golden/dynamics/$$n.csv"; \

@@ -52,9 +52,10 @@ check "mech solve -o OUT.h5 (HDF5)" solve mechanisms/fourbar.yaml --forces -o "$
 check "mech compare an HDF5 file" compare "$tmp/run.h5" tests/golden/fourbar.csv --columns A.x
 check "mech solve, a rise-dwell-return program" solve tests/programs/follower.yaml -o "$tmp/prog.csv"
 check "mech solve, laws of exp, log, tanh" solve tests/programs/functions.yaml -o "$tmp/prog.csv"
-check "mech solve, a cam driving a four-bar" solve tests/cams/oscillating.yaml -o "$tmp/cam.csv"
-check "mech cam, the profile and outlines" cam tests/cams/translating.yaml -o "$tmp/p.csv" --svg "$tmp/p.svg" --dxf "$tmp/p.dxf"
-check "mech animate, a cam turning" animate tests/cams/translating.yaml -o "$tmp/cam.svg"
+check "mech solve, a cam driving a four-bar" solve mechanisms/cams/cam-fourbar.yaml -o "$tmp/cam.csv"
+check "mech cam, the profile and outlines" cam mechanisms/cams/translating-roller.yaml -o "$tmp/p.csv" --svg "$tmp/p.svg" --dxf "$tmp/p.dxf"
+check "mech solve --forces, a cam held by a spring" solve tests/cams/forces-fourbar.yaml -o "$tmp/camf.csv"
+check "mech animate, a cam turning" animate mechanisms/cams/translating-roller.yaml -o "$tmp/cam.svg"
 check "mech simulate (BDF)" simulate tests/dynamics/pendulum.yaml --to 1 --step 0.05 -o "$tmp/sim.csv"
 check "mech simulate (two free cranks, Adams)" simulate mechanisms/dynamics/five-bar-free.yaml --to 0.5 --method adams -o "$tmp/sim.csv"
 check "mech simulate --stop-at-rest" simulate tests/dynamics/pendulum.yaml --stop-at-rest -o "$tmp/sim.csv"

@@ -255,6 +255,12 @@ int codegen_init(codegen *g, const mech_model *m, const codegen_options *o, mech
     int rc = plan_solver(g, d);
     if (rc != MECH_OK)
         goto fail;
+    if (g->want_forces && model_ncams(m) > 0) {  /* the contact's geometry is the loader's */
+        rc = diag_error(d, m->file, m->cams->cam[0].mark, "codegen: forces through a cam pair "
+                        "('%s') are not generated (docs/cams.md, Limits): the interpreter "
+                        "computes them", m->cams->cam[0].name);
+        goto fail;
+    }
     if (g->want_forces && (rc = codegen_forces_plan(g, d)) != MECH_OK)
         goto fail;
     int friction = !g->want_forces || !g->fp.friction ? 0 : g->fp.want_frictionless ? 2 : 1;

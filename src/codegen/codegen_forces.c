@@ -287,7 +287,7 @@ static int emit_matrix(const codegen *g, FILE *f)
             fprintf(f, "    s->fv[%d] = 0.0;\n", i);
     free(filled);
     for (int c = 0; c < fp->ncols; c++)
-        fprintf(f, "    s->fcs[%d] = rt_scale_into(e, rt_fcol_entries(&fcols[%d], %s, F, s->cg, e), "
+        fprintf(f, "    s->fcs[%d] = rt_scale_into(e, rt_fcol_entries(&fcols[%d], %s, NULL, F, s->cg, e), "
                    "s->fv, fdst + %d);\n",
                 c, c, g->m->ngears > 0 ? "fgears" : "NULL", fp->Ap[c]);
     fprintf(f, "}\n\n");

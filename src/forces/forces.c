@@ -60,6 +60,13 @@ static rt_fcol describe_column(const forces_plan *fp, int c)
 {
     const mech_model *m = fp->m;
     rt_fcol d = {RT_COL_FORCE, {0, 0}, {0, {0.0, 0.0}}, RT_DIR_X, 0, 0.0, 0};
+    if (fp->kind[c] == FC_CAM) {  /* pushes the follower off the cam */
+        const mech_cam *cm = &m->cams->cam[fp->joint[c]];
+        d.kind = RT_COL_CAM;
+        d.gear = fp->joint[c];
+        d.on[0] = cm->follower, d.on[1] = cm->cam;
+        return d;
+    }
     if (fp->kind[c] == FC_GEAR) {  /* on link[1], its opposite on link[0] */
         const mech_gear *gr = &m->gears[fp->joint[c]];
         d.kind = RT_COL_GEAR;
@@ -233,6 +240,9 @@ static void make_columns(forces_plan *fp)
     fp->gcol = fp->ncols;
     for (int g = 0; g < m->ngears; g++)
         add_column(fp, FC_GEAR, g);
+    fp->ccol = fp->ncols;
+    for (int i = 0; i < model_ncams(m); i++)
+        add_column(fp, FC_CAM, i);
     fp->ndrive = m->ndrivers;
     for (int k = 0; k < fp->ndrive; k++)
         add_column(fp, FC_DRIVE, -1 - k);
@@ -287,12 +297,9 @@ int forces_plan_init(forces_plan *fp, const solver_plan *sp, int friction, mech_
     const mech_model *m = sp->m;
     memset(fp, 0, sizeof *fp);
     fp->m = m;
-    if (model_ncams(m) > 0)  /* the contact force along the common normal: issue 30, point 4 */
-        return diag_error(d, m->file, m->cams->cam[0].mark, "cam '%s': forces through a cam "
-                          "pair are not computed yet (docs/cams.md, Limits); solve the "
-                          "kinematics without --forces", m->cams->cam[0].name);
     fp->nrows = 3 * (m->nlinks - 1);
-    size_t nc = 2 * (size_t)m->njoints + (size_t)m->ngears + 1 + (size_t)m->ndrivers;
+    size_t nc = 2 * (size_t)m->njoints + (size_t)m->ngears + (size_t)model_ncams(m) + 1 +
+                (size_t)m->ndrivers;
     fp->kind = xcalloc(nc, sizeof *fp->kind);
     fp->joint = xcalloc(nc, sizeof *fp->joint);
     fp->jcol = xcalloc((size_t)m->njoints + 1, sizeof *fp->jcol);
@@ -349,10 +356,11 @@ int forces_init(forces *fc, const forces_plan *fp)
     size_t nl2 = 2 * (size_t)fp->m->nlinks, depth = RT_ANDERSON_DEPTH;
     double **arrays[] = {&fc->Ax, &fc->cscale, &fc->b, &fc->y, &fc->y0, &fc->ynext,
                          &fc->aa_g, &fc->aa_r, &fc->aa_dg, &fc->aa_dr, &fc->fric,
-                         &fc->g, &fc->vg, &fc->ag, &fc->spr};
+                         &fc->g, &fc->vg, &fc->ag, &fc->spr, &fc->cam};
     size_t sizes[] = {(size_t)fp->nnz + 1, nc, nr + nc, nr + nc, nr + nc, nr + nc,
                       nr, nr, depth * nr, depth * nr, nr, nl2, nl2, nl2,
-                      RT_SPRING_STATE * (size_t)fp->num.nsprings + 1};
+                      RT_SPRING_STATE * (size_t)fp->num.nsprings + 1,
+                      4 * (size_t)model_ncams(fp->m) + 1};
     if (xcalloc_doubles(arrays, sizes, 0, COUNT_OF(arrays)) < 0)
         return -1;
     if (fp->m->state_loads && !(fc->sl_reg = state_loads_registers(fp->m->state_loads)))
@@ -364,7 +372,8 @@ void forces_free(forces *fc)
 {
     linsys_free(&fc->ls);
     void *blocks[] = {fc->Ax, fc->b, fc->y, fc->y0, fc->ynext, fc->fric, fc->cscale,
-                      fc->g, fc->vg, fc->ag, fc->aa_g, fc->aa_r, fc->aa_dg, fc->aa_dr, fc->spr};
+                      fc->g, fc->vg, fc->ag, fc->aa_g, fc->aa_r, fc->aa_dg, fc->aa_dr, fc->spr,
+                      fc->cam};
     free_all(blocks, COUNT_OF(blocks));
     free(fc->sl_reg);
     memset(fc, 0, sizeof *fc);
@@ -389,14 +398,35 @@ static void known_loads(const forces *fc, const solver *sv, double *rhs)
         rt_load_apply(&fn->loads[i], F, fc->g, fc->sl_reg, rhs);
 }
 
+/* Each cam's contact at this position (docs/cams.md 6): the profile's
+ * point and outward normal where the follower touches it (cam_geometry at
+ * the cam's angle on its arm), turned into the ground frame by the cam's. */
+static void cam_contacts(forces *fc, const solver *sv)
+{
+    const mech_model *m = fc->p->m;
+    const rt_frame *F = sv->ks.F;
+    for (int i = 0; i < model_ncams(m); i++) {
+        const mech_cam *cm = &m->cams->cam[i];
+        double x = cm->sense * (F[cm->cam].th - F[cm->arm].th - cm->start);
+        cam_point g;
+        cam_geometry(m, cm, x, &g);
+        rt_point at = {cm->cam, {g.profile[0], g.profile[1]}};
+        double c = cos(F[cm->cam].th), s = sin(F[cm->cam].th), *k = fc->cam + 4 * i;
+        rt_point_motion(F, &at, k, NULL, NULL);
+        k[2] = c * g.normal[0] - s * g.normal[1];
+        k[3] = s * g.normal[0] + c * g.normal[1];
+    }
+}
+
 /* Assemble the force matrix at the position (each column scaled to unit
  * largest entry) and factor it; -1 when singular. */
 static int factor(forces *fc, const solver *sv)
 {
     const forces_plan *fp = fc->p;
     double e[MAX_ENTRIES];
+    cam_contacts(fc, sv);
     for (int c = 0; c < fp->ncols; c++) {
-        int n = rt_fcol_entries(&fp->num.cols[c], fp->num.gears, sv->ks.F, fc->g, e);
+        int n = rt_fcol_entries(&fp->num.cols[c], fp->num.gears, fc->cam, sv->ks.F, fc->g, e);
         fc->cscale[c] = rt_scale_into(e, n, fc->Ax, fp->slot + fp->Ap[c]);
     }
     if (linsys_factor(&fc->ls, fc->Ax) < 0) {
@@ -481,6 +511,11 @@ static double ctx_power(void *c, double pd, double pfric)
         rt_power_spring(&pw, &fn->springs[i], fc->spr + RT_SPRING_STATE * i);
     for (int i = fn->nconst; i < fn->nloads; i++)
         rt_power_load(&pw, &fn->loads[i], F, fc->sl_reg);
+    /* a cam's contact force, like a load, scales by its size times the speed:
+       on a dwell every power vanishes while the driver's torque carries the
+       rounding of forces of that size (the frictionless solve's, y0) */
+    for (int i = 0; i < model_ncams(fc->p->m); i++)
+        pw.scale += fabs(fc->y0[fc->p->ccol + i]) * fn->linear;
     return rt_power_end(&pw, pd, pfric);
 }
 
@@ -586,6 +621,11 @@ double forces_gear(const forces *fc, int i, int with_friction)
 {
     const forces_plan *fp = fc->p;
     return rt_tooth_force(&fp->num.gears[i], (with_friction ? fc->y : fc->y0)[fp->gcol + i]);
+}
+
+double forces_cam(const forces *fc, int i, int with_friction)
+{
+    return (with_friction ? fc->y : fc->y0)[fc->p->ccol + i];
 }
 
 double forces_drive_of(const forces *fc, int with_friction, int k)

@@ -39,7 +39,7 @@ void springs_describe(const mech_model *m, int i, char *buf, size_t size);
 void state_loads_eval(const state_loads *s, const solver *sv, double *reg);
 
 /* What one column of the force system is. */
-typedef enum { FC_FX, FC_FY, FC_NORMAL, FC_MOMENT, FC_DRIVE, FC_GEAR } fc_kind;
+typedef enum { FC_FX, FC_FY, FC_NORMAL, FC_MOMENT, FC_DRIVE, FC_GEAR, FC_CAM } fc_kind;
 
 /* The numbers of the force system: what enters each row and column,
  * described once as the tables of rt_forces.h, which forces.c and the
@@ -78,6 +78,8 @@ typedef struct forces_plan {
                                -1 - k: driver k of `drivers:`; FC_GEAR: the gear pair) */
     int gcol;               /* first tooth-force column (one per gear pair, before the
                                drivers', which stay last) */
+    int ccol;               /* first cam contact-force column (one per cam, after the
+                               gears') */
     int ndrive;             /* driver columns, the last ones: 1, or the `drivers:` */
     int *jcol;              /* [njoints] first column of each joint */
     int *Ap, *Ai;           /* [ncols+1], [nnz] */
@@ -101,6 +103,8 @@ typedef struct forces {
     double *cscale;         /* [ncols] column equilibration */
     double *spr;            /* [RT_SPRING_STATE nsprings] the springs at this step */
     double *sl_reg;         /* registers of the loads that depend on the motion, or NULL */
+    double *cam;            /* [4 ncams] each cam's contact point and outward unit normal
+                               at this step, ground frame (rt_fcol_entries' table) */
     linsys ls;              /* factors of the force system */
     rt_forces_out out;      /* per step results (rt_forces.h): friction iterations, the
                                power balance with and without friction (residual0 0 when
@@ -142,6 +146,8 @@ void forces_joint(const forces *fc, const solver *sv, int j, int with_friction, 
 /* Tooth force of gear pair i along its line of action (gears.h), N: the
  * sign of its tangential part F (on link[1], along t). */
 double forces_gear(const forces *fc, int i, int with_friction);
+/* Cam i's contact force along the common normal (+: pressing), N. */
+double forces_cam(const forces *fc, int i, int with_friction);
 /* The load of driver k: 0 for `driver:`, 0 .. ndrive-1 for `drivers:`. */
 double forces_drive_of(const forces *fc, int with_friction, int k);
 /* After forces_solve returned -1: the names of the joints involved. */

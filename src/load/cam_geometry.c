@@ -68,10 +68,70 @@ static void trace_point(const mech_model *m, const mech_cam *c, const double s[3
     }
 }
 
+/* An oscillating flat face (section 3 of docs/cams.md): the face's line
+ * p . nu = d in the arm's frame from O, nu = R(psi) J w, d = (P - O) . nu
+ * + k; seen from the cam, a line whose normal turns at phi' = rise s' -
+ * sense, so the contact (its envelope) is h n + (h' / phi') J n with h =
+ * |d| and n = sign(d) nu, and the profile's radius h + (h'' phi' - h'
+ * phi'') / phi'^3. */
+static void oscillating_face(const mech_model *m, const mech_cam *c, const double s[3],
+                             double x, cam_point *g)
+{
+    const mech_link *fl = &m->links[c->follower];
+    const mech_point *pf = &fl->points[c->follower_pivot[0]];
+    const mech_point *pa = &m->links[c->arm].points[c->follower_pivot[1]];
+    const mech_point *o = &m->links[c->arm].points[c->cam_pivot[1]];
+    const mech_point *a = &fl->points[c->face[0]], *b = &fl->points[c->face[1]];
+    double wl = hypot(b->x - a->x, b->y - a->y), w0[2] = {(b->x - a->x) / wl, (b->y - a->y) / wl};
+    double jw0[2], w[2], nu[2], jnu[2], dv[2] = {pa->x - o->x, pa->y - o->y};
+    perp(w0, jw0);
+    double k = (a->x - pf->x) * jw0[0] + (a->y - pf->y) * jw0[1];
+    double r = c->rise, psi = c->c0 + r * s[0], p1 = r * s[1], p2 = r * s[2];
+    rotate(psi, w0, w);
+    perp(w, nu);
+    perp(nu, jnu);  /* = -w */
+    double d = dv[0] * nu[0] + dv[1] * nu[1] + k;
+    double dw = dv[0] * w[0] + dv[1] * w[1];        /* (P - O) . w */
+    double sg = d < 0.0 ? -1.0 : 1.0, h = sg * d;
+    double h1 = sg * -dw * p1;                      /* dd/dpsi = -(P - O) . w */
+    double h2 = sg * (-d + k) * p1 * p1 - sg * dw * p2;  /* d2: -(P - O) . nu psi'^2 - ... */
+    double f1 = p1 - c->sense, f2 = p2;             /* the normal's turning rate in the cam */
+    double n[2] = {sg * nu[0], sg * nu[1]}, jn[2];
+    perp(n, jn);
+    double contact[2], th = c->start + c->sense * x;
+    for (int i = 0; i < 2; i++)
+        contact[i] = h * n[i] + h1 / f1 * jn[i];
+    g->rho_pitch = NAN;
+    g->rho_profile = h + (h2 * f1 - h1 * f2) / (f1 * f1 * f1);
+    /* the contact along the face from A (where the follower's point A is) */
+    double ax = pa->x - o->x, ay = pa->y - o->y, av[2] = {a->x - pf->x, a->y - pf->y}, ar[2];
+    rotate(psi, av, ar);
+    g->face = (contact[0] - ax - ar[0]) * w[0] + (contact[1] - ay - ar[1]) * w[1];
+    /* the pressure angle: from the motion of the follower's point at the
+       contact (about the pivot, as the lift grows) to the normal */
+    double rel[2] = {contact[0] - ax, contact[1] - ay}, mv[2];
+    perp(rel, mv);
+    double ml = hypot(mv[0], mv[1]);
+    mv[0] *= r / ml, mv[1] *= r / ml;
+    g->pressure = atan2(cross(mv, n), mv[0] * n[0] + mv[1] * n[1]);
+    double foot[2] = {d * nu[0], d * nu[1]}, pitch[2];
+    rotate(-th, foot, pitch);
+    rotate(-th, contact, g->profile);
+    rotate(-th, n, g->normal);
+    (void)jnu;
+    const mech_point *oc = &m->links[c->cam].points[c->cam_pivot[0]];
+    g->pitch[0] = oc->x + pitch[0], g->pitch[1] = oc->y + pitch[1];
+    g->profile[0] += oc->x, g->profile[1] += oc->y;
+}
+
 void cam_geometry(const mech_model *m, const mech_cam *c, double x, cam_point *g)
 {
     double s[4], q[3][2], mv[2], jq[2], jq1[2], w[2], w1[2], jw[2], w2[2], n[2];
     program_eval(c->program->progs[0], x, s);
+    g->x = x;
+    g->s[0] = s[0], g->s[1] = s[1], g->s[2] = s[2];
+    if (c->motion == CAM_OSCILLATING && c->contact == CAM_FLAT_FACED)
+        return oscillating_face(m, c, s, x, g);
     trace_point(m, c, s, q, mv);
     double sg = c->sense;
     perp(q[0], jq);
@@ -88,7 +148,7 @@ void cam_geometry(const mech_model *m, const mech_cam *c, double x, cam_point *g
         n[i] = sg * jw[i] / len;  /* the outward normal, in the arm's frame */
     double th = c->start + sg * x;
     const mech_point *oc = &m->links[c->cam].points[c->cam_pivot[0]];
-    double pitch[2], contact[2];
+    double pitch[2], contact[2], normal[2] = {n[0], n[1]};
     g->x = x;
     g->s[0] = s[0], g->s[1] = s[1], g->s[2] = s[2];
     g->rho_pitch = -sg * len * len * len / cross(w, w2);
@@ -100,6 +160,7 @@ void cam_geometry(const mech_model *m, const mech_cam *c, double x, cam_point *g
         for (int i = 0; i < 2; i++)
             contact[i] = along * u[i] + side * un[i];
         g->face = side - c->offset;
+        normal[0] = u[0], normal[1] = u[1];
         g->pressure = 0.0;
         g->rho_profile = c->base + s[0] + s[2];
     } else {
@@ -110,6 +171,7 @@ void cam_geometry(const mech_model *m, const mech_cam *c, double x, cam_point *g
     }
     rotate(-th, q[0], pitch);
     rotate(-th, contact, g->profile);
+    rotate(-th, normal, g->normal);
     g->pitch[0] = oc->x + pitch[0], g->pitch[1] = oc->y + pitch[1];
     g->profile[0] += oc->x, g->profile[1] += oc->y;
 }

@@ -771,6 +771,7 @@ typedef struct mech_cam {
     int follower_pivot[2]; /* oscillating: the follower's pivot in it and in the arm */
     int at;              /* oscillating roller or knife-edge: the follower's point at the
                             roller's centre or the knife's tip; else -1 */
+    int face[2];         /* oscillating flat-faced: two points of the follower on its face */
     cam_motion motion;
     cam_contact contact;
     int sense;           /* +1: x grows as the cam turns counterclockwise on the arm */
@@ -805,6 +806,8 @@ typedef struct cam_point {
     double pitch[2];     /* the trace point (roller's centre, knife's tip, flat face's foot
                             on its line) in the cam's own frame, m */
     double profile[2];   /* the contact point on the profile, in the cam's frame, m */
+    double normal[2];    /* the common normal there, from the cam to the follower (unit,
+                            in the cam's frame) */
     double pressure;     /* the angle from the trace point's motion to the common
                             normal, rad (0 for a flat face) */
     double rho_pitch;    /* the pitch curve's radius of curvature, m: + convex */

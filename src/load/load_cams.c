@@ -154,6 +154,36 @@ static int find_arm(loader *ld, const ynode *fn, mech_cam *c)
                     m->links[c->follower].name, m->links[c->cam].name), 0;
 }
 
+/* An oscillating flat face: 'face: [A, B]', two points of the follower. */
+static int load_face(loader *ld, const ynode *map, mech_cam *c)
+{
+    const ynode *fc = ymap_get(map, "face");
+    if (load_key_of(map, "at"))
+        return load_err(ld, load_key_of(map, "at"), "a flat-faced follower touches along its "
+                        "face: give 'face: [A, B]', not 'at'"), 0;
+    if (!fc)
+        return load_err(ld, map, "an oscillating flat-faced follower needs 'face: [A, B]': two "
+                        "points of the follower on its face"), 0;
+    if (!load_want_kind(ld, fc, YNODE_SEQ, "'face'"))
+        return 0;
+    if (fc->n != 2)
+        return load_err(ld, fc, "'face' needs two points of the follower, [A, B]"), 0;
+    for (int k = 0; k < 2; k++) {
+        int id = load_find_point_or_report(ld, fc->items[k], "'face'");
+        if (id < 0)
+            return 0;
+        c->face[k] = load_point_in_link(ld, c->follower, id);
+        if (c->face[k] < 0)
+            return load_err(ld, fc->items[k], "point '%s' is not on the follower '%s'",
+                            fc->items[k]->text, ld->m->links[c->follower].name), 0;
+    }
+    const mech_link *f = &ld->m->links[c->follower];
+    const mech_point *a = &f->points[c->face[0]], *b = &f->points[c->face[1]];
+    if (a->x == b->x && a->y == b->y)
+        return load_err(ld, fc, "the face's two points are at one place"), 0;
+    return 1;
+}
+
 static int load_oscillating(loader *ld, const ynode *map, const ynode *fn, mech_cam *c)
 {
     const ynode *at = ymap_get(map, "at");
@@ -161,9 +191,7 @@ static int load_oscillating(loader *ld, const ynode *map, const ynode *fn, mech_
     if (!find_arm(ld, fn, c))
         return 0;
     if (c->contact == CAM_FLAT_FACED)
-        return load_err(ld, load_key_of(map, "contact"), "an oscillating flat-faced follower is "
-                        "not supported yet (docs/cams.md, Limits): use a roller or a "
-                        "knife-edge"), 0;
+        return load_face(ld, map, c);
     if (!at)
         return load_err(ld, map, "an oscillating follower needs 'at': its point at the "
                         "roller's centre (or the knife's tip)"), 0;
@@ -175,6 +203,19 @@ static int load_oscillating(loader *ld, const ynode *map, const ynode *fn, mech_
         return load_err(ld, at, "point '%s' is not on the follower '%s'", at->text,
                         ld->m->links[c->follower].name), 0;
     return 1;
+}
+
+/* The follower's guess less the arm's (0 when none is given). */
+static double guess_on_arm(const mech_model *m, const mech_cam *c)
+{
+    double guess = 0.0;
+    for (int g = 0; g < m->nguesses; g++)
+        if (!m->guesses[g].is_slider && m->guesses[g].index == c->follower)
+            guess += m->guesses[g].value;
+    for (int g = 0; g < m->nguesses; g++)
+        if (!m->guesses[g].is_slider && m->guesses[g].index == c->arm)
+            guess -= m->guesses[g].value;
+    return guess;
 }
 
 /* The oscillating follower's angle on the arm where the roller's centre
@@ -201,13 +242,7 @@ static void place_oscillating(loader *ld, mech_cam *c)
                                 "centre) cannot reach the base circle%s (%.6g mm)", c->name,
                                 r->name, mm(len), mm(d), c->roller > 0 ? " plus the roller" :
                                 "", mm(reach));
-    double guess = 0.0;
-    for (int g = 0; g < m->nguesses; g++)
-        if (!m->guesses[g].is_slider && m->guesses[g].index == c->follower)
-            guess += m->guesses[g].value;
-    for (int g = 0; g < m->nguesses; g++)
-        if (!m->guesses[g].is_slider && m->guesses[g].index == c->arm)
-            guess -= m->guesses[g].value;
+    double guess = guess_on_arm(m, c);
     double base = atan2(wy, wx) - atan2(vy, vx), a = acos(cs), best = 0.0, bestd = INFINITY;
     for (int k = 0; k < 2; k++) {
         double psi = base + (k ? -a : a);
@@ -221,12 +256,50 @@ static void place_oscillating(loader *ld, mech_cam *c)
     c->c0 = best;
 }
 
+/* An oscillating flat face: the follower's angle psi on the arm where the
+ * face's line is the base radius from the cam's centre, d(psi) = (P - O)
+ * . R(psi) J w + k = +-base (w the face's direction in the follower, k =
+ * (A - P_f) . J w): of the solutions, the one nearest the guess; the lift
+ * moves the face away from the centre. */
+static void place_face(loader *ld, mech_cam *c)
+{
+    const mech_model *m = ld->m;
+    const mech_link *fl = &m->links[c->follower];
+    const mech_point *pf = &fl->points[c->follower_pivot[0]];
+    const mech_point *pa = &m->links[c->arm].points[c->follower_pivot[1]];
+    const mech_point *o = &m->links[c->arm].points[c->cam_pivot[1]];
+    const mech_point *a = &fl->points[c->face[0]], *b = &fl->points[c->face[1]];
+    double wl = hypot(b->x - a->x, b->y - a->y), wx = (b->x - a->x) / wl, wy = (b->y - a->y) / wl;
+    double k = (a->x - pf->x) * -wy + (a->y - pf->y) * wx;
+    double dx = pa->x - o->x, dy = pa->y - o->y, dl = hypot(dx, dy);
+    double om = atan2(wx, -wy), ga = atan2(dy, dx), guess = guess_on_arm(m, c), best = NAN;
+    for (int side = -1; side <= 1; side += 2) {
+        double cs = (side * c->base - k) / dl;
+        if (!(dl > 0.0 && fabs(cs) < 1.0))
+            continue;
+        for (int sg = -1; sg <= 1; sg += 2) {
+            double psi = ga - om + sg * acos(cs);
+            psi -= 2.0 * PI * floor((psi - guess + PI) / (2.0 * PI));
+            if (isnan(best) || fabs(psi - guess) < fabs(best - guess)) {
+                best = psi;
+                /* d|d|/dpsi = side * -dl sin(psi + om - ga) = side * -dl * sg sin(acos) */
+                c->rise = -side * sg > 0 ? 1 : -1;
+            }
+        }
+    }
+    if (isnan(best))
+        return (void)diag_error(ld->d, ld->file, c->mark, "cam '%s': the follower's face cannot "
+                                "touch the base circle (%.6g mm) at any angle", c->name,
+                                mm(c->base));
+    c->c0 = best;
+}
+
 /* 'follower': a slider (translating) or a link (oscillating). */
 static int load_follower(loader *ld, const ynode *map, mech_cam *c)
 {
     const mech_model *m = ld->m;
     const ynode *fn = ymap_get(map, "follower");
-    c->slider = c->at = -1;
+    c->slider = c->at = c->face[0] = c->face[1] = -1;
     if (!fn)
         return load_err(ld, map, "a cam needs 'follower': a slider (a translating follower) or "
                         "a link (an oscillating one)"), 0;
@@ -299,7 +372,8 @@ static int name_cam(loader *ld, const ynode *map, mech_cam *c, name_map *names)
 void load_cams(loader *ld, const ynode *seq)
 {
     static const char *const keys[] = {"name", "cam", "follower", "contact", "base_radius",
-                                       "roller_radius", "at", "turning", "start", "program"};
+                                       "roller_radius", "at", "face", "turning", "start",
+                                       "program"};
     if (!load_want_kind(ld, seq, YNODE_SEQ, "'cams'"))
         return;
     if (seq->n > MAX_CAMS)
@@ -381,7 +455,7 @@ void load_cams_place(loader *ld)
         mech_cam *c = &cs->cam[i];
         size_t before = ld->d->nerrors;
         if (c->motion == CAM_OSCILLATING && c->program)
-            place_oscillating(ld, c);
+            (c->contact == CAM_FLAT_FACED ? place_face : place_oscillating)(ld, c);
         if (c->program && ld->d->nerrors == before)
             scan_design(ld, c);
     }

@@ -181,7 +181,10 @@ RT_INLINE void rt_slider_reaction(const rt_frame *G, double angle, double n, dou
 enum {
     RT_COL_FORCE,   /* a force along a direction at a point of a joint */
     RT_COL_MOMENT,  /* a couple (a locked slider's, a turning driver's) */
-    RT_COL_GEAR     /* the tooth force of a gear pair, along its tangent */
+    RT_COL_GEAR,    /* the tooth force of a gear pair, along its tangent */
+    RT_COL_CAM      /* a cam's contact force along the common normal, at the contact:
+                       the caller's table of each cam's contact point and unit normal
+                       at this position (x, y, nx, ny in the ground frame) */
 };
 enum { RT_DIR_X, RT_DIR_Y, RT_DIR_NORMAL, RT_DIR_ALONG };  /* a force column's direction */
 
@@ -192,7 +195,8 @@ typedef struct rt_fcol {
     int dir;           /* FORCE: x, y, or across or along the guide */
     int guide;         /* NORMAL, ALONG: the guide's link and angle */
     double angle;
-    int gear;          /* GEAR: its pair in the rt_gear table */
+    int gear;          /* GEAR: its pair in the rt_gear table; CAM: its pair in the
+                          contacts' table */
 } rt_fcol;
 
 /* The rows of column c's entries, in the order rt_fcol_entries makes
@@ -217,8 +221,8 @@ static inline int rt_fcol_rows(const rt_fcol *c, int *rows)
 /* The entries e[] of column c at the frames F, centres g: a unit force
  * (its x and y and its moment about the centre) or couple on on[0], and
  * its opposite on on[1]; how many. */
-RT_INLINE int rt_fcol_entries(const rt_fcol *c, const rt_gear *gears, const rt_frame *F,
-                              const double *g, double *e)
+RT_INLINE int rt_fcol_entries(const rt_fcol *c, const rt_gear *gears, const double *cams,
+                              const rt_frame *F, const double *g, double *e)
 {
     int n = 0;
     double p[2], d[2];
@@ -231,6 +235,9 @@ RT_INLINE int rt_fcol_entries(const rt_fcol *c, const rt_gear *gears, const rt_f
     if (c->kind == RT_COL_GEAR) {
         double r[2];
         rt_gear_contact(&gears[c->gear], F, p, d, r);
+    } else if (c->kind == RT_COL_CAM) {
+        const double *k = cams + 4 * c->gear;
+        p[0] = k[0], p[1] = k[1], d[0] = k[2], d[1] = k[3];
     } else {
         rt_point_motion(F, &c->at, p, NULL, NULL);
         double u[2] = {1.0, 0.0};

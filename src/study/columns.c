@@ -183,6 +183,8 @@ static int dynamic_columns(column_layout *cl, const mech_model *m, const column_
     rc |= spring_columns(cl, m);
     for (int i = 0; i < m->ngears; i++)  /* each mesh's tooth force (docs/forces.md) */
         rc |= add(cl, SRC_GEAR, i, 0, m->gears[i].name, ".W", "N");
+    for (int i = 0; i < model_ncams(m); i++)  /* each cam's contact force (docs/cams.md 6) */
+        rc |= add(cl, SRC_CAM, i, 0, m->cams->cam[i].name, ".F", "N");
     for (int j = 0; j < m->njoints; j++)
         free(label[j]);
     free(label);
@@ -319,6 +321,7 @@ static void source_values(const column_group *g, const row_sources *rs, double *
     case SRC_SUBSTEPS: v[0] = rs->substeps; break;
     case SRC_SPRING: spring_values(g->obj, sv, v); break;
     case SRC_GEAR: v[0] = forces_gear(rs->fc, g->obj, 1); break;
+    case SRC_CAM: v[0] = forces_cam(rs->fc, g->obj, 1); break;
     }
 }
 

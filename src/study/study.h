@@ -38,7 +38,8 @@ typedef enum {
     SRC_RCOND,
     SRC_SUBSTEPS,
     SRC_SPRING,          /* obj: spring; comp 0..2: length (angle), rate, force (torque) */
-    SRC_GEAR             /* obj: gear pair; the tooth force along the line of action */
+    SRC_GEAR,            /* obj: gear pair; the tooth force along the line of action */
+    SRC_CAM              /* obj: cam pair; the contact force along the common normal */
 } column_source;
 
 typedef struct column_desc {

@@ -268,6 +268,7 @@ typedef struct run {
     mech_solve_stats *st;
     mech_table *t;             /* rows are appended here */
     int refined_notes;         /* refinements reported so far */
+    int lift_off;              /* a cam's lift-off reported (the first only) */
     assembly_samples smp;      /* positions kept for the assembly's checks (assembly.c) */
 } run;
 
@@ -304,11 +305,31 @@ static int forces_failed(run *r, double q, int rc)
                      diagnose_q_text(m, q, qb, sizeof qb), 100);
 }
 
+/* A cam's contact cannot pull (docs/cams.md 6): the first row where one
+ * would is a warning naming the cam and the driver's position. */
+static void check_lift_off(run *r, double q)
+{
+    const mech_model *m = r->a->m;
+    for (int i = 0; i < model_ncams(m) && !r->lift_off; i++) {
+        double f = forces_cam(&r->fc, i, 1);
+        if (f >= 0.0)
+            continue;
+        char qb[64];
+        r->lift_off = 1;
+        diag_warning(r->d, m->file, m->cams->cam[i].mark, "cam '%s': the follower lifts off "
+                     "at %s = %s: the contact would have to pull (%.6g N); a follower spring "
+                     "with more preload or stiffness, or a lower speed, keeps it on the cam "
+                     "(the rows there are not a motion that can happen)", m->cams->cam[i].name,
+                     diagnose_driver_word(m), diagnose_q_text(m, q, qb, sizeof qb), f);
+    }
+}
+
 static int solve_forces(run *r, double q)
 {
     int rc = forces_solve(&r->fc, &r->c.sv);
     if (rc < 0)
         return forces_failed(r, q, rc);
+    check_lift_off(r, q);
     double worst = fmax(fabs(r->fc.out.residual), fabs(r->fc.out.residual0));
     if (worst > r->st->worst_power_residual)
         r->st->worst_power_residual = worst;

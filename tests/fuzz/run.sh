@@ -55,7 +55,7 @@ fi
 
 # Seed corpus: the examples, the malformed corpus, the solver cases, the
 # drawn-form files and every input that once crashed.
-for f in mechanisms/*.yaml tests/bad/*.yaml tests/solve/*.yaml tests/drawn/*.yaml tests/dynamics/*.yaml mechanisms/dynamics/*.yaml tests/programs/*.yaml tests/cams/*.yaml tests/fit/*.yaml $regressions; do
+for f in mechanisms/*.yaml tests/bad/*.yaml tests/solve/*.yaml tests/drawn/*.yaml tests/dynamics/*.yaml mechanisms/dynamics/*.yaml tests/programs/*.yaml tests/cams/*.yaml mechanisms/cams/*.yaml tests/fit/*.yaml $regressions; do
     [ -f "$f" ] && cp "$f" "$out/corpus/seed-$(basename "$f")"
 done
 # -fork=N runs N fuzzing processes; the first crash still stops the run.

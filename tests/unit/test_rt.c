@@ -267,7 +267,7 @@ Test(rt, crank_standing_in_gravity)
         rt_centre(&body[l], &F[l], cg + 2 * l, vg + 2 * l, ag + 2 * l);
     cr_assert(fabs(cg[2] - L / 2 * cos(q)) <= 1e-16 && fabs(cg[3] - L / 2 * sin(q)) <= 1e-16);
     for (int c = 0; c < 3; c++) {
-        int n = rt_fcol_entries(&col[c], NULL, F, cg, e);
+        int n = rt_fcol_entries(&col[c], NULL, NULL, F, cg, e);
         cr_assert_eq(rt_fcol_rows(&col[c], rows), n);
         for (int k = 0; k < n; k++)
             a[rows[k] + 3 * c] = e[k];
