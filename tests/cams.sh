@@ -301,6 +301,21 @@ run "forces: jit falls back" 0 "$MECH" solve "$F" --jit -o "$tmp/foj.csv" &&
     has_line "$tmp/err" "forces through a cam pair ('disc') are not generated" "forces: jit's note" &&
     { cmp -s "$tmp/fo.csv" "$tmp/foj.csv" && pass || fail "forces: the fallback's rows differ"; }
 
+# 4d. mech plot and mech report draw each cam's lift, its three derivatives
+# against the cam's angle and its profile with the pitch curve
+if run "plot a cam" 0 "$MECH" plot "$D/translating-roller.yaml" --out "$tmp/figs"; then
+    for k in lift velocity acceleration jerk profile; do
+        has_line "$tmp/out" "^$tmp/figs/translating-roller-cam-disc-$k.svg\$" "plot a cam: $k said"
+        python3 -c "import sys, xml.dom.minidom as X; X.parse(sys.argv[1])" "$tmp/figs/translating-roller-cam-disc-$k.svg" &&
+            pass || fail "plot a cam: $k is not well-formed"
+    done
+    has_line "$tmp/figs/translating-roller-cam-disc-lift.svg" "cam angle x of 'disc' \[deg\]" "plot a cam: the x axis"
+fi
+if run "report a cam" 0 "$MECH" report "$D/cam-fourbar.yaml" -o "$tmp/cam.html"; then
+    [ "$(grep -c "<title[^>]*>Cam 'disc'" "$tmp/cam.html")" -eq 5 ] && pass || fail "report a cam: not its 5 figures"
+    grep -q 'class="cam"' "$tmp/cam.html" && pass || fail "report a cam: the animation lacks the cam"
+fi
+
 # 5. the generated code: bit for bit
 if run "jit translating" 0 "$MECH" solve "$D/translating-roller.yaml" --jit -o "$tmp/tj.csv"; then
     cmp -s "$tmp/t.csv" "$tmp/tj.csv" && pass || fail "jit translating: not bit for bit"

@@ -206,6 +206,42 @@ static int write_fit_figure(const plot_args *a, const mech_model *m, const char 
     return code;
 }
 
+/* A file with cams: DIR/STEM-cam-NAME-{lift,velocity,acceleration,jerk,
+ * profile}.svg (docs/cams.md 5). */
+typedef struct cam_fig_ctx {
+    const plot_args *a;
+    const mech_model *m;
+    const char *dir, *stem;
+    mech_diag *d;
+} cam_fig_ctx;
+
+static int write_cam_figure(void *vctx, const mech_table *t, const plot_figure *f)
+{
+    const cam_fig_ctx *c = vctx;
+    char path[4096];
+    if ((size_t)snprintf(path, sizeof path, "%s/%s-%s.svg", c->dir, c->stem, f->name) >=
+        sizeof path)
+        return diag_error(c->d, c->m->file, (mech_mark){0, 0}, "the figure's path is too long");
+    if (cmd_refuse_input("plot", path, &c->a->file, 1) >= 0)
+        return MECH_EINPUT;
+    int rc = plot_figure_write(c->m, t, f, c->m->name, path, c->d);
+    if (rc == MECH_OK)
+        printf("%s\n", path);
+    return rc;
+}
+
+static int write_cam_figures(const plot_args *a, const mech_model *m, const char *dir,
+                             const char *stem)
+{
+    mech_diag d;
+    mech_diag_init(&d);
+    cam_fig_ctx c = {a, m, dir, stem, &d};
+    int rc = cam_figures_each(m, write_cam_figure, &c, &d);
+    mech_diag_print(&d, stderr);
+    mech_diag_free(&d);
+    return rc == MECH_OK ? MECH_EXIT_OK : cmd_exit_status(rc);
+}
+
 static int write_figures(const plot_args *a, const mech_model *m, const mech_table *t)
 {
     enum { MAXFIG = 4096 };
@@ -249,6 +285,8 @@ static int write_figures(const plot_args *a, const mech_model *m, const mech_tab
     free(figs);
     if (code == MECH_EXIT_OK && m->fit)
         code = write_fit_figure(a, m, dir, stem);
+    if (code == MECH_EXIT_OK && m->cams)
+        code = write_cam_figures(a, m, dir, stem);
     return code;
 }
 

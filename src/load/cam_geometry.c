@@ -129,7 +129,7 @@ void cam_geometry(const mech_model *m, const mech_cam *c, double x, cam_point *g
     double s[4], q[3][2], mv[2], jq[2], jq1[2], w[2], w1[2], jw[2], w2[2], n[2];
     program_eval(c->program->progs[0], x, s);
     g->x = x;
-    g->s[0] = s[0], g->s[1] = s[1], g->s[2] = s[2];
+    g->s[0] = s[0], g->s[1] = s[1], g->s[2] = s[2], g->s[3] = s[3];
     if (c->motion == CAM_OSCILLATING && c->contact == CAM_FLAT_FACED)
         return oscillating_face(m, c, s, x, g);
     trace_point(m, c, s, q, mv);
@@ -149,8 +149,6 @@ void cam_geometry(const mech_model *m, const mech_cam *c, double x, cam_point *g
     double th = c->start + sg * x;
     const mech_point *oc = &m->links[c->cam].points[c->cam_pivot[0]];
     double pitch[2], contact[2], normal[2] = {n[0], n[1]};
-    g->x = x;
-    g->s[0] = s[0], g->s[1] = s[1], g->s[2] = s[2];
     g->rho_pitch = -sg * len * len * len / cross(w, w2);
     g->face = 0.0;
     if (c->contact == CAM_FLAT_FACED) {  /* the face normal to the line, touching where */

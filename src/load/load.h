@@ -802,7 +802,7 @@ void load_cams(loader *ld, const ynode *seq);
 /* cam_geometry.c: cam c at the program's x (docs/cams.md 3). */
 typedef struct cam_point {
     double x;            /* the program's variable: the cam's angle from 'start', rad */
-    double s[3];         /* the lift and its first two derivatives in x */
+    double s[4];         /* the lift and its first three derivatives in x */
     double pitch[2];     /* the trace point (roller's centre, knife's tip, flat face's foot
                             on its line) in the cam's own frame, m */
     double profile[2];   /* the contact point on the profile, in the cam's frame, m */

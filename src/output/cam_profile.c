@@ -40,12 +40,12 @@ int cam_profile_table(const mech_model *m, int i, int n, mech_table *t)
 {
     static const char *const names[] = {"x", "s", "ds", "dds", "pitch.x", "pitch.y",
                                         "profile.x", "profile.y", "pressure_angle",
-                                        "rho_pitch", "rho_profile", "face"};
+                                        "rho_pitch", "rho_profile", "face", "ddds"};
     const mech_cam *c = &m->cams->cam[i];
     int lin = c->motion == CAM_TRANSLATING;
     const char *units[] = {"rad", lin ? "m" : "rad", lin ? "m/rad" : "rad/rad",
                            lin ? "m/rad^2" : "rad/rad^2", "m", "m", "m", "m", "rad", "m", "m",
-                           "m"};
+                           "m", lin ? "m/rad^3" : "rad/rad^3"};
     enum { NCOL = sizeof names / sizeof names[0] };
     memset(t, 0, sizeof *t);
     t->columns = xcalloc(NCOL, sizeof *t->columns);
@@ -61,7 +61,7 @@ int cam_profile_table(const mech_model *m, int i, int n, mech_table *t)
         cam_geometry(m, c, period * r / n, &g);
         const double v[NCOL] = {g.x, g.s[0], g.s[1], g.s[2], g.pitch[0], g.pitch[1],
                                 g.profile[0], g.profile[1], g.pressure, g.rho_pitch,
-                                g.rho_profile, g.face};
+                                g.rho_profile, g.face, g.s[3]};
         memcpy(t->values + (size_t)r * NCOL, v, sizeof v);
     }
     t->nrows = t->nrequested = n;
@@ -171,3 +171,61 @@ int cam_steps(const mech_model *m, int i, double step)
 }
 
 double cam_default_step(void) { return PI / 180.0; }
+
+/* ---- the figures of mech plot and mech report ---------------------------- */
+
+int cam_plan(const mech_model *m, int i, plot_figure *figs)
+{
+    static const char *const stem[] = {"lift", "velocity", "acceleration", "jerk"};
+    static const char *const what[] = {"lift s", "ds/dx", "d2s/dx2", "d3s/dx3"};
+    static const int col[] = {1, 2, 3, 12};  /* s, ds, dds, ddds of cam_profile_table */
+    const mech_cam *c = &m->cams->cam[i];
+    int lin = c->motion == CAM_TRANSLATING;
+    for (int k = 0; k < 4; k++) {
+        plot_figure *f = &figs[k];
+        memset(f, 0, sizeof *f);
+        snprintf(f->name, sizeof f->name, "cam-%.40s-%s", c->name, stem[k]);
+        snprintf(f->title, sizeof f->title, "Cam '%.40s': the follower's %s against the cam's "
+                 "angle", c->name, what[k]);
+        snprintf(f->ylabel, sizeof f->ylabel, "%s", what[k]);
+        snprintf(f->yunit, sizeof f->yunit, "%s%s", lin ? "mm" : "deg",
+                 k == 0 ? "" : k == 1 ? "/rad" : k == 2 ? "/rad^2" : "/rad^3");
+        f->yscale = lin ? 1e3 : 180.0 / PI;
+        f->col[0] = col[k];
+        snprintf(f->label[0], sizeof f->label[0], "%s", what[k]);
+        f->nseries = 1;
+        snprintf(f->xlabel, sizeof f->xlabel, "cam angle x of '%.30s' [deg]", c->name);
+    }
+    plot_figure *f = &figs[4];
+    memset(f, 0, sizeof *f);
+    snprintf(f->name, sizeof f->name, "cam-%.40s-profile", c->name);
+    snprintf(f->title, sizeof f->title, "Cam '%.40s': the profile and the pitch curve in its "
+             "frame", c->name);
+    snprintf(f->ylabel, sizeof f->ylabel, "y");
+    snprintf(f->yunit, sizeof f->yunit, "mm");
+    f->yscale = 1e3;
+    f->kind = PLOT_PATH;
+    f->col[0] = 6, f->ycol[0] = 7;  /* profile.x, profile.y */
+    f->col[1] = 4, f->ycol[1] = 5;  /* pitch.x, pitch.y */
+    snprintf(f->label[0], sizeof f->label[0], "profile");
+    snprintf(f->label[1], sizeof f->label[1], "pitch curve");
+    f->nseries = c->contact == CAM_KNIFE_EDGE ? 1 : 2;  /* a knife's pitch curve is its profile */
+    return CAM_FIGURES;
+}
+
+int cam_figures_each(const mech_model *m, cam_figure_fn write, void *ctx, mech_diag *d)
+{
+    int rc = MECH_OK;
+    for (int i = 0; i < model_ncams(m) && rc == MECH_OK; i++) {
+        mech_table t;
+        plot_figure figs[CAM_FIGURES];
+        rc = cam_profile_table(m, i, cam_steps(m, i, cam_default_step()), &t);
+        if (rc != MECH_OK)
+            rc = diag_nomem(d, m->file, (mech_mark){0, 0});
+        int n = rc == MECH_OK ? cam_plan(m, i, figs) : 0;
+        for (int k = 0; k < n && rc == MECH_OK; k++)
+            rc = write(ctx, &t, &figs[k]);
+        mech_table_free(&t);
+    }
+    return rc;
+}

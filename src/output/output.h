@@ -209,6 +209,8 @@ typedef struct plot_figure {
     unsigned char dots[PLOT_MAX_SERIES]; /* 1: series s is points (mech fit's targets): its
                                          marker at every finite row, class "dot", no
                                          line, arrows or start marker */
+    char xlabel[64];                  /* not empty: column 0 is an angle (rad) drawn in
+                                         deg under this title, not the driver */
 } plot_figure;
 
 /* The figures a table calls for, in order: points (positions, velocities,
@@ -610,5 +612,14 @@ int cam_outline_dxf(const mech_model *m, int i, const mech_table *t, const char 
  * and the default step (1 deg). */
 int cam_steps(const mech_model *m, int i, double step);
 double cam_default_step(void);
+/* The figures of cam i (mech plot, mech report) over its profile table:
+ * the lift and its three derivatives against the cam's angle, and the
+ * profile with the pitch curve (a path, mm). Returns 5 (figs[0..4]). */
+enum { CAM_FIGURES = 5 };
+int cam_plan(const mech_model *m, int i, plot_figure *figs);
+/* write(ctx, table, figure) for every figure of every cam, in order (each
+ * cam's table at 1 deg); the first status that is not MECH_OK stops it. */
+typedef int (*cam_figure_fn)(void *ctx, const mech_table *t, const plot_figure *f);
+int cam_figures_each(const mech_model *m, cam_figure_fn write, void *ctx, mech_diag *d);
 
 #endif

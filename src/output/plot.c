@@ -291,6 +291,8 @@ typedef struct fig_ctx {
 static double xval(const fig_ctx *c, int r)
 {
     double q = mech_table_get(c->t, r, 0);
+    if (c->f->xlabel[0])
+        return q * RAD2DEG;  /* an angle of its own (a cam's) */
     if (c->m->has_driver && c->m->driver.kind == MECH_DRIVE_TIME)
         return q;  /* drivers as laws of time: t in s */
     return c->m->has_driver && c->m->driver.kind == MECH_DRIVE_SLIDER ? q * 1e3 : q * RAD2DEG;
@@ -299,7 +301,9 @@ static double xval(const fig_ctx *c, int r)
 static void x_title(const fig_ctx *c, FILE *f)
 {
     const mech_model *m = c->m;
-    if (m->has_driver && m->driver.kind == MECH_DRIVE_TIME) {
+    if (c->f->xlabel[0]) {
+        plot_put_text(f, c->f->xlabel);
+    } else if (m->has_driver && m->driver.kind == MECH_DRIVE_TIME) {
         fputs("time t [s]", f);
     } else if (m->has_driver && m->driver.kind == MECH_DRIVE_SLIDER) {
         fputs("displacement of slider ", f);

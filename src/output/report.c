@@ -84,6 +84,26 @@ static int scratch_take(scratch *s, char **text, mech_diag *d)
     return MECH_OK;
 }
 
+/* One cam figure drawn into the scratch file and taken as out[*k]. */
+typedef struct report_cams {
+    const mech_model *m;
+    scratch *s;
+    char **out;
+    int *k, max;
+    mech_diag *d;
+} report_cams;
+
+static int report_cam_figure(void *vctx, const mech_table *t, const plot_figure *f)
+{
+    report_cams *c = vctx;
+    if (*c->k >= c->max)
+        return MECH_OK;
+    int rc = plot_figure_write(c->m, t, f, c->m->name, c->s->path, c->d);
+    if (rc == MECH_OK && (rc = scratch_take(c->s, &c->out[*c->k], c->d)) == MECH_OK)
+        (*c->k)++;
+    return rc;
+}
+
 int report_figures(const mech_model *m, const mech_table *t, char ***svgs, int *n, mech_diag *d)
 {
     enum { MAXFIG = 4096 };
@@ -105,6 +125,11 @@ int report_figures(const mech_model *m, const mech_table *t, char ***svgs, int *
         rc = plot_figure_write(m, t, &figs[k], m->name, s.path, d);
         if (rc == MECH_OK)
             rc = scratch_take(&s, &out[k], d);
+    }
+    if (rc == MECH_OK && m->cams) {  /* each cam's figures, as mech plot writes them */
+        report_cams rcx = {m, &s, out, &k, MAXFIG, d};
+        rc = cam_figures_each(m, report_cam_figure, &rcx, d);
+        nf = k;
     }
     if (rc == MECH_OK && m->fit && nf < MAXFIG) {
         /* the fit: section's figure last, as mech plot writes it; left
