@@ -30,17 +30,20 @@ LAWS='function cyc(u, k) { return k == 0 ? u - sin(2 * PI * u) / (2 * PI) : k ==
 function p345(u, k) { return k == 0 ? 10 * u^3 - 15 * u^4 + 6 * u^5 : k == 1 ? 30 * u^2 - 60 * u^3 + 30 * u^4 : 60 * u - 180 * u^2 + 120 * u^3 }
 function p4567(u, k) { return k == 0 ? 35 * u^4 - 84 * u^5 + 70 * u^6 - 20 * u^7 : k == 1 ? 140 * u^3 - 420 * u^4 + 420 * u^5 - 140 * u^6 : 420 * u^2 - 1680 * u^3 + 2100 * u^4 - 840 * u^5 }
 function harm(u, k) { return k == 0 ? (1 - cos(PI * u)) / 2 : k == 1 ? PI * sin(PI * u) / 2 : PI * PI * cos(PI * u) / 2 }'
+# translating-roller.yaml's program: cycloidal rise of h over 120 deg, dwell
+# 60, 3-4-5 return over 120, dwell 60 (x in rad, D = pi / 180)
+ROLLER_LIFT='
+function lift(x, k,   b, u) { b = 120 * D
+    if (x < b) { u = x / b; return h * cyc(u, k) / b^k }
+    if (x < 180 * D) return k == 0 ? h : 0
+    if (x < 300 * D) { u = (x - 180 * D) / b; return k == 0 ? h - h * p345(u, 0) : -h * p345(u, k) / b^k }
+    return 0 }'
 
 # 1. translating roller, offset 10 mm: R = (10, sqrt(50^2 - 10^2) + s) mm,
 # vy = s' w, ay = s'' w^2 (w = 60 rpm); rise 20 mm cycloidal over 120 deg,
 # dwell 60, return 3-4-5 over 120, dwell 60
 check_translating() {  # FILE: mech solve's columns of translating-roller.yaml
-    awk -F, "$LAWS"'
-        function lift(x, k,   b, u) { b = 120 * D
-            if (x < b) { u = x / b; return h * cyc(u, k) / b^k }
-            if (x < 180 * D) return k == 0 ? h : 0
-            if (x < 300 * D) { u = (x - 180 * D) / b; return k == 0 ? h - h * p345(u, 0) : -h * p345(u, k) / b^k }
-            return 0 }
+    awk -F, "$LAWS$ROLLER_LIFT"'
         BEGIN { PI = atan2(0, -1); D = PI / 180; h = 0.020; w = 2 * PI; worst = 0; d0 = sqrt(0.05^2 - 0.01^2) }
         NR > 1 { x = $1; if (x >= 2 * PI - 1e-12) x = 0
             e[1] = ($2 - 0.010) / h; e[2] = ($3 - d0 - lift(x, 0)) / h
@@ -91,12 +94,7 @@ fi
 # the lift is the program's at the cam's angle on the arm, its rate s'
 # times the difference of their rates, its acceleration the chain rule's
 if run "solve arm" 0 "$MECH" solve tests/cams/arm.yaml -o "$tmp/a.csv"; then
-    awk -F, "$LAWS"'
-        function lift(x, k,   b, u) { b = 120 * D
-            if (x < b) { u = x / b; return h * cyc(u, k) / b^k }
-            if (x < 180 * D) return k == 0 ? h : 0
-            if (x < 300 * D) { u = (x - 180 * D) / b; return k == 0 ? h - h * p345(u, 0) : -h * p345(u, k) / b^k }
-            return 0 }
+    awk -F, "$LAWS$ROLLER_LIFT"'
         BEGIN { PI = atan2(0, -1); D = PI / 180; h = 0.020; worst = 0; d0 = sqrt(0.05^2 - 0.01^2) }
         NR > 1 { x = $11 - $8; w = $12 - $9; al = $13 - $10; x -= 2 * PI * int(x / (2 * PI)); if (x < 0) x += 2 * PI
             e[1] = ($14 - d0 - lift(x, 0)) / h; e[2] = ($15 - lift(x, 1) * w) / (h * 2 * PI)

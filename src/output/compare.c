@@ -165,24 +165,17 @@ static int split_fields(csv_reader *r)
         while (is_blank(*s))
             s++;
         char *start = s, *end;
-        if (*s == '"') {
+        if (*s == '"') {  /* a quoted field: what follows the quote up to the comma is dropped */
             s = unquote(s, &end);
             while (*s && *s != ',')
                 s++;
-            int more = *s == ',';
-            *end = '\0';
-            if (push_field(r, start, (size_t)(start - r->line)) != MECH_OK)
-                return MECH_ENOMEM;
-            if (!more)
-                return MECH_OK;
-            s++;
-            continue;
+        } else {
+            while (*s && *s != ',')
+                s++;
+            end = s;
+            while (end > start && is_blank(end[-1]))
+                end--;
         }
-        while (*s && *s != ',')
-            s++;
-        end = s;
-        while (end > start && is_blank(end[-1]))
-            end--;
         int more = *s == ',';
         *end = '\0';
         if (push_field(r, start, (size_t)(start - r->line)) != MECH_OK)

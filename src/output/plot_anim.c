@@ -320,6 +320,20 @@ static void gear_of(const anim_ctx *c, int which, int *link, int *p, double *rad
     *radius = g->radius[k];
 }
 
+/* The box grows to hold a circle of radius rad about point p in every row. */
+static void hold_circle(const anim_ctx *c, int p, double rad, box *b)
+{
+    for (int r = 0; r < c->nrows; r++) {
+        double x = c->X[(size_t)r * c->np + p], y = c->Y[(size_t)r * c->np + p];
+        if (isfinite(x) && isfinite(y)) {
+            b->xmin = fmin(b->xmin, x - rad);
+            b->xmax = fmax(b->xmax, x + rad);
+            b->ymin = fmin(b->ymin, y - rad);
+            b->ymax = fmax(b->ymax, y + rad);
+        }
+    }
+}
+
 static void place_gears(const anim_ctx *c, box *b)
 {
     for (int w = 0; w < 2 * c->m->ngears; w++) {
@@ -328,15 +342,7 @@ static void place_gears(const anim_ctx *c, box *b)
         int l, p;
         double rad;
         gear_of(c, w, &l, &p, &rad);
-        for (int r = 0; r < c->nrows; r++) {
-            double x = c->X[(size_t)r * c->np + p], y = c->Y[(size_t)r * c->np + p];
-            if (isfinite(x) && isfinite(y)) {
-                b->xmin = fmin(b->xmin, x - rad);
-                b->xmax = fmax(b->xmax, x + rad);
-                b->ymin = fmin(b->ymin, y - rad);
-                b->ymax = fmax(b->ymax, y + rad);
-            }
-        }
+        hold_circle(c, p, rad, b);
     }
 }
 
@@ -356,15 +362,7 @@ static void place_cams(const anim_ctx *c, box *b)
             cam_geometry(c->m, cm, period * k / CAM_SEGMENTS, &g);
             rad = fmax(rad, hypot(g.profile[0] - oc->x, g.profile[1] - oc->y));
         }
-        for (int r = 0; r < c->nrows; r++) {
-            double x = c->X[(size_t)r * c->np + p], y = c->Y[(size_t)r * c->np + p];
-            if (isfinite(x) && isfinite(y)) {
-                b->xmin = fmin(b->xmin, x - rad);
-                b->xmax = fmax(b->xmax, x + rad);
-                b->ymin = fmin(b->ymin, y - rad);
-                b->ymax = fmax(b->ymax, y + rad);
-            }
-        }
+        hold_circle(c, p, rad, b);
     }
 }
 
