@@ -205,6 +205,7 @@ fi
 # solved face; its radius against three-point circles (0.1 deg)
 if run "solve oscillating flat" 0 "$MECH" solve "$D/oscillating-flat.yaml" -o "$tmp/of.csv" &&
    run "cam oscillating flat" 0 "$MECH" cam "$D/oscillating-flat.yaml" --step 5 -o "$tmp/of5.csv" &&
+   has_line "$tmp/out" "^design       disc: face from 27.7134 to 61.1888 mm along it from its first point (width at least 33.4755 mm)" "cam oscillating flat: the face's extent" &&
    run "cam oscillating flat, fine" 0 "$MECH" cam "$D/oscillating-flat.yaml" --step 0.1 -o "$tmp/of01.csv"; then
     python3 - "$tmp/of.csv" "$tmp/of5.csv" "$tmp/of01.csv" <<'EOF' && pass || fail "oscillating flat: the geometry"
 import csv, math, sys

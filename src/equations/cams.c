@@ -35,9 +35,11 @@ void cams_design(const mech_model *m, int i, char *buf, size_t size)
         at += (size_t)snprintf(buf, size, "%s: pressure angle at most %.4g deg (at %.4g deg), ",
                                c->name, c->pressure_max * deg, c->pressure_at * deg);
     else
-        at += (size_t)snprintf(buf, size, "%s: face from %.6g to %.6g mm of the follower's line "
-                               "(width at least %.6g mm), ", c->name, c->face_lo * 1e3,
-                               c->face_hi * 1e3, (c->face_hi - c->face_lo) * 1e3);
+        at += (size_t)snprintf(buf, size, "%s: face from %.6g to %.6g mm %s (width at least "
+                               "%.6g mm), ", c->name, c->face_lo * 1e3, c->face_hi * 1e3,
+                               c->motion == CAM_TRANSLATING ? "of the follower's line"
+                               : "along it from its first point",
+                               (c->face_hi - c->face_lo) * 1e3);
     if (at < size && c->contact != CAM_FLAT_FACED && isfinite(c->rho_pitch_min))
         at += (size_t)snprintf(buf + at, size - at, "pitch curve radius at least %.6g mm (at "
                                "%.4g deg), ", c->rho_pitch_min * 1e3, c->rho_pitch_at * deg);
