@@ -300,6 +300,36 @@ run "forces: jit falls back" 0 "$MECH" solve "$F" --jit -o "$tmp/foj.csv" &&
     has_line "$tmp/err" "forces through a cam pair ('disc') are not generated" "forces: jit's note" &&
     { cmp -s "$tmp/fo.csv" "$tmp/foj.csv" && pass || fail "forces: the fallback's rows differ"; }
 
+# 4e. friction at the contact (tests/cams/friction.yaml: a flat face on a
+# line through the centre, mu 0.1, held by its weight, 60 rpm): the face
+# carries F = m (g + y''), and the cam's moment balance about its centre,
+# the normal force at the contact's offset s' along the face and the
+# friction mu F at the lever base + s, gives T = m (g + y'') (s' + mu
+# (base + s)); the power balance still closes (with the friction's power)
+if run "friction" 0 "$MECH" solve tests/cams/friction.yaml -o "$tmp/fri.csv"; then
+    awk -F, "$LAWS"'
+        function lift(x, k,   b, u) { b = 150 * D
+            if (x < b) { u = x / b; return h * cyc(u, k) / b^k }
+            if (x < 180 * D) return k == 0 ? h : 0
+            if (x < 330 * D) { u = (x - 180 * D) / b; return k == 0 ? h - h * cyc(u, 0) : -h * cyc(u, k) / b^k }
+            return 0 }
+        BEGIN { PI = atan2(0, -1); D = PI / 180; h = 0.018; w = 2 * PI; m = 0.5; g = 9.81; mu = 0.1 }
+        NR > 1 { x = $1; if (x >= 2 * PI - 1e-12) x = 0
+            load = m * (g + lift(x, 2) * w * w)
+            e1 = ($19 - load) / (m * g); e2 = ($15 - load * (lift(x, 1) + mu * (0.035 + lift(x, 0)))) / (m * g * 0.05)
+            r = $16; for (k = 1; k <= 3; k++) { v = k == 1 ? e1 : k == 2 ? e2 : r; if (v < 0) v = -v; if (v > worst) worst = v } }
+        END { printf "%.3g\n", worst; exit !(worst < 1e-12) }' "$tmp/fri.csv" >"$tmp/w" &&
+        pass || fail "friction: the force, the moment balance or the power balance: $(cat "$tmp/w")"
+fi
+sed 's/^    contact: flat-faced/    contact: knife-edge/' tests/cams/friction.yaml >"$tmp/knife.yaml"
+run "friction on a knife" 0 "$MECH" solve "$tmp/knife.yaml" -o "$tmp/x.csv"
+sed 's/^    base_radius: 35 mm/    base_radius: 35 mm\n    roller_radius: 5 mm/; s/^    contact: flat-faced/    contact: roller/' tests/cams/friction.yaml >"$tmp/roll.yaml"
+sed 's/^    contact: roller/    contact: knife-edge\n    friction: 0.1/; /roller_radius/d' tests/cams/free.yaml >"$tmp/free-fric.yaml"
+run "simulate refuses contact friction" 2 "$MECH" simulate "$tmp/free-fric.yaml" -o "$tmp/x.csv" &&
+    has_line "$tmp/err" "error: cam 'disc' has Coulomb friction at its contact, which mech simulate does not model" "simulate refuses contact friction: message"
+run "friction on a roller" 2 "$MECH" check "$tmp/roll.yaml" &&
+    has_line "$tmp/err" "roll.yaml:[0-9]*:15: error: a roller rolls on the cam: there is no sliding friction at its contact" "friction on a roller: message"
+
 # 4d. mech plot and mech report draw each cam's lift, its three derivatives
 # against the cam's angle and its profile with the pitch curve
 if run "plot a cam" 0 "$MECH" plot "$D/translating-roller.yaml" --out "$tmp/figs"; then

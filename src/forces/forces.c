@@ -241,8 +241,11 @@ static void make_columns(forces_plan *fp)
     for (int g = 0; g < m->ngears; g++)
         add_column(fp, FC_GEAR, g);
     fp->ccol = fp->ncols;
-    for (int i = 0; i < model_ncams(m); i++)
+    for (int i = 0; i < model_ncams(m); i++) {
         add_column(fp, FC_CAM, i);
+        if (m->cams->cam[i].friction > 0.0)
+            fp->has_friction = 1;
+    }
     fp->ndrive = m->ndrivers;
     for (int k = 0; k < fp->ndrive; k++)
         add_column(fp, FC_DRIVE, -1 - k);
@@ -466,6 +469,39 @@ static void ctx_solve(void *c, const double *rhs, double *y)
     solve_rhs(((solve_ctx *)c)->fc, rhs, y);
 }
 
+/* The velocity at the ground point p of the material of frame Fl. */
+static void material_velocity(const rt_frame *Fl, const double p[2], double v[2])
+{
+    v[0] = Fl->vo[0] - Fl->om * (p[1] - Fl->o[1]);
+    v[1] = Fl->vo[1] + Fl->om * (p[0] - Fl->o[0]);
+}
+
+/* Coulomb friction at each cam's contact (docs/cams.md 6): mu |F| along
+ * the common tangent, against the follower's sliding on the cam there, on
+ * the follower and its opposite on the cam; returns the power it takes. */
+static double cam_friction(const forces *fc, const rt_frame *F, const double *y, double eps,
+                           double *fric)
+{
+    const mech_model *m = fc->p->m;
+    double power = 0.0;
+    for (int i = 0; i < model_ncams(m); i++) {
+        const mech_cam *cm = &m->cams->cam[i];
+        if (!(cm->friction > 0.0))
+            continue;
+        const double *k = fc->cam + 4 * i;
+        double p[2] = {k[0], k[1]}, t[2] = {-k[3], k[2]}, vf[2], vc[2];
+        material_velocity(&F[cm->follower], p, vf);
+        material_velocity(&F[cm->cam], p, vc);
+        double slide = (vf[0] - vc[0]) * t[0] + (vf[1] - vc[1]) * t[1];
+        double ff = cm->friction * fabs(y[fc->p->ccol + i]) * rt_smooth_sign(slide, eps);
+        double on_f[2] = {-ff * t[0], -ff * t[1]}, on_c[2] = {ff * t[0], ff * t[1]};
+        rt_load_force(fric, fc->g, cm->follower, p, on_f);
+        rt_load_force(fric, fc->g, cm->cam, p, on_c);
+        power += ff * slide;
+    }
+    return power;
+}
+
 static double ctx_friction(void *c, const double *y, double *fric)
 {
     const solve_ctx *x = c;
@@ -475,7 +511,7 @@ static double ctx_friction(void *c, const double *y, double *fric)
     for (int k = 0; k < fn->nfric; k++)
         power += rt_friction_load(&fn->fric[k], x->sv->ks.F, x->fc->g, x->sv->vel, y,
                                   fn->speed_eps, fn->lref, fric);
-    return power;
+    return power + cam_friction(x->fc, x->sv->ks.F, y, fn->speed_eps * fn->lref, fric);
 }
 
 static void ctx_separation(void *c, const double *y, double *rhs)

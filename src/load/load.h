@@ -777,6 +777,7 @@ typedef struct mech_cam {
     int sense;           /* +1: x grows as the cam turns counterclockwise on the arm */
     double start;        /* the cam's angle on the arm where x = 0, rad */
     double base, roller; /* the base circle's radius, the roller's (0: none), m */
+    double friction;     /* the Coulomb coefficient at the contact (0: none) */
     double offset;       /* translating: the signed distance of the follower's line from
                             the cam's centre (+: the line passes to the centre's left,
                             looking along the line's direction), m */

@@ -4,7 +4,8 @@
  *   cams:
  *     - {name, cam: LINK, follower: SLIDER | LINK, contact: roller | knife-edge |
  *        flat-faced, base_radius, roller_radius, at: POINT, turning: ccw | cw,
- *        start: ANGLE, program: {segments: [...], period, start, continuity}}
+ *        start: ANGLE, face: [A, B], friction: MU,
+ *        program: {segments: [...], period, start, continuity}}
  *
  * The cam turns on the arm that guides the follower: a translating
  * follower's slider runs on it, an oscillating follower turns on it. The
@@ -323,6 +324,23 @@ static int load_follower(loader *ld, const ynode *map, mech_cam *c)
     return load_oscillating(ld, map, fn, c);
 }
 
+/* 'friction': the Coulomb coefficient at the contact, 0 to 1. */
+static int load_friction(loader *ld, const ynode *n, mech_cam *c)
+{
+    if (!n)
+        return 1;
+    if (!load_get_quantity(ld, n, Q_NUMBER, "friction", &c->friction))
+        return 0;
+    if (!(c->friction >= 0.0 && c->friction <= 1.0))
+        return load_err(ld, n, "a cam's friction coefficient is from 0 to 1, not %g",
+                        c->friction), 0;
+    if (c->contact == CAM_ROLLER && c->friction > 0.0)
+        return load_err(ld, n, "a roller rolls on the cam: there is no sliding friction at its "
+                        "contact (its losses are its pin's); 'friction' applies to a "
+                        "knife-edge or a flat face"), 0;
+    return 1;
+}
+
 static int load_one(loader *ld, const ynode *map, mech_cam *c)
 {
     const ynode *cn = ymap_get(map, "cam"), *pm = ymap_get(map, "program");
@@ -334,7 +352,8 @@ static int load_one(loader *ld, const ynode *map, mech_cam *c)
         return 0;
     if (c->cam == 0)
         return load_err(ld, cn, "the ground cannot be the cam: a cam turns"), 0;
-    if (!load_contact(ld, map, c) || !load_phase(ld, map, c) || !load_follower(ld, map, c))
+    if (!load_contact(ld, map, c) || !load_phase(ld, map, c) || !load_follower(ld, map, c) ||
+        !load_friction(ld, ymap_get(map, "friction"), c))
         return 0;
     if (!pm)
         return load_err(ld, map, "a cam needs 'program': the follower's lift against the cam's "
@@ -373,7 +392,7 @@ void load_cams(loader *ld, const ynode *seq)
 {
     static const char *const keys[] = {"name", "cam", "follower", "contact", "base_radius",
                                        "roller_radius", "at", "face", "turning", "start",
-                                       "program"};
+                                       "friction", "program"};
     if (!load_want_kind(ld, seq, YNODE_SEQ, "'cams'"))
         return;
     if (seq->n > MAX_CAMS)

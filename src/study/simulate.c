@@ -275,6 +275,12 @@ static int refuse(const mech_model *m, mech_diag *d)
                               "model (the driver loads are then not linear in the "
                               "accelerations): remove 'friction' to simulate without it",
                               m->joints[j].name);
+    for (int i = 0; i < model_ncams(m); i++)
+        if (m->cams->cam[i].friction > 0.0)
+            return diag_error(d, m->file, m->cams->cam[i].mark,
+                              "cam '%s' has Coulomb friction at its contact, which mech "
+                              "simulate does not model (as a joint's): remove 'friction' to "
+                              "simulate without it", m->cams->cam[i].name);
     const state_loads *sl = m->state_loads;
     for (int i = 0; sl && i < sl->nin; i++)
         if (sl->in[i].kind == SLIN_PAX || sl->in[i].kind == SLIN_PAY ||
