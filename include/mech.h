@@ -301,6 +301,10 @@ typedef struct mech_outputs {
     int *sliders;      /* [nsliders] joint indices */
     int nsliders;
     int forces;        /* joint reactions and driver torque wanted */
+    int *cams;         /* [ncams] cam pairs whose design quantities are columns (the cam's
+                          angle on its arm, pressure angle, radii of curvature;
+                          docs/cams.md); appended: the fields before keep their places */
+    int ncams;
 } mech_outputs;
 
 typedef struct mech_model {

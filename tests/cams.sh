@@ -330,6 +330,28 @@ run "simulate refuses contact friction" 2 "$MECH" simulate "$tmp/free-fric.yaml"
 run "friction on a roller" 2 "$MECH" check "$tmp/roll.yaml" &&
     has_line "$tmp/err" "roll.yaml:[0-9]*:15: error: a roller rolls on the cam: there is no sliding friction at its contact" "friction on a roller: message"
 
+# 4f. the design quantities as columns of mech solve (--outputs NAME or
+# outputs: {cams: [NAME]}): at each row the cam's angle on its arm and the
+# quantities mech cam gives at that angle
+if run "design columns" 0 "$MECH" solve "$D/translating-roller.yaml" --outputs R,disc -o "$tmp/dq.csv" &&
+   run "design columns: the table" 0 "$MECH" cam "$D/translating-roller.yaml" --step 5 -o "$tmp/dq5.csv"; then
+    has_line "$tmp/dq.csv" "^q \[rad\],R.x \[m\],.*,disc.x \[rad\],disc.pressure_angle \[rad\],disc.rho_pitch \[m\],disc.rho_profile \[m\]\$" "design columns: the header"
+    awk -F, 'FNR == 1 { f++ } f == 1 && FNR > 1 { x[FNR] = $1; p[FNR] = $9; rp[FNR] = $10; rf[FNR] = $11 }
+        f == 2 && FNR > 1 { k = FNR; if (k > 73) k = 2
+            e = ($8 - $1); if (e < 0) e = -e; if (e > w) w = e
+            e = ($9 - p[k]); if (e < 0) e = -e; if (e > w) w = e
+            e = ($10 - rp[k]) / rp[k]; if (e < 0) e = -e; if (e > w) w = e
+            e = ($11 - rf[k]) / rf[k]; if (e < 0) e = -e; if (e > w) w = e }
+        END { printf "%.3g\n", w; exit !(w < 1e-12) }' "$tmp/dq5.csv" "$tmp/dq.csv" >"$tmp/w" &&
+        pass || fail "design columns against mech cam's table: $(cat "$tmp/w")"
+fi
+sed 's/^  sliders: \[y_R\]/  sliders: [y_R]\n  cams: [disc]/' "$D/translating-roller.yaml" >"$tmp/dcol.yaml"
+run "design columns: jit refuses" 0 "$MECH" solve "$tmp/dcol.yaml" --jit -o "$tmp/x.csv" &&
+    has_line "$tmp/err" "the design quantities of cam 'disc' are not generated" "design columns: jit's note"
+sed 's/^  sliders: \[y_R\]/  sliders: [y_R]\n  cams: [nope]/' "$D/translating-roller.yaml" >"$tmp/dbad.yaml"
+run "design columns: no such cam" 2 "$MECH" check "$tmp/dbad.yaml" &&
+    has_line "$tmp/err" "dbad.yaml:[0-9]*:10: error: 'nope' is not a cam of the file's 'cams:'" "design columns: no such cam: message"
+
 # 4d. mech plot and mech report draw each cam's lift, its three derivatives
 # against the cam's angle and its profile with the pitch curve
 if run "plot a cam" 0 "$MECH" plot "$D/translating-roller.yaml" --out "$tmp/figs"; then

@@ -125,8 +125,8 @@ static const cmd_opt options[] = {
              "rss(COL) = sqrt(sum (d(COL)/dp tol_p)^2); print the\n"
              "largest of each over the sweep to standard error"},
     {.names = "--outputs", .kind = CMD_OPT_TEXT, .at = AT(outputs), .label = "--outputs LIST",
-     .help = "comma-separated point, link and slider names to output\n"
-             "instead of the file's outputs"},
+     .help = "comma-separated point, link, slider and cam names to\n"
+             "output instead of the file's outputs"},
     {.names = "--level", .kind = CMD_OPT_WORD, .at = AT(opt.want), .words = levels,
      .expect = "is positions, velocities or accelerations", .label = "--level L",
      .help = "positions, velocities or accelerations (default): the\n"

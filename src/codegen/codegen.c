@@ -261,6 +261,13 @@ int codegen_init(codegen *g, const mech_model *m, const codegen_options *o, mech
                         "computes them", m->cams->cam[0].name);
         goto fail;
     }
+    if (m->outputs.ncams > 0) {  /* the design quantities are the loader's geometry */
+        rc = diag_error(d, m->file, m->cams->cam[m->outputs.cams[0]].mark, "codegen: the "
+                        "design quantities of cam '%s' are not generated (docs/cams.md, "
+                        "Limits): the interpreter computes them",
+                        m->cams->cam[m->outputs.cams[0]].name);
+        goto fail;
+    }
     if (g->want_forces && (rc = codegen_forces_plan(g, d)) != MECH_OK)
         goto fail;
     int friction = !g->want_forces || !g->fp.friction ? 0 : g->fp.want_frictionless ? 2 : 1;

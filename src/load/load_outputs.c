@@ -146,6 +146,15 @@ static int resolve_slider(loader *ld, const ynode *n)
 {
     return load_slider_by_name(ld, n, "output slider");
 }
+static int resolve_cam(loader *ld, const ynode *n)
+{
+    const model_cams *cs = ld->m->cams;
+    for (int i = 0; cs && n->text && i < cs->n; i++)
+        if (cs->cam[i].name && strcmp(cs->cam[i].name, n->text) == 0)
+            return i;
+    return load_err(ld, n, "'%s' is not a cam of the file's 'cams:'%s", n->text ? n->text : "",
+                    cs && cs->n ? "" : " (it has none)"), -1;
+}
 
 /* The names of list `what`, resolved by fn to indices below `range`; a name
  * given twice is an error at its second place, as `--outputs` refuses it
@@ -199,7 +208,7 @@ void load_default_outputs(mech_model *m)
 
 void load_outputs(loader *ld, const ynode *map)
 {
-    static const char *const keys[] = {"points", "links", "sliders", "forces"};
+    static const char *const keys[] = {"points", "links", "sliders", "cams", "forces"};
     mech_outputs *o = &ld->m->outputs;
     if (!load_check_keys(ld, map, keys, COUNT(keys), "outputs"))
         return;
@@ -213,6 +222,10 @@ void load_outputs(loader *ld, const ynode *map)
     if (s)
         load_name_list(ld, s, "'sliders'", resolve_slider, ld->m->njoints, &o->sliders,
                        &o->nsliders);
+    const ynode *c = ymap_get(map, "cams");
+    if (c)
+        load_name_list(ld, c, "'cams'", resolve_cam, model_ncams(ld->m) + 1, &o->cams,
+                       &o->ncams);
     if (f)
         load_get_bool(ld, f, "'forces'", &o->forces);
 }

@@ -139,7 +139,15 @@ static const char *output_near(const char *w, const char **names, int n)
     return nearest_name(w, names, (size_t)n);
 }
 
-/* Add output `w` (a point, moving link or slider name) to `o`; MECH_EINPUT
+static int cam_by_name(const mech_model *m, const char *w)
+{
+    for (int i = 0; i < model_ncams(m); i++)
+        if (m->cams->cam[i].name && strcmp(m->cams->cam[i].name, w) == 0)
+            return i;
+    return -1;
+}
+
+/* Add output `w` (a point, moving link, slider or cam name) to `o`; MECH_EINPUT
  * with a message in err when it is none of them. */
 static int add_output(const mech_model *m, mech_outputs *o, const char *w, char *err,
                       size_t errsize)
@@ -151,13 +159,16 @@ static int add_output(const mech_model *m, mech_outputs *o, const char *w, char 
         o->links[o->nlinks++] = k;
     else if ((k = mech_find_joint(m, w)) >= 0 && m->joints[k].kind == MECH_JOINT_SLIDER)
         o->sliders[o->nsliders++] = k;
+    else if ((k = cam_by_name(m, w)) >= 0)
+        o->cams[o->ncams++] = k;
     else {
         int n;
         const char **names = all_names(m, &n);
         const char *near = names ? output_near(w, names, n) : NULL;
         const char *dot = strchr(w, '.');
         int column = near && dot && strlen(near) == (size_t)(dot - w);
-        snprintf(err, errsize, "'%s' is not a point, moving link or slider of %s%s%s%s%s", w,
+        snprintf(err, errsize, "'%s' is not a point, moving link%s of %s%s%s%s%s", w,
+                 model_ncams(m) ? ", slider or cam" : " or slider",
                  m->file, near ? " (did you mean '" : "", near ? near : "", near ? "'?)" : "",
                  column ? "; outputs are names, each giving all its columns" : "");
         free(names);
@@ -216,9 +227,10 @@ int mech_outputs_parse(const mech_model *m, const char *list, mech_outputs *out,
     o.points = xcalloc(len + 1, sizeof *o.points);
     o.links = xcalloc(len + 1, sizeof *o.links);
     o.sliders = xcalloc(len + 1, sizeof *o.sliders);
+    o.cams = xcalloc(len + 1, sizeof *o.cams);
     o.forces = m->outputs.forces;
     int rc = MECH_OK;
-    if (!copy || !o.points || !o.links || !o.sliders) {
+    if (!copy || !o.points || !o.links || !o.sliders || !o.cams) {
         snprintf(err, errsize, "out of memory");
         rc = MECH_ENOMEM;
     }
@@ -229,6 +241,7 @@ int mech_outputs_parse(const mech_model *m, const char *list, mech_outputs *out,
         free(o.points);
         free(o.links);
         free(o.sliders);
+        free(o.cams);
         return rc;
     }
     if (out)
@@ -245,5 +258,6 @@ void mech_outputs_free(mech_outputs *o)
     free(o->points);
     free(o->links);
     free(o->sliders);
+    free(o->cams);
     memset(o, 0, sizeof *o);
 }

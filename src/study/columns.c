@@ -74,6 +74,12 @@ static int kinematic_columns(column_layout *cl, const mech_model *m, const mech_
     for (int i = 0; i < o->nsliders; i++)
         rc |= add_levels(cl, level, SRC_SLIDER, o->sliders[i], m->joints[o->sliders[i]].name,
                          slide_sfx, slide_unit);
+    static const char *const cam_sfx[] = {".x", ".pressure_angle", ".rho_pitch", ".rho_profile"};
+    static const char *const cam_unit[] = {"rad", "rad", "m", "m"};
+    for (int i = 0; i < o->ncams; i++)  /* a cam's design quantities (docs/cams.md 3) */
+        for (int k = 0; k < 4; k++)
+            rc |= add(cl, SRC_CAM_DESIGN, o->cams[i], k, m->cams->cam[o->cams[i]].name,
+                      cam_sfx[k], cam_unit[k]);
     /* each driven coordinate, after the outputs when they do not list it
        (the sweep's own coordinate is q) */
     for (int k = 0; k < m->ndrivers; k++) {
@@ -203,7 +209,7 @@ static int source_width(column_source src)
     switch (src) {
     case SRC_POINT: return 6;
     case SRC_LINK: case SRC_SLIDER: case SRC_SPRING: return 3;
-    case SRC_REACTION: return 4;
+    case SRC_REACTION: case SRC_CAM_DESIGN: return 4;
     default: return 1;
     }
 }
@@ -287,6 +293,21 @@ static void reaction_values(const row_sources *rs, int joint, int set, double *r
         r[2] = hypot(r[0], r[1]);
 }
 
+/* Cam i's design quantities at the cam's angle on its arm (cam_geometry). */
+static void cam_design_values(int i, const solver *sv, double *v)
+{
+    const mech_model *m = sv->p->m;
+    const mech_cam *c = &m->cams->cam[i];
+    const rt_frame *F = sv->ks.F;
+    cam_point g;
+    double x = c->sense * (F[c->cam].th - F[c->arm].th - c->start);
+    cam_geometry(m, c, x, &g);
+    v[0] = x;
+    v[1] = g.pressure;
+    v[2] = g.rho_pitch;
+    v[3] = g.rho_profile;
+}
+
 static void spring_values(int i, const solver *sv, double *v)
 {
     spring_state st;
@@ -322,6 +343,7 @@ static void source_values(const column_group *g, const row_sources *rs, double *
     case SRC_SPRING: spring_values(g->obj, sv, v); break;
     case SRC_GEAR: v[0] = forces_gear(rs->fc, g->obj, 1); break;
     case SRC_CAM: v[0] = forces_cam(rs->fc, g->obj, 1); break;
+    case SRC_CAM_DESIGN: cam_design_values(g->obj, sv, v); break;
     }
 }
 

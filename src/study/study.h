@@ -39,7 +39,9 @@ typedef enum {
     SRC_SUBSTEPS,
     SRC_SPRING,          /* obj: spring; comp 0..2: length (angle), rate, force (torque) */
     SRC_GEAR,            /* obj: gear pair; the tooth force along the line of action */
-    SRC_CAM              /* obj: cam pair; the contact force along the common normal */
+    SRC_CAM,             /* obj: cam pair; the contact force along the common normal */
+    SRC_CAM_DESIGN       /* obj: cam pair; comp 0..3: its angle x, pressure angle,
+                            radii of curvature of the pitch curve and the profile */
 } column_source;
 
 typedef struct column_desc {

@@ -97,10 +97,13 @@ static int copy_outputs(mech_outputs *to, const mech_outputs *from)
     to->points = xcalloc((size_t)from->npoints + 1, sizeof *to->points);
     to->links = xcalloc((size_t)from->nlinks + 1, sizeof *to->links);
     to->sliders = xcalloc((size_t)from->nsliders + 1, sizeof *to->sliders);
-    if (!to->points || !to->links || !to->sliders) {
+    to->cams = xcalloc((size_t)from->ncams + 1, sizeof *to->cams);
+    if (!to->points || !to->links || !to->sliders || !to->cams) {
         mech_outputs_free(to);
         return -1;
     }
+    if (from->ncams)
+        memcpy(to->cams, from->cams, (size_t)from->ncams * sizeof *to->cams);
     if (from->npoints)  /* an empty list may be NULL: memcpy from NULL is undefined */
         memcpy(to->points, from->points, (size_t)from->npoints * sizeof *to->points);
     if (from->nlinks)
