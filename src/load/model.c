@@ -94,6 +94,7 @@ void mech_model_free(mech_model **pm)
     free(m->outputs.points);
     free(m->outputs.links);
     free(m->outputs.sliders);
+    free(m->outputs.cams);
     free(m->file);
     free(m->name);
     free(m->description);
