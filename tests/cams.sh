@@ -367,6 +367,13 @@ if run "report a cam" 0 "$MECH" report "$D/cam-fourbar.yaml" -o "$tmp/cam.html";
     grep -q 'class="cam"' "$tmp/cam.html" && pass || fail "report a cam: the animation lacks the cam"
 fi
 
+# 4g. the drawn form (mech convert) of a file with a cam solves the same
+if run "convert a cam" 0 "$MECH" convert "$D/translating-roller.yaml" -o "$tmp/drawn.yaml" &&
+   run "convert a cam: solve" 0 "$MECH" solve "$tmp/drawn.yaml" -o "$tmp/drawn.csv"; then
+    has_line "$tmp/drawn.yaml" "^drawing:" "convert a cam: the drawn form"
+    run "convert a cam: compare" 0 "$MECH" compare "$tmp/drawn.csv" tests/golden/cams/translating-roller.csv --rtol 1e-12 --atol 1e-15 && pass
+fi
+
 # 5. the generated code: bit for bit
 if run "jit translating" 0 "$MECH" solve "$D/translating-roller.yaml" --jit -o "$tmp/tj.csv"; then
     cmp -s "$tmp/t.csv" "$tmp/tj.csv" && pass || fail "jit translating: not bit for bit"
