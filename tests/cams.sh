@@ -112,7 +112,7 @@ fi
 # follower's line turned into the cam's frame
 if run "cam translating" 0 "$MECH" cam "$D/translating-roller.yaml" --step 0.1 -o "$tmp/p.csv" \
     --svg "$tmp/p.svg" --dxf "$tmp/p.dxf"; then
-    has_line "$tmp/out" "^points       3600, 0.1 deg apart\$" "cam: the points"
+    has_line "$tmp/out" "^points       3600 over a turn, 0.1 deg apart\$" "cam: the points"
     python3 - "$tmp/p.csv" <<'EOF' && pass || fail "cam translating: the profile's geometry"
 import csv, math, sys
 rows = [[float(v) for v in r] for r in list(csv.reader(open(sys.argv[1])))[1:]]
@@ -394,6 +394,15 @@ bad "at on a slider" 2 "bad.yaml:[0-9]*:5: error: a translating follower touches
 bad "program of" 2 "bad.yaml:[0-9]*:7: error: a cam's program has no 'of': its variable is the cam's angle" 's/^    program:/    program:\n      of: t/'
 bad "oscillating flat without face" 2 "error: an oscillating flat-faced follower needs 'face: \[A, B\]'" 's/^    contact: roller/    contact: flat-faced/; /roller_radius/d; /^    at: R/d' cam-fourbar.yaml
 bad "out of reach" 2 "bad.yaml:[0-9]*:5: error: cam 'disc': the follower's point R (80 mm from its pivot, which is 100 mm from the cam's centre) cannot reach the base circle plus the roller (10.5 mm)" 's/^    base_radius: 30 mm/    base_radius: 0.5 mm/' cam-fourbar.yaml
+bad "open profile" 2 "error: cam 'disc': the program rises 10 mm more than it returns over its period" 's/return: 20 mm, over: 120 deg/return: 10 mm, over: 120 deg/'
+bad "period not a turn" 2 "error: cam 'disc': the program's period 350 deg does not divide a turn" '0,/dwell: 60 deg/ s//dwell: 50 deg/'
+sed 's/over: 120 deg, law: cycloidal/over: 60 deg, law: cycloidal/; s/over: 120 deg, law: 3-4-5/over: 60 deg, law: 3-4-5/; s/dwell: 60 deg/dwell: 30 deg/' "$D/translating-roller.yaml" >"$tmp/twice.yaml"
+if run "twice a turn" 0 "$MECH" cam "$tmp/twice.yaml" --step 1 -o "$tmp/twice.csv"; then
+    awk -F, 'NR > 1 { s[NR - 2] = $2; n = NR - 1 }
+        END { for (i = 0; i < 180; i++) { e = s[i] - s[i + 180]; if (e < 0) e = -e; if (e > w) w = e }
+              exit !(n == 360 && w < 1e-15) }' "$tmp/twice.csv" &&
+        pass || fail "twice a turn: the table is not a whole turn of the repeated program"
+fi
 bad "jump in the program" 2 "error: cam 'disc': an acceleration jump of [-0-9.]* mm/deg^2 (d2s/dx2) at 180 deg" 's/law: 3-4-5/law: harmonic/'
 printf 'parameters:\n  rb: 40 mm\n' >"$tmp/par.yaml"
 sed 's/^    base_radius: 40 mm/    base_radius: rb/' "$D/translating-roller.yaml" >>"$tmp/par.yaml"

@@ -84,8 +84,7 @@ static void print_summary(const mech_model *m, int i, int n)
     printf("cam          %s\n", b);
     cams_design(m, i, b, sizeof b);
     printf("design       %s\n", b);
-    printf("points       %d, %.6g deg apart\n", n,
-           m->cams->cam[i].program->progs[0]->period / n * 180.0 / 3.14159265358979323846);
+    printf("points       %d over a turn, %.6g deg apart\n", n, 360.0 / n);
 }
 
 static int write_outputs(const cam_args *a, const mech_model *m, int i, const mech_table *t)

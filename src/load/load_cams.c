@@ -341,6 +341,23 @@ static int load_friction(loader *ld, const ynode *n, mech_cam *c)
     return 1;
 }
 
+/* A disc cam's profile closes over a turn: its program returns to its
+ * start (no net lift) and repeats a whole number of times in 360 deg. */
+static int closed_profile(loader *ld, const ynode *pm, mech_cam *c)
+{
+    const struct mech_program *p = c->program->progs[0];
+    double k = 2.0 * PI / p->period, scale = c->motion == CAM_TRANSLATING ? 1e3 : 180.0 / PI;
+    if (fabs(p->net) > 1e-12 * (1.0 + fabs(p->start)))
+        return load_err(ld, pm, "cam '%s': the program rises %.6g %s more than it returns over "
+                        "its period: a cam's profile must come back to where it started",
+                        c->name, p->net * scale, c->motion == CAM_TRANSLATING ? "mm" : "deg"), 0;
+    if (fabs(k - round(k)) > 1e-9 * k || round(k) < 1.0)
+        return load_err(ld, pm, "cam '%s': the program's period %.6g deg does not divide a turn "
+                        "(360 deg) a whole number of times: the profile would not close",
+                        c->name, p->period * 180.0 / PI), 0;
+    return 1;
+}
+
 static int load_one(loader *ld, const ynode *map, mech_cam *c)
 {
     const ynode *cn = ymap_get(map, "cam"), *pm = ymap_get(map, "program");
@@ -364,7 +381,7 @@ static int load_one(loader *ld, const ynode *map, mech_cam *c)
                          &c->program))
         return 0;
     snprintf(c->program->name, sizeof c->program->name, "s_%s", c->name);
-    return 1;
+    return closed_profile(ld, pm, c);
 }
 
 /* The pair's name: 'name', else CAM_FOLLOWER. */

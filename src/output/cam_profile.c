@@ -55,10 +55,9 @@ int cam_profile_table(const mech_model *m, int i, int n, mech_table *t)
     for (int k = 0; k < NCOL; k++, t->ncolumns++)
         if (set_column(t, k, names[k], units[k]) < 0)
             return MECH_ENOMEM;
-    double period = c->program->progs[0]->period;
-    for (int r = 0; r < n; r++) {
+    for (int r = 0; r < n; r++) {  /* a whole turn: the program repeats within it */
         cam_point g;
-        cam_geometry(m, c, period * r / n, &g);
+        cam_geometry(m, c, 2.0 * PI * r / n, &g);
         const double v[NCOL] = {g.x, g.s[0], g.s[1], g.s[2], g.pitch[0], g.pitch[1],
                                 g.profile[0], g.profile[1], g.pressure, g.rho_pitch,
                                 g.rho_profile, g.face, g.s[3]};
@@ -165,8 +164,8 @@ int cam_outline_dxf(const mech_model *m, int i, const mech_table *t, const char 
 
 int cam_steps(const mech_model *m, int i, double step)
 {
-    double period = m->cams->cam[i].program->progs[0]->period;
-    double n = ceil(period / step - 1e-9);
+    (void)m, (void)i;
+    double n = ceil(2.0 * PI / step - 1e-9);  /* a whole turn of the cam */
     return n < 3 ? 3 : n > 1e7 ? 10000000 : (int)n;
 }
 

@@ -356,10 +356,10 @@ static void place_cams(const anim_ctx *c, box *b)
         const mech_cam *cm = &c->m->cams->cam[w];
         const mech_point *oc = &c->m->links[cm->cam].points[cm->cam_pivot[0]];
         int p = oc->id;
-        double rad = 0.0, period = cm->program->progs[0]->period;
-        for (int k = 0; k < CAM_SEGMENTS; k++) {
+        double rad = 0.0;
+        for (int k = 0; k < CAM_SEGMENTS; k++) {  /* a whole turn */
             cam_point g;
-            cam_geometry(c->m, cm, period * k / CAM_SEGMENTS, &g);
+            cam_geometry(c->m, cm, 2.0 * 3.14159265358979323846 * k / CAM_SEGMENTS, &g);
             rad = fmax(rad, hypot(g.profile[0] - oc->x, g.profile[1] - oc->y));
         }
         hold_circle(c, p, rad, b);
@@ -529,10 +529,9 @@ static int cam_shape(const anim_ctx *c, int which, int r, double *xs, double *ys
     const mech_point *oc = &c->m->links[cm->cam].points[cm->cam_pivot[0]];
     double x = c->X[(size_t)r * c->np + oc->id], y = c->Y[(size_t)r * c->np + oc->id];
     double a = c->ang[(size_t)r * c->m->nlinks + cm->cam], ca = cos(a), sa = sin(a);
-    double period = cm->program->progs[0]->period;
-    for (int k = 0; k < CAM_SEGMENTS; k++) {
+    for (int k = 0; k < CAM_SEGMENTS; k++) {  /* a whole turn */
         cam_point g;
-        cam_geometry(c->m, cm, period * k / CAM_SEGMENTS, &g);
+        cam_geometry(c->m, cm, 2.0 * 3.14159265358979323846 * k / CAM_SEGMENTS, &g);
         double dx = g.profile[0] - oc->x, dy = g.profile[1] - oc->y;
         xs[k] = x + c->s * (ca * dx - sa * dy);
         ys[k] = y - c->s * (sa * dx + ca * dy);  /* screen y points down */
