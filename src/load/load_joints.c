@@ -421,8 +421,9 @@ void load_check_link_points(loader *ld)
             slides[m->joints[ji].link[0]] = 1;
     for (int g = 0; g < m->ngears; g++)  /* a gear turning on its pivot: one point will do */
         slides[m->gears[g].link[0]] = slides[m->gears[g].link[1]] = 1;
-    for (int c = 0; c < model_ncams(m); c++)  /* a cam on its pivot likewise */
-        slides[m->cams->cam[c].cam] = 1;
+    for (int c = 0; c < model_ncams(m); c++)  /* a cam on its pivot likewise (a cam whose */
+        if (m->cams->cam[c].cam > 0 && m->cams->cam[c].cam < m->nlinks)  /* link failed: -1) */
+            slides[m->cams->cam[c].cam] = 1;
     for (int li = 1; li < m->nlinks; li++) {
         const mech_link *l = &m->links[li];
         if (!l->name || (ld->link_failed[li] & LINK_FAILED) || slides[li])
