@@ -280,7 +280,7 @@ static int replace_value(ynode *map, const char *key, ynode *v)
     if (!v)
         return -1;
     for (size_t i = 0; i < map->n; i++)
-        if (strcmp(map->items[2 * i]->text, key) == 0) {
+        if (map->items[2 * i]->text && strcmp(map->items[2 * i]->text, key) == 0) {
             ytree_free(map->items[2 * i + 1]);
             map->items[2 * i + 1] = v;
             return 0;
