@@ -488,6 +488,9 @@ void load_state_load(loader *ld, const ynode *map, const ynode *value, int link,
 {
     sl_load l = {value->kind != YNODE_SEQ, link, point, {-1, -1}, map->mark};
     int ok;
+    if (!l.torque && value->n != 2)
+        return (void)load_err(ld, value, "a force needs two components, [Fx, Fy], not %zu",
+                              value->n);
     if (l.torque)
         ok = (l.reg[0] = component(ld, value, Q_TORQUE, "torque")) >= 0;
     else {
