@@ -112,7 +112,7 @@ static int run(const cam_args *a, const mech_model *m)
     double step = cam_default_step();
     if (a->step && (output_parse_quantity(m, a->step, "rad", &step) < 0 || !(step > 0)))
         return cmd_usage_error("cam", "--step needs a positive angle, not '%s'", a->step);
-    int n = cam_steps(m, i, step);
+    int n = cam_steps(step);
     mech_table t;
     int rc = cam_profile_table(m, i, n, &t);
     if (rc != MECH_OK) {

@@ -301,12 +301,8 @@ static int check_model(const mech_model *m, mech_summary *s, mech_diag *d)
         mech_mark at = m->has_driver ? m->driver.mark : (mech_mark){0, 0};
         int excess = s->mobility - s->ndrivers, abs_excess = excess < 0 ? -excess : excess;
         char gruebler[192];
-        char mesh[64] = "";
-        if (m->ngears)
-            snprintf(mesh, sizeof mesh, " - %d gear%s", m->ngears, m->ngears == 1 ? "" : "s");
-        if (s->ncams)
-            snprintf(mesh + strlen(mesh), sizeof mesh - strlen(mesh), " - %d cam%s", s->ncams,
-                     s->ncams == 1 ? "" : "s");
+        char mesh[64];
+        check_higher_pairs_text(s, mesh, sizeof mesh);
         snprintf(gruebler, sizeof gruebler, "%d degree%s of freedom (Gruebler: 3*(%d-1) - 2*%d "
                  "- %d%s = %d) but %d driver%s, so %d unknown%s for %d loop equations",
                  s->mobility, s->mobility == 1 || s->mobility == -1 ? "" : "s", m->nlinks,
@@ -341,6 +337,15 @@ static int check_model(const mech_model *m, mech_summary *s, mech_diag *d)
     free(work);
     free(njoints_of);
     return d->nerrors > before ? diag_status_since(d, first, MECH_EINPUT) : MECH_OK;
+}
+
+void check_higher_pairs_text(const mech_summary *s, char *buf, size_t size)
+{
+    int n = snprintf(buf, size, "%s", "");
+    if (s->ngears)
+        n = snprintf(buf, size, " - %d gear%s", s->ngears, s->ngears == 1 ? "" : "s");
+    if (s->ncams && n >= 0 && (size_t)n < size)
+        snprintf(buf + n, size - (size_t)n, " - %d cam%s", s->ncams, s->ncams == 1 ? "" : "s");
 }
 
 int mech_check(const mech_model *m, mech_summary *s, mech_diag *d)

@@ -241,6 +241,10 @@ ex gears_row(mech_system *s, int i);
  * force system's unknown. */
 void gears_rt(const mech_model *m, int i, rt_gear *out);
 
+/* check.c: the higher pairs' terms of Gruebler's count, " - 2 gears - 1 cam"
+ * (empty without any), as mech check's summary and its error show them. */
+void check_higher_pairs_text(const mech_summary *s, char *buf, size_t size);
+
 /* Gear pair i in words, as mech check shows it. */
 void gears_describe(const mech_model *m, int i, char *buf, size_t size);
 

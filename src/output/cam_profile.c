@@ -162,9 +162,8 @@ int cam_outline_dxf(const mech_model *m, int i, const mech_table *t, const char 
     return write_file_whole(path, emit_dxf, &o, d);
 }
 
-int cam_steps(const mech_model *m, int i, double step)
+int cam_steps(double step)
 {
-    (void)m, (void)i;
     double n = ceil(2.0 * PI / step - 1e-9);  /* a whole turn of the cam */
     return n < 3 ? 3 : n > 1e7 ? 10000000 : (int)n;
 }
@@ -218,7 +217,7 @@ int cam_figures_each(const mech_model *m, cam_figure_fn write, void *ctx, mech_d
     for (int i = 0; i < model_ncams(m) && rc == MECH_OK; i++) {
         mech_table t;
         plot_figure figs[CAM_FIGURES];
-        rc = cam_profile_table(m, i, cam_steps(m, i, cam_default_step()), &t);
+        rc = cam_profile_table(m, i, cam_steps(cam_default_step()), &t);
         if (rc != MECH_OK)
             rc = diag_nomem(d, m->file, (mech_mark){0, 0});
         int n = rc == MECH_OK ? cam_plan(m, i, figs) : 0;

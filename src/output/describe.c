@@ -58,12 +58,8 @@ void model_describe(const mech_model *m, const mech_summary *s, describe_emit em
     snprintf(b, sizeof b, "%d independent%s, %d equations", s->nloops,
              m->nloops ? " (listed in the file)" : " (found automatically)", s->nequations);
     emit(ctx, "loops", b);
-    char mesh[64] = "";  /* each gear pair, rack or cam removes one freedom (gears.c) */
-    if (s->ngears)
-        snprintf(mesh, sizeof mesh, " - %d gear%s", s->ngears, s->ngears == 1 ? "" : "s");
-    if (s->ncams)
-        snprintf(mesh + strlen(mesh), sizeof mesh - strlen(mesh), " - %d cam%s", s->ncams,
-                 s->ncams == 1 ? "" : "s");
+    char mesh[64];  /* each gear pair, rack or cam removes one freedom */
+    check_higher_pairs_text(s, mesh, sizeof mesh);
     snprintf(b, sizeof b, "%d = 3*(%d-1) - 2*%d - %d%s, drivers %d", s->mobility, s->nlinks,
              s->nrevolute + s->nprismatic, s->npin_in_slot, mesh, s->ndrivers);
     emit(ctx, "mobility", b);

@@ -608,9 +608,9 @@ int cam_outline_svg(const mech_model *m, int i, const mech_table *t, const char 
                     mech_diag *d);
 int cam_outline_dxf(const mech_model *m, int i, const mech_table *t, const char *path,
                     mech_diag *d);
-/* The number of angles at most `step` apart over cam i's period (3 to 1e7),
+/* The number of angles at most `step` apart over a turn (3 to 1e7),
  * and the default step (1 deg). */
-int cam_steps(const mech_model *m, int i, double step);
+int cam_steps(double step);
 double cam_default_step(void);
 /* The figures of cam i (mech plot, mech report) over its profile table:
  * the lift and its three derivatives against the cam's angle, and the

@@ -30,6 +30,8 @@ enum { ANIM_SCALE_BAR = 18 };  /* px below the bottom pad: the scale bar's strip
 enum { ANIM_LEGEND = 36 };     /* px under the caption for the legend of a ghost */
 
 /* The animation: the table's positions on screen, the frames, the outlines. */
+enum { CAM_SEGMENTS = 180 };  /* points of a cam's drawn profile */
+
 typedef struct anim_ctx {
     const mech_model *m;
     const mech_table *t;
@@ -50,6 +52,8 @@ typedef struct anim_ctx {
     double *GX, *GY;   /* [points of all links] the ghost pose's points, world m then
                           screen px (o->ghost), else NULL */
     int *gbase;        /* [nlinks] index in GX, GY of each link's first point */
+    double *cam;       /* [ncams * 2 CAM_SEGMENTS] each cam's profile from its pivot, in its
+                          frame, m (computed once: the same at every frame) */
 } anim_ctx;
 
 static double cross3(const mech_point *o, const mech_point *a, const mech_point *b)
@@ -111,6 +115,7 @@ static void anim_free(anim_ctx *c)
     free(c->GX);
     free(c->GY);
     free(c->gbase);
+    free(c->cam);
 }
 
 /* Sliding point (name id), through point (name id) and guide link of joint j. */
@@ -143,8 +148,9 @@ static int anim_alloc(anim_ctx *c, mech_diag *d)
     c->on_ground = xcalloc((size_t)c->np + 1, 1);
     c->pinned = xcalloc((size_t)c->np + 1, 1);
     c->rows = xcalloc((size_t)c->nrows, sizeof *c->rows);
+    c->cam = xcalloc(2 * CAM_SEGMENTS * (size_t)model_ncams(m) + 1, sizeof *c->cam);
     if (!c->X || !c->Y || !c->ang || !c->guide || !c->hull || !c->nhull || !c->on_ground ||
-        !c->pinned || !c->rows)
+        !c->pinned || !c->rows || !c->cam)
         return diag_nomem(d, m->file, (mech_mark){0, 0});
     return MECH_OK;
 }
@@ -347,20 +353,22 @@ static void place_gears(const anim_ctx *c, box *b)
 }
 
 /* A cam's profile (docs/cams.md 5): drawn about its pivot in the cam's
- * frame, CAM_SEGMENTS points of cam_geometry; the box holds its farthest. */
-enum { CAM_SEGMENTS = 180 };
+ * frame, CAM_SEGMENTS points of cam_geometry over a turn (kept in c->cam);
+ * the box holds its farthest. */
 
-static void place_cams(const anim_ctx *c, box *b)
+static void place_cams(anim_ctx *c, box *b)
 {
     for (int w = 0; w < model_ncams(c->m); w++) {
         const mech_cam *cm = &c->m->cams->cam[w];
         const mech_point *oc = &c->m->links[cm->cam].points[cm->cam_pivot[0]];
         int p = oc->id;
-        double rad = 0.0;
+        double rad = 0.0, *xy = c->cam + 2 * CAM_SEGMENTS * (size_t)w;
         for (int k = 0; k < CAM_SEGMENTS; k++) {  /* a whole turn */
             cam_point g;
             cam_geometry(c->m, cm, 2.0 * 3.14159265358979323846 * k / CAM_SEGMENTS, &g);
-            rad = fmax(rad, hypot(g.profile[0] - oc->x, g.profile[1] - oc->y));
+            xy[2 * k] = g.profile[0] - oc->x;
+            xy[2 * k + 1] = g.profile[1] - oc->y;
+            rad = fmax(rad, hypot(xy[2 * k], xy[2 * k + 1]));
         }
         hold_circle(c, p, rad, b);
     }
@@ -529,10 +537,9 @@ static int cam_shape(const anim_ctx *c, int which, int r, double *xs, double *ys
     const mech_point *oc = &c->m->links[cm->cam].points[cm->cam_pivot[0]];
     double x = c->X[(size_t)r * c->np + oc->id], y = c->Y[(size_t)r * c->np + oc->id];
     double a = c->ang[(size_t)r * c->m->nlinks + cm->cam], ca = cos(a), sa = sin(a);
-    for (int k = 0; k < CAM_SEGMENTS; k++) {  /* a whole turn */
-        cam_point g;
-        cam_geometry(c->m, cm, 2.0 * 3.14159265358979323846 * k / CAM_SEGMENTS, &g);
-        double dx = g.profile[0] - oc->x, dy = g.profile[1] - oc->y;
+    const double *xy = c->cam + 2 * CAM_SEGMENTS * (size_t)which;
+    for (int k = 0; k < CAM_SEGMENTS; k++) {
+        double dx = xy[2 * k], dy = xy[2 * k + 1];
         xs[k] = x + c->s * (ca * dx - sa * dy);
         ys[k] = y - c->s * (sa * dx + ca * dy);  /* screen y points down */
     }
