@@ -66,15 +66,20 @@ SOABI    = $(if $(filter 0,$(SOMAJOR)),0.$(SOMINOR),$(SOMAJOR))
 SONAME   = libmech.so.$(SOABI)
 
 SRC_INC = $(addprefix -I,$(SRC_DIRS))
-CFLAGS  = $(CFLAGS_BASE) $(OPT) $(SAN) -Iinclude $(SRC_INC) $(YAML_CFLAGS) $(KLU_CFLAGS) $(MINPACK_CFLAGS) $(HDF5_CFLAGS)
+CFLAGS  = $(CFLAGS_BASE) $(OPT) $(SAN) -Iinclude $(SRC_INC) $(YAML_CFLAGS) $(KLU_CFLAGS) $(MINPACK_CFLAGS) $(HDF5_CFLAGS) $(GSL_CFLAGS)
 # HDF5 (binary output, -o OUT.h5; src/output/output_h5.c): Debian's
 # libhdf5-dev, its serial flavour (pkg-config's plain hdf5 may be MPI's)
 HDF5_CFLAGS := $(shell pkg-config --cflags hdf5-serial 2>/dev/null || echo -I/usr/include/hdf5/serial)
 HDF5_LIBS   := $(shell pkg-config --libs hdf5-serial 2>/dev/null || echo -lhdf5_serial)
 # SUNDIALS CVODE (mech simulate, docs/dynamics.md): Debian's libsundials-dev
+# GSL (libgsl-dev): the periodic cubic splines and the one-dimensional
+# minimiser and root finder of a cam given by its profile's points
+# (src/load/cam_points.c, docs/cams.md 7)
+GSL_CFLAGS := $(shell pkg-config --cflags gsl 2>/dev/null)
+GSL_LIBS   := $(shell pkg-config --libs gsl 2>/dev/null || echo -lgsl -lgslcblas)
 SUNDIALS_LIBS = -lsundials_cvode -lsundials_sunlinsoldense -lsundials_sunmatrixdense \
                 -lsundials_nvecserial -lsundials_generic
-LDLIBS  = $(YAML_LIBS) $(KLU_LIBS) $(SUNDIALS_LIBS) $(HDF5_LIBS) $(MINPACK_LIBS) -lm -pthread
+LDLIBS  = $(YAML_LIBS) $(KLU_LIBS) $(SUNDIALS_LIBS) $(HDF5_LIBS) $(MINPACK_LIBS) $(GSL_LIBS) -lm -pthread
 LDFLAGS = $(SAN) -pthread
 
 # src/ is one folder per stage of the pipeline, each with one header
@@ -386,7 +391,7 @@ install: all $(if $(filter 1,$(WITH_PYTHON)),python)
 	install -m 755 $(BUILD)/libmech.so.$(VERSION) $(DESTDIR)$(PREFIX)/lib/libmech.so.$(VERSION)
 	ln -sf libmech.so.$(VERSION) $(DESTDIR)$(PREFIX)/lib/$(SONAME)
 	ln -sf $(SONAME) $(DESTDIR)$(PREFIX)/lib/libmech.so
-	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@VERSION@|$(VERSION)|' -e 's|@KLU_LIBS@|$(KLU_LIBS) $(SUNDIALS_LIBS) $(HDF5_LIBS)|' \
+	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@VERSION@|$(VERSION)|' -e 's|@KLU_LIBS@|$(KLU_LIBS) $(SUNDIALS_LIBS) $(HDF5_LIBS) $(GSL_LIBS)|' \
 	    mech.pc.in >$(DESTDIR)$(PREFIX)/lib/pkgconfig/mech.pc
 	install -m 644 include/mech.h $(DESTDIR)$(PREFIX)/include/mech.h
 	install -m 644 docs/mech.1 $(DESTDIR)$(PREFIX)/share/man/man1/mech.1

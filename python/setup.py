@@ -95,6 +95,8 @@ yaml_libs = pkg_config('--libs', 'yaml-0.1', ['-lyaml'])
 # HDF5's serial flavour, as the Makefile's HDF5_CFLAGS and HDF5_LIBS
 hdf5_cflags = pkg_config('--cflags', 'hdf5-serial', ['-I/usr/include/hdf5/serial'])
 hdf5_libs = pkg_config('--libs', 'hdf5-serial', ['-lhdf5_serial'])
+# GSL, as the Makefile's GSL_LIBS (a cam's profile points, src/load/cam_points.c)
+gsl_libs = pkg_config('--libs', 'gsl', ['-lgsl', '-lgslcblas'])
 
 
 def sundials_libs():
@@ -126,7 +128,7 @@ extension = Extension(
     define_macros=buildinfo.define_macros(),
     extra_compile_args=['-std=c11', '-D_POSIX_C_SOURCE=200809L'] + klu_cflags + hdf5_cflags +
     minpack_cflags,
-    extra_link_args=yaml_libs + klu_libs + sundials_libs() + hdf5_libs + minpack_libs +
+    extra_link_args=yaml_libs + klu_libs + sundials_libs() + hdf5_libs + minpack_libs + gsl_libs +
     ['-lm', '-pthread'],
 )
 

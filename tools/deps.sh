@@ -3,7 +3,7 @@
 # Runs apt-get as root, or through sudo when not root.
 set -e
 # Extra packages may be named as arguments (make test-slurm: slurm-wlm munge).
-PKGS="make gcc libc6-dev pkg-config libyaml-dev libsuitesparse-dev libsundials-dev libhdf5-dev libcriterion-dev python3-dev python3-numpy python3-pytest parallel libcminpack-dev libnlopt-dev $*"
+PKGS="make gcc libc6-dev pkg-config libyaml-dev libsuitesparse-dev libsundials-dev libhdf5-dev libgsl-dev libcriterion-dev python3-dev python3-numpy python3-pytest parallel libcminpack-dev libnlopt-dev $*"
 missing=""
 for p in $PKGS; do
     if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then

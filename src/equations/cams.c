@@ -61,11 +61,16 @@ void cams_describe(const mech_model *m, int i, char *buf, size_t size)
     else
         snprintf(base, sizeof base, "'%s' at %.6g deg %c s", m->links[c->follower].name,
                  c->c0 * deg, c->rise > 0 ? '+' : '-');
-    char roller[48] = "";
+    char roller[48] = "", law[64];
+    if (c->points)
+        snprintf(law, sizeof law, "profile of %d points (the lift at every %.6g deg)",
+                 c->npoints, p->period / p->n * deg);
+    else
+        snprintf(law, sizeof law, "program of %d segments over %.6g deg", p->n, p->period * deg);
     if (c->roller > 0)
         snprintf(roller, sizeof roller, ", roller %.6g mm", c->roller * 1e3);
     snprintf(buf, size, "%s: cam '%s' on '%s' turning %s, %s follower %s, base radius %.6g mm"
-             "%s, program of %d segments over %.6g deg", c->name, m->links[c->cam].name,
+             "%s, %s", c->name, m->links[c->cam].name,
              m->links[c->arm].name, c->sense > 0 ? "ccw" : "cw", contact[c->contact], base,
-             c->base * 1e3, roller, p->n, p->period * deg);
+             c->base * 1e3, roller, law);
 }

@@ -560,7 +560,8 @@ static int same_program(const mech_program *p, const mech_program *q)
         const prog_segment *x = &p->seg[i], *y = &q->seg[i];
         if (x->kind != y->kind || x->shape != y->shape || !same_bits(x->x0, y->x0) ||
             !same_bits(x->span, y->span) || !same_bits(x->s0, y->s0) ||
-            !same_bits(x->lift, y->lift) || !same_law(x->user_law, y->user_law))
+            !same_bits(x->lift, y->lift) || !same_law(x->user_law, y->user_law) ||
+            x->npieces != y->npieces || memcmp(x->piece, y->piece, sizeof x->piece) != 0)
             return 0;
     }
     return 1;

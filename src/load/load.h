@@ -359,7 +359,7 @@ typedef enum {
     SHAPE_NONE = RT_SHAPE_NONE, SHAPE_CYCLOIDAL = RT_SHAPE_CYCLOIDAL,
     SHAPE_HARMONIC = RT_SHAPE_HARMONIC, SHAPE_345 = RT_SHAPE_345, SHAPE_4567 = RT_SHAPE_4567,
     SHAPE_MODTRAP = RT_SHAPE_MODTRAP, SHAPE_MODSINE = RT_SHAPE_MODSINE,
-    SHAPE_USER = RT_SHAPE_USER
+    SHAPE_USER = RT_SHAPE_USER, SHAPE_CUBIC = RT_SHAPE_CUBIC
 } prog_shape;
 enum { PROG_USER_MAX_NODES = RT_LAW_USER_MAX };  /* operations in a segment's f(u) */
 /* a segment (rt_law.h): kind, shape, x0, span (SI of x), s0 (s at its
@@ -784,6 +784,10 @@ typedef struct mech_cam {
     double c0;           /* the follower's coordinate at zero lift (m or rad) */
     int rise;            /* +1 or -1: the coordinate's change as the lift grows */
     struct mech_law *program; /* the lift s(x), a law of x: owned */
+    double *points;      /* a cam given by its profile: [2 * npoints] the points in the
+                            cam's frame, m (owned; cam_points.c), and the program is
+                            the lift they give; NULL when the file gives the program */
+    int npoints;
     mech_mark mark;
     /* the design quantities over the period (load_cams_place; docs/cams.md 3),
        each with its x where it is worst */
@@ -817,6 +821,14 @@ typedef struct cam_point {
                             follower's line, m; else 0 */
 } cam_point;
 void cam_geometry(const mech_model *m, const mech_cam *c, double x, cam_point *g);
+/* cam_points.c: a cam given by its profile's points (docs/cams.md 7).
+ * 'profile: [[x, y], ...]' or '{file: CSV}' into c->points (1, or 0 reported);
+ * the least distance of their closed curve from the cam's centre into
+ * c->base (1, or 0 reported; once the cam's pivot is known); the follower's
+ * lift they give as c->program (after the follower is placed). */
+int cam_points_load(loader *ld, const ynode *n, mech_cam *c);
+int cam_points_base(loader *ld, mech_cam *c);
+int cam_points_program(loader *ld, mech_cam *c);
 /* The base positions that need the follower's guess (after the guesses). */
 void load_cams_place(loader *ld);
 void model_cams_free(model_cams *c);

@@ -31,6 +31,7 @@ void model_cams_free(model_cams *c)
         return;
     for (int i = 0; i < c->n; i++) {
         free(c->cam[i].name);
+        free(c->cam[i].points);
         law_free(c->cam[i].program);
     }
     free(c->cam);
@@ -55,12 +56,16 @@ static int load_contact(loader *ld, const ynode *map, mech_cam *c)
         return load_err(ld, n, "'contact' is roller, knife-edge or flat-faced, not '%s'",
                         n->text), 0;
     c->contact = (cam_contact)k;
-    if (!b)
+    if (!b && !c->points)
         return load_err(ld, map, "a cam needs 'base_radius' (the radius of the base circle, "
                         "the profile's least)"), 0;
-    if (!load_get_quantity(ld, b, Q_LENGTH, "base_radius", &c->base))
+    if (b && c->points)
+        return load_err(ld, load_key_of(map, "base_radius"), "a cam given by its 'profile' has "
+                        "the base circle of the profile (its least distance from the centre): "
+                        "'base_radius' does not apply"), 0;
+    if (b && !load_get_quantity(ld, b, Q_LENGTH, "base_radius", &c->base))
         return 0;
-    if (!(c->base > 0.0))
+    if (b && !(c->base > 0.0))
         return load_err(ld, b, "base_radius must be positive"), 0;
     if (c->contact == CAM_ROLLER && !r)
         return load_err(ld, map, "a roller follower needs 'roller_radius'"), 0;
@@ -111,6 +116,8 @@ static int place_translating(loader *ld, const ynode *fn, mech_cam *c)
         return load_err(ld, fn, "the cam '%s' has no pivot on '%s', the follower's guide (no "
                         "revolute joint joins them): the cam must turn on the link that guides "
                         "its follower", m->links[c->cam].name, m->links[c->arm].name), 0;
+    if (c->points && !cam_points_base(ld, c))
+        return 0;
     const mech_point *o = point_of(m, c->arm, c->cam_pivot[1]);
     const mech_point *t = point_of(m, c->arm, jt->point[1]);
     double ux = cos(jt->angle), uy = sin(jt->angle);
@@ -189,7 +196,7 @@ static int load_oscillating(loader *ld, const ynode *map, const ynode *fn, mech_
 {
     const ynode *at = ymap_get(map, "at");
     c->motion = CAM_OSCILLATING;
-    if (!find_arm(ld, fn, c))
+    if (!find_arm(ld, fn, c) || (c->points && !cam_points_base(ld, c)))
         return 0;
     if (c->contact == CAM_FLAT_FACED)
         return load_face(ld, map, c);
@@ -360,7 +367,8 @@ static int closed_profile(loader *ld, const ynode *pm, mech_cam *c)
 
 static int load_one(loader *ld, const ynode *map, mech_cam *c)
 {
-    const ynode *cn = ymap_get(map, "cam"), *pm = ymap_get(map, "program");
+    const ynode *cn = ymap_get(map, "cam"), *pm = ymap_get(map, "program"),
+                *pr = ymap_get(map, "profile");
     c->mark = map->mark;
     if (!cn)
         return load_err(ld, map, "a cam needs 'cam': the link that carries the profile"), 0;
@@ -369,12 +377,21 @@ static int load_one(loader *ld, const ynode *map, mech_cam *c)
         return 0;
     if (c->cam == 0)
         return load_err(ld, cn, "the ground cannot be the cam: a cam turns"), 0;
+    if (pm && pr)
+        return load_err(ld, load_key_of(map, "profile"), "a cam has 'program' (the follower's "
+                        "lift, the profile derived) or 'profile' (its points, the lift "
+                        "derived), not both"), 0;
+    if (pr && !cam_points_load(ld, pr, c))
+        return 0;
     if (!load_contact(ld, map, c) || !load_phase(ld, map, c) || !load_follower(ld, map, c) ||
         !load_friction(ld, ymap_get(map, "friction"), c))
         return 0;
+    if (pr)
+        return 1;  /* the lift comes from the points once the follower is placed */
     if (!pm)
-        return load_err(ld, map, "a cam needs 'program': the follower's lift against the cam's "
-                        "angle (segments of rise, dwell and return)"), 0;
+        return load_err(ld, map, "a cam needs 'program' (the follower's lift against the cam's "
+                        "angle: segments of rise, dwell and return) or 'profile' (the "
+                        "profile's points)"), 0;
     char who[MAX_NAME + 16];
     snprintf(who, sizeof who, "cam '%s'", c->name);
     if (!load_program_as(ld, pm, c->motion == CAM_TRANSLATING ? Q_LENGTH : Q_ANGLE, who, 1,
@@ -409,7 +426,7 @@ void load_cams(loader *ld, const ynode *seq)
 {
     static const char *const keys[] = {"name", "cam", "follower", "contact", "base_radius",
                                        "roller_radius", "at", "face", "turning", "start",
-                                       "friction", "program"};
+                                       "friction", "program", "profile"};
     if (!load_want_kind(ld, seq, YNODE_SEQ, "'cams'"))
         return;
     if (seq->n > MAX_CAMS)
@@ -444,7 +461,7 @@ static void scan_design(loader *ld, mech_cam *c)
 {
     const struct mech_program *p = c->program->progs[0];
     int n = (int)ceil(p->period / (0.1 * PI / 180.0));
-    if (n < 100 * p->n)
+    if (n < 100 * p->n && !c->points)  /* a profile's spline: one sample a piece */
         n = 100 * p->n;
     c->pressure_max = 0.0, c->rho_pitch_min = c->rho_profile_min = INFINITY;
     c->face_lo = INFINITY, c->face_hi = -INFINITY;
@@ -490,8 +507,10 @@ void load_cams_place(loader *ld)
     for (int i = 0; cs && i < cs->n; i++) {
         mech_cam *c = &cs->cam[i];
         size_t before = ld->d->nerrors;
-        if (c->motion == CAM_OSCILLATING && c->program)
+        if (c->motion == CAM_OSCILLATING && (c->program || c->points))
             (c->contact == CAM_FLAT_FACED ? place_face : place_oscillating)(ld, c);
+        if (c->points && !c->program && ld->d->nerrors == before)
+            cam_points_program(ld, c);
         if (c->program && ld->d->nerrors == before)
             scan_design(ld, c);
     }

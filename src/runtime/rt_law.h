@@ -33,7 +33,7 @@ enum {
 /* a program segment's law (shape) */
 enum {
     RT_SHAPE_NONE, RT_SHAPE_CYCLOIDAL, RT_SHAPE_HARMONIC, RT_SHAPE_345, RT_SHAPE_4567,
-    RT_SHAPE_MODTRAP, RT_SHAPE_MODSINE, RT_SHAPE_USER
+    RT_SHAPE_MODTRAP, RT_SHAPE_MODSINE, RT_SHAPE_USER, RT_SHAPE_CUBIC
 };
 enum { RT_LAW_USER_MAX = 256 };  /* operations of a segment's own law f(u) */
 
@@ -241,6 +241,15 @@ RT_LAWFN void rt_shape_eval(const rt_segment *sg, double u, double f[4])
         while (j > 0 && u < sg->piece[j].u0)
             j--;
         rt_piece_at(&sg->piece[j], u, f);
+        break;
+    }
+    case RT_SHAPE_CUBIC: {  /* a spline's piece (a cam's profile points): piece[0] holds
+                               f = f1 u + c0 u^2 / 2 + c1 u^3 / 6 */
+        const rt_piece *p = &sg->piece[0];
+        f[3] = p->c1;
+        f[2] = p->c0 + p->c1 * u;
+        f[1] = p->f1 + u * (p->c0 + 0.5 * p->c1 * u);
+        f[0] = u * (p->f1 + u * (0.5 * p->c0 + p->c1 * u / 6.0));
         break;
     }
     case RT_SHAPE_USER: {
