@@ -242,6 +242,7 @@ define SUITES
 	$(TIMED) drivers $(SUITE_ENV) sh tests/drivers.sh
 	$(TIMED) programs $(SUITE_ENV) sh tests/programs.sh
 	$(TIMED) cams $(SUITE_ENV) sh tests/cams.sh
+	$(TIMED) cam_points $(SUITE_ENV) sh tests/cam_points.sh
 	$(TIMED) fit $(SUITE_ENV) sh tests/fit.sh
 	$(TIMED) dynamics $(SUITE_ENV) sh tests/dynamics.sh
 	$(TIMED) drawn $(SUITE_ENV) sh tests/drawn.sh

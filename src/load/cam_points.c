@@ -26,7 +26,6 @@
 #include <gsl/gsl_spline.h>
 
 #include "load.h"
-#include "output.h"
 
 enum {
     MAX_POINTS = 100000,
@@ -96,8 +95,100 @@ static void curve_at(curve *cv, double u, double p[2])
 
 /* ---- reading the points ---------------------------------------------------- */
 
-/* 'profile: {file: CSV}': the columns profile.x and profile.y (mech cam's),
- * else x and y; each in its header's unit, else the file's length unit. */
+/* A header cell "NAME [UNIT]" of length n: does NAME equal want? The
+ * unit's text into unit (empty when none). */
+static int header_cell(const char *cell, size_t n, const char *want, char *unit, size_t usize)
+{
+    const char *br = memchr(cell, '[', n);
+    size_t name = br ? (size_t)(br - cell) : n;
+    while (name > 0 && cell[name - 1] == ' ')
+        name--;
+    unit[0] = 0;
+    if (br) {
+        const char *close = memchr(br, ']', n - (size_t)(br - cell));
+        size_t ul = close ? (size_t)(close - br - 1) : 0;
+        if (ul < usize)
+            memcpy(unit, br + 1, ul), unit[ul] = 0;
+    }
+    return strlen(want) == name && memcmp(cell, want, name) == 0;
+}
+
+/* The header's columns of x and y (profile.x and profile.y, as mech cam
+ * writes, else x and y) and their units' scales (the file's length unit
+ * when none). */
+static int csv_columns(loader *ld, const ynode *f, const char *path, const char *line,
+                       const mech_cam *c, int col[2], double scale[2])
+{
+    static const char *const names[2][2] = {{"profile.x", "x"}, {"profile.y", "y"}};
+    char unit[2][64];
+    col[0] = col[1] = -1;
+    for (int w = 0; w < 2; w++) {
+        const char *cell = line;
+        for (int j = 0; *cell && *cell != '\n'; j++) {
+            size_t n = strcspn(cell, ",\r\n");
+            char u[64];
+            for (int k = 0; k < 2; k++)
+                if (col[k] < 0 && header_cell(cell, n, names[k][w], u, sizeof u))
+                    col[k] = j, memcpy(unit[k], u, sizeof u);
+            cell += n;
+            if (*cell == ',')
+                cell++;
+            else
+                break;
+        }
+    }
+    if (col[0] < 0 || col[1] < 0)
+        return load_err(ld, f, "cam '%s': '%s' has no columns profile.x and profile.y (mech "
+                        "cam's) or x and y", c->name, path), 0;
+    for (int k = 0; k < 2; k++) {
+        dim d;
+        const char *end;
+        scale[k] = file_units_of(ld->m->units, quantity_get(Q_LENGTH)->d, NULL, 0);
+        if (unit[k][0] && (!unit_parse(unit[k], &scale[k], &d, &end) || *end ||
+                           !dim_equal(d, quantity_get(Q_LENGTH)->d)))
+            return load_err(ld, f, "cam '%s': the profile's %s column of '%s' is in '%s', not a "
+                            "length", c->name, k ? "y" : "x", path, unit[k]), 0;
+    }
+    return 1;
+}
+
+/* The numbers of columns col[0], col[1] of the data line at *at (advanced
+ * past it). 1 read, 0 a blank line, -1 malformed (*bad: its column). */
+static int csv_row(const char **at, const int col[2], double v[2], int *bad)
+{
+    const char *p = *at;
+    int got = 0, j = 0, blank = 1;
+    for (;; j++) {
+        size_t n = strcspn(p, ",\r\n");
+        if (n > 0)
+            blank = 0;
+        for (int k = 0; k < 2; k++)
+            if (j == col[k]) {
+                char *end;
+                v[k] = strtod(p, &end);
+                while (end < p + n && *end == ' ')
+                    end++;
+                if (end != p + n || n == 0)
+                    *bad = j + 1;
+                else
+                    got |= 1 << k;
+            }
+        p += n;
+        if (*p != ',')
+            break;
+        p++;
+    }
+    while (*p == '\r')
+        p++;
+    if (*p == '\n')
+        p++;
+    *at = p;
+    return blank && j == 0 ? 0 : got == 3 ? 1 : -1;
+}
+
+/* 'profile: {file: CSV}' (relative to the file's folder): the columns
+ * profile.x and profile.y (mech cam's) or x and y, each in its header's
+ * unit, else the file's length unit. */
 static int points_of_csv(loader *ld, const ynode *f, mech_cam *c, double **out, int *n)
 {
     char path[4096];
@@ -105,46 +196,41 @@ static int points_of_csv(loader *ld, const ynode *f, mech_cam *c, double **out, 
     int len = f->text[0] != '/' && slash ? (int)(slash - ld->file) + 1 : 0;
     if ((size_t)snprintf(path, sizeof path, "%.*s%s", len, ld->file, f->text) >= sizeof path)
         return load_err(ld, f, "the profile's path is too long"), 0;
-    compare_table t = {0};
-    if (compare_read_csv(path, &t, ld->d) != MECH_OK)
+    size_t size;
+    int rc, col[2];
+    double scale[2];
+    char *raw = load_read_file(path, (size_t)64 << 20, &size, ld->d, &rc);
+    char *text = raw ? malloc(size + 1) : NULL;  /* a string: the reader's is not ended */
+    if (text)
+        memcpy(text, raw, size), text[size] = 0;
+    free(raw);
+    if (!text)
         return load_err(ld, f, "cam '%s': the profile '%s' cannot be read (above)", c->name,
                         path), 0;
-    int col[2] = {-1, -1};
-    static const char *const names[2][2] = {{"profile.x", "x"}, {"profile.y", "y"}};
-    for (int k = 0; k < 2; k++)
-        for (int w = 0; w < 2 && col[k] < 0; w++)
-            for (size_t j = 0; j < t.ncols; j++)
-                if (strcmp(t.names[j], names[k][w]) == 0)
-                    col[k] = (int)j;
-    double scale[2];
-    int ok = col[0] >= 0 && col[1] >= 0;
-    if (!ok)
-        load_err(ld, f, "cam '%s': '%s' has no columns profile.x and profile.y (mech cam's) "
-                 "or x and y", c->name, path);
-    for (int k = 0; ok && k < 2; k++) {
-        const char *u = t.units[col[k]];
-        dim d;
-        const char *end;
-        if (!u || !u[0]) {
-            scale[k] = file_units_of(ld->m->units, quantity_get(Q_LENGTH)->d, NULL, 0);
-        } else if (!unit_parse(u, &scale[k], &d, &end) || *end ||
-                   !dim_equal(d, quantity_get(Q_LENGTH)->d)) {
-            ok = load_err(ld, f, "cam '%s': column %s of '%s' is in '%s', not a length",
-                          c->name, t.names[col[k]], path, u);
-        }
-    }
-    if (ok && (t.nrows > MAX_POINTS))
-        ok = load_err(ld, f, "cam '%s': %zu profile points (at most %d)", c->name, t.nrows,
-                      MAX_POINTS);
-    double *p = ok ? xcalloc(2 * t.nrows + 2, sizeof *p) : NULL;
-    if (ok && !p)
+    const char *at = strchr(text, '\n');
+    size_t lines = 0;
+    for (const char *q = text; *q; q++)
+        lines += *q == '\n';
+    double *p = lines <= MAX_POINTS ? xcalloc(2 * lines + 2, sizeof *p) : NULL;
+    int ok = csv_columns(ld, f, path, text, c, col, scale);
+    if (ok && lines > MAX_POINTS)
+        ok = load_err(ld, f, "cam '%s': more than %d profile points in '%s'", c->name,
+                      MAX_POINTS, path);
+    else if (ok && !p)
         ok = (load_nomem(ld, f), 0);
-    for (size_t r = 0; ok && r < t.nrows; r++)
-        for (int k = 0; k < 2; k++)
-            p[2 * r + k] = t.values[r * t.ncols + (size_t)col[k]] * scale[k];
+    *n = 0;
+    for (int line = 2; ok && at && *++at; line++) {
+        double v[2];
+        int bad = 0, r = csv_row(&at, col, v, &bad);
+        if (r < 0)
+            ok = (diag_error(ld->d, path, (mech_mark){line, bad ? bad : 1}, "not a number in "
+                             "the profile's %s column", bad == col[1] + 1 ? "y" : "x"), 0);
+        else if (r > 0 && *n < (int)lines)
+            p[2 * *n] = v[0] * scale[0], p[2 * *n + 1] = v[1] * scale[1], ++*n;
+        at--;  /* at the next line's start: the loop's ++ steps onto it */
+    }
+    free(text);
     *out = p;
-    *n = (int)t.nrows;
-    compare_table_free(&t);
     return ok;
 }
 
@@ -517,6 +603,11 @@ static int sample_lifts(loader *ld, mech_cam *c, contact *k, double *s, int n)
         if (!(s[i] > UNDEFINED / 2) || !isfinite(s[i]))
             ok = !diag_error(ld->d, ld->file, c->mark, "cam '%s': at %.4g deg of the cam the "
                             "follower does not touch the profile", c->name, x * 180.0 / PI);
+        else if (c->motion == CAM_OSCILLATING && s[i] > k->far - 1e-9)
+            ok = !diag_error(ld->d, ld->file, c->mark, "cam '%s': at %.4g deg of the cam the "
+                             "follower cannot clear the profile: it would have to swing past "
+                             "its farthest reach from the cam's centre (%.6g deg from its base "
+                             "position)", c->name, x * 180.0 / PI, k->far * 180.0 / PI);
         else if (s[i] < -tol)
             ok = !diag_error(ld->d, ld->file, c->mark, "cam '%s': at %.4g deg of the cam the "
                             "follower touches the profile inside its base circle (the profile "
