@@ -120,6 +120,20 @@ if run "check oscillating roller" 0 "$MECH" check "$tmp/or.yaml"; then
     has_line "$tmp/out" "cam        disc: .* base radius 30 mm, roller 8 mm, profile of 360 points (the lift at every 0.1 deg)" "check: the profile's cam, its base circle 40 - 10 mm"
 fi
 
+# mech cam's profile of the disc given by points (the envelope of the
+# roller over the derived lift, in the cam's frame) lies on the disc:
+# 40 mm from its centre (10, 0) mm, every 0.1 deg
+for f in tr tf ok; do
+    if run "cam $f" 0 "$MECH" cam "$tmp/$f.yaml" --step 0.1 -o "$tmp/$f.p.csv"; then
+        awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) col[$i] = i; next }
+            { x = $col["profile.x [m]"] - 0.010; y = $col["profile.y [m]"]; e = sqrt(x * x + y * y) - 0.040
+              if (e < 0) e = -e; if (e > w) w = e }
+            END { printf "%.2g m\n", w; exit !(NR > 3600 && w < 1e-8) }' "$tmp/$f.p.csv" >"$tmp/w" &&
+            { pass; [ -z "${VERBOSE:-}" ] || echo "cam $f: $(cat "$tmp/w")"; } ||
+            fail "cam $f: mech cam's profile is $(cat "$tmp/w") off the disc"
+    fi
+done
+
 # the oscillating flat face from A to B: C's distance from its line is 40
 # mm; its rate and acceleration with the line's normal n = J (B - A) / |B - A|
 disc "$OSC_FLAT" '    follower: follower

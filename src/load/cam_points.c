@@ -28,7 +28,7 @@
 #include "load.h"
 
 enum {
-    MAX_POINTS = 100000,
+    MAX_POINTS = 20000,     /* 4 samples a piece at each of 3600 angles: about 3 s at most */
     LIFT_SAMPLES = 3600,    /* the lift found at every 0.1 deg of the cam */
     MIN_DENSE = 720,        /* the curve scanned at 4 places a piece, at least this often */
     MAX_ITER = 100
