@@ -204,6 +204,7 @@ bad "program and profile" "bad.yaml:[0-9]*:5: error: a cam has 'program' (the fo
 bad "base radius and profile" "bad.yaml:[0-9]*:5: error: a cam given by its 'profile' has the base circle of the profile" 's/^    roller_radius: 8 mm/    roller_radius: 8 mm\n    base_radius: 30 mm/'
 bad "centre outside" "bad.yaml:[0-9]*:5: error: cam 'disc': the cam's centre (its pivot O at 70, 0 mm) is not inside its profile" 's/^      O: \[0, 0\]$/      O: [70, 0]/; s/^  O: \[0, 0\]/  O: [70, 0]/'
 bad "too few" "bad.yaml:[0-9]*:14: error: cam 'disc': a profile needs at least 8 points around the cam, not 3" 's/^    profile: .*/    profile: [[40, 0], [0, 40], [-40, 0]]/'
+bad "twice around" "bad.yaml:[0-9]*:5: error: cam 'disc': the profile's points go 2 times around the cam's centre" 's/^    profile: .*/    profile: [[40, 0], [0, 40], [-40, 0], [0, -40], [40, 0.1], [0, 40.1], [-40, 0.1], [0, -40.1]]/'
 bad "repeated point" "error: cam 'disc': profile points 8 and 9 are at one place" 's/^    profile: .*/    profile: [[40, 0], [30, 30], [0, 40], [-30, 30], [-40, 0], [-30, -30], [0, -40], [30, -30], [30, -30]]/'
 bad "not a point" "bad.yaml:[0-9]*:[0-9]*: error: a profile point is \[x, y\], not 3 numbers" 's/^    profile: \[\[/    profile: [[1, /'
 printf 'x [mm],y [mm]\n40,0\n30,30\n0,40\n-30,30\n-40,zero\n' >"$tmp/p.csv"

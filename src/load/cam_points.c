@@ -372,10 +372,15 @@ int cam_points_base(loader *ld, mech_cam *c)
     const mech_model *m = ld->m;
     const mech_point *o = &m->links[c->cam].points[c->cam_pivot[0]];
     contact k = {.c = c, .oc = {o->x, o->y}};
-    if (winds_around(c->points, c->npoints, k.oc) == 0)
+    int turns = winds_around(c->points, c->npoints, k.oc);
+    if (turns == 0)
         return diag_error(ld->d, ld->file, c->mark, "cam '%s': the cam's centre (its pivot %s "
                           "at %.6g, %.6g mm) is not inside its profile", c->name, o->name,
                           o->x * 1e3, o->y * 1e3), 0;
+    if (turns != 1 && turns != -1)
+        return diag_error(ld->d, ld->file, c->mark, "cam '%s': the profile's points go %d times "
+                          "around the cam's centre: a profile goes around once", c->name,
+                          abs(turns)), 0;
     if (!curve_make(&k.cv, c->points, c->npoints))
         return diag_error(ld->d, ld->file, c->mark, "out of memory"), 0;
     k.mn = gsl_min_fminimizer_alloc(gsl_min_fminimizer_brent);
