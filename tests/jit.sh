@@ -245,4 +245,48 @@ MECH_JIT_CACHE=off jitrun "$tmp/c15.csv" && [ -s "$tmp/cc.log" ] && [ ! -e "$cdi
     grep -q "not cached: MECH_JIT_CACHE=off" "$tmp/cache.err" && pass || fail "cache: MECH_JIT_CACHE=off still used it"
 [ -z "$(ls "$tmp/jt")" ] && pass || fail "cache: files left in TMPDIR: $(ls "$tmp/jt")"
 
+
+# ---- --engine auto: compiled by itself where it pays off ------------------
+# autorun ROWS OUT [OPTIONS]: mech solve (no --jit) with MECH_JIT_AUTO_ROWS=ROWS,
+# the automatic choice on, through the logging compiler, --stats in auto.err
+adir=$tmp/auto-cache
+autorun() {
+    rows=$1 out=$2
+    shift 2
+    rm -f "$tmp/cc.log"
+    env -u MECH_JIT_AUTO MECH_JIT_AUTO_ROWS="$rows" MECH_CACHE_DIR="$adir" TMPDIR=$tmp/jt \
+        CC=$tmp/cc-log "$MECH" solve mechanisms/fourbar.yaml -q --stats "$@" -o "$out" 2>"$tmp/auto.err"
+}
+# 361 rows, fewer than a hundredth of 100 000: interpreted, no compiler run
+autorun 100000 "$tmp/a1.csv" && [ ! -e "$tmp/cc.log" ] &&
+    grep -q "solver .*interpreted (auto: 361 rows, fewer than the 100000 from which compiling pays off)" "$tmp/auto.err" &&
+    cmp -s "$tmp/a1.csv" "$tmp/c-interp.csv" && pass || fail "auto: a short run was not interpreted: $(grep solver "$tmp/auto.err")"
+# 361 rows from 300: compiled and stored, the interpreter's table byte for byte
+autorun 300 "$tmp/a2.csv" && [ -s "$tmp/cc.log" ] && grep -q "solver .*compiled (auto: compiled in" "$tmp/auto.err" &&
+    cmp -s "$tmp/a2.csv" "$tmp/c-interp.csv" && pass || fail "auto: a long run was not compiled: $(grep solver "$tmp/auto.err")"
+# a hundredth of 30 000 (300) rows and the solver cached: loaded, not compiled
+autorun 30000 "$tmp/a3.csv" && [ ! -e "$tmp/cc.log" ] && grep -q "solver .*compiled (auto: from the cache" "$tmp/auto.err" &&
+    cmp -s "$tmp/a3.csv" "$tmp/c-interp.csv" && pass || fail "auto: the cached solver was not used: $(grep solver "$tmp/auto.err")"
+# ... but not below that hundredth (the cache's few milliseconds do not pay)
+autorun 100000 "$tmp/a4.csv" && [ ! -e "$tmp/cc.log" ] && grep -q "solver .*interpreted (auto: 361 rows" "$tmp/auto.err" &&
+    pass || fail "auto: a very short run loaded the cached solver: $(grep solver "$tmp/auto.err")"
+# options the generated code does not follow, --engine interpreted, MECH_JIT_AUTO=off
+autorun 300 "$tmp/a5.csv" --outputs B && [ ! -e "$tmp/cc.log" ] &&
+    grep -q "solver .*interpreted (auto: the compiled solver does not follow --outputs)" "$tmp/auto.err" &&
+    pass || fail "auto: --outputs compiled: $(grep solver "$tmp/auto.err")"
+autorun 300 "$tmp/a6.csv" --engine interpreted && [ ! -e "$tmp/cc.log" ] &&
+    grep -q "solver .*interpreted (--engine interpreted)" "$tmp/auto.err" && pass || fail "auto: --engine interpreted compiled"
+rm -f "$tmp/cc.log"
+env MECH_JIT_AUTO=off MECH_JIT_AUTO_ROWS=300 MECH_CACHE_DIR="$adir" TMPDIR=$tmp/jt CC=$tmp/cc-log "$MECH" solve \
+    mechanisms/fourbar.yaml -q --stats -o "$tmp/a7.csv" 2>"$tmp/auto.err"
+[ ! -e "$tmp/cc.log" ] && grep -q "solver .*interpreted (auto: MECH_JIT_AUTO=off)" "$tmp/auto.err" && pass ||
+    fail "auto: MECH_JIT_AUTO=off compiled"
+# a compiler that fails: a long run says so and is interpreted; a short one, silent
+rm -rf "$adir"
+env -u MECH_JIT_AUTO MECH_JIT_AUTO_ROWS=300 MECH_CACHE_DIR="$adir" TMPDIR=$tmp/jt CC=false "$MECH" solve \
+    mechanisms/fourbar.yaml -q -o "$tmp/a8.csv" 2>"$tmp/auto.err"
+grep -q "mech solve: note: the compiled solver: no C compiler ran ('false' .*the interpreter solves the sweep" "$tmp/auto.err" &&
+    cmp -s "$tmp/a8.csv" "$tmp/c-interp.csv" && pass || fail "auto: a failing compiler: $(cat "$tmp/auto.err")"
+[ -z "$(ls "$tmp/jt")" ] && pass || fail "auto: files left in TMPDIR: $(ls "$tmp/jt")"
+
 summary

@@ -33,6 +33,11 @@ trap 'rm -rf "$tmp"' EXIT
 # suite reads or fills the user's cache (docs/codegen.md)
 MECH_CACHE_DIR=$tmp/cache
 export MECH_CACHE_DIR
+# the suites compare the interpreter with the compiled solver: plain runs
+# stay interpreted (--engine auto would load what --jit cached); tests/jit.sh
+# turns it on where it checks the automatic choice
+MECH_JIT_AUTO=off
+export MECH_JIT_AUTO
 trap 'exit 2' INT TERM HUP
 
 passed=0

@@ -305,9 +305,16 @@ int cmd_report(int argc, char **argv);
 extern const cmd_spec cmd_codegen_spec;
 int cmd_codegen(int argc, char **argv);
 /* `mech solve --jit` (cmd_codegen_jit.c): mech_solve through the generated
- * code, compiled and loaded; the interpreter, with a note, where it cannot. */
+ * code, compiled and loaded; the interpreter, with a note, where it cannot.
+ * automatic (--engine auto, the default): compiled only where it pays off:
+ * at least cmd_jit_auto_rows() rows, or a hundredth of them and a cached
+ * solver of the structure; the interpreter otherwise, silently (--stats
+ * says which). */
 int cmd_jit_solve(const mech_model *m, const mech_solve_options *o, mech_table *t,
-                  mech_solve_stats *st, mech_diag *d);
+                  mech_solve_stats *st, mech_diag *d, int automatic);
+/* The rows from which --engine auto compiles: $MECH_JIT_AUTO_ROWS, else
+ * 2 000 000; -1 when MECH_JIT_AUTO=off (never by itself). */
+long cmd_jit_auto_rows(void);
 /* How the last cmd_jit_solve ran, for --stats: "compiled (...)", or why
  * the interpreter did ("" before any). */
 const char *cmd_jit_how(void);
@@ -329,6 +336,8 @@ void jit_cache_close(jit_cache *c);
 /* 1 with the path of the object compiled for key (klen bytes) in so_path,
  * when the cache holds it whole and unchanged; 0 otherwise. */
 int jit_cache_find(const jit_cache *c, const char *key, size_t klen, char *so_path, size_t size);
+/* 1 when the cache holds no entry (or is not used). */
+int jit_cache_empty(const jit_cache *c);
 /* The object at so_path stored for key: 0, or -1 (nothing stored). */
 int jit_cache_put(const jit_cache *c, const char *key, size_t klen, const char *so_path);
 /* `mech merge -o OUT SHARD...` (cmd_merge.c): shards of a sweep or batch. */

@@ -428,7 +428,7 @@ static int compile(cc_command *cp, char *note, size_t size)
 /* Generate, compile and load the solver of m in the private directory: 0,
  * or -1 with why in note. */
 static int build_in_dir(jit *j, const mech_model *m, const mech_solve_options *o,
-                        mech_solve_stats *st, char *note, size_t size)
+                        mech_solve_stats *st, int cached_only, char *note, size_t size)
 {
     codegen g;
     mech_diag d;
@@ -461,6 +461,11 @@ static int build_in_dir(jit *j, const mech_model *m, const mech_solve_options *o
     jit_cache cache;
     jit_cache_open(&cache);
     int hit = key && jit_cache_find(&cache, key, klen, cached, sizeof cached);
+    if (cached_only && !hit) {  /* --engine auto: a short run does not compile */
+        jit_cache_close(&cache);
+        free(key);
+        return snprintf(note, size, "no compiled solver of this structure in the cache"), -2;
+    }
     double t0 = clock_seconds();
     rc = hit ? 0 : compile(&c, note, size);
     if (rc == 0 && !hit) {
@@ -492,15 +497,15 @@ static int build_in_dir(jit *j, const mech_model *m, const mech_solve_options *o
 
 /* Build the solver of m in a private directory of $TMPDIR (else /tmp),
  * removed before returning, also on a signal meanwhile: 0, or -1 with why
- * in note. */
+ * in note (-2: cached_only and the cache has none). */
 static int jit_build(jit *j, const mech_model *m, const mech_solve_options *o,
-                     mech_solve_stats *st, char *note, size_t size)
+                     mech_solve_stats *st, int cached_only, char *note, size_t size)
 {
     const char *tmp = getenv("TMPDIR");
     if (!tmp || !*tmp || strlen(tmp) > 400)
         tmp = "/tmp";
     guard_begin();
-    int rc = guard_mkdtemp(tmp) == 0 ? build_in_dir(j, m, o, st, note, size)
+    int rc = guard_mkdtemp(tmp) == 0 ? build_in_dir(j, m, o, st, cached_only, note, size)
              : (snprintf(note, size, "cannot make a temporary directory in %s", tmp), -1);
     guard_end();
     return rc;
@@ -577,12 +582,54 @@ static int jit_sweep(const jit *j, const mech_model *m, const mech_analysis *a, 
     return 0;
 }
 
+long cmd_jit_auto_rows(void)
+{
+    const char *off = getenv("MECH_JIT_AUTO"), *rows = getenv("MECH_JIT_AUTO_ROWS");
+    if (off && strcmp(off, "off") == 0)
+        return -1;
+    char *end;
+    long n = rows && *rows ? strtol(rows, &end, 10) : 0;
+    return rows && *rows && !*end && n > 0 ? n : 2000000;
+}
+
+/* --engine auto: 1 (why in how) to keep the interpreter: options the
+ * generated code does not follow, or a run too short to pay for the
+ * compiler while the cache holds no solver; 0 to go on. *worth: the run is
+ * long enough to compile. */
+static int auto_keeps_interpreter(const mech_model *m, const mech_solve_options *o, int *worth)
+{
+    const char *opt = unsupported(o);
+    long at = cmd_jit_auto_rows();
+    int nq = 0;
+    double *q = positions(m, o, &nq);
+    free(q);
+    *worth = at > 0 && nq >= at;
+    long hit_at = at / 100 > 1 ? at / 100 : 1;  /* loading a cached solver: about 3 ms */
+    if (opt)
+        return snprintf(how, sizeof how, "interpreted (auto: the compiled solver does not "
+                        "follow %s)", opt), 1;
+    if (at < 0)
+        return snprintf(how, sizeof how, "interpreted (auto: MECH_JIT_AUTO=off)"), 1;
+    jit_cache cache;
+    jit_cache_open(&cache);
+    int empty = jit_cache_empty(&cache);
+    jit_cache_close(&cache);
+    if (!*worth && (empty || nq < hit_at))
+        return snprintf(how, sizeof how, "interpreted (auto: %d rows, fewer than the %ld from "
+                        "which compiling pays off%s)", nq, at, nq < hit_at ? ""
+                        : "; no compiled solver in the cache"), 1;
+    return 0;
+}
+
 int cmd_jit_solve(const mech_model *m, const mech_solve_options *o, mech_table *t,
-                  mech_solve_stats *st, mech_diag *d)
+                  mech_solve_stats *st, mech_diag *d, int automatic)
 {
     char note[700] = "";
-    const char *opt = unsupported(o);
+    int worth = 1;
     how[0] = '\0';
+    if (automatic && auto_keeps_interpreter(m, o, &worth))
+        return mech_solve(m, o, t, st, d);
+    const char *opt = unsupported(o);
     if (opt) {
         snprintf(how, sizeof how, "interpreted (--jit does not follow %s)", opt);
         fprintf(stderr, "mech solve: note: --jit does not follow %s: the interpreter solves the "
@@ -605,7 +652,7 @@ int cmd_jit_solve(const mech_model *m, const mech_solve_options *o, mech_table *
     memset(st, 0, sizeof *st);
     st->min_rcond = INFINITY;  /* as the interpreter (sweep.c): row 0 sets it */
     st->failure_q = NAN;       /* no failure (a failing sweep is the interpreter's) */
-    int ok = q && jit_build(&j, m, o, st, note, sizeof note) == 0;
+    int ok = q && jit_build(&j, m, o, st, automatic && !worth, note, sizeof note) == 0;
     double t1 = clock_seconds();
     if (ok && mech_analysis_header(a, t) == MECH_OK) {
         t->nrequested = nq;
@@ -633,12 +680,18 @@ int cmd_jit_solve(const mech_model *m, const mech_solve_options *o, mech_table *
     if (ok) {
         char built[sizeof how];
         snprintf(built, sizeof built, "%s", how);
-        snprintf(how, sizeof how, "compiled (%.680s)", built);
+        snprintf(how, sizeof how, "compiled (%s%.660s)", automatic ? "auto: " : "", built);
         return status;
     }
-    snprintf(how, sizeof how, "interpreted (--jit: %.660s)", note);
     mech_table_free(t);
     memset(t, 0, sizeof *t);
-    fprintf(stderr, "mech solve: note: --jit: %s; the interpreter solves the sweep\n", note);
+    if (automatic && !worth) {  /* a short run: the cache had none, or it cannot */
+        snprintf(how, sizeof how, "interpreted (auto: %d rows, fewer than the %ld from which "
+                 "compiling pays off; %.400s)", nq, cmd_jit_auto_rows(), note);
+        return mech_solve(m, o, t, st, d);
+    }
+    snprintf(how, sizeof how, "interpreted (%s: %.600s)", automatic ? "auto" : "--jit", note);
+    fprintf(stderr, "mech solve: note: %s: %s; the interpreter solves the sweep\n",
+            automatic ? "the compiled solver" : "--jit", note);
     return mech_solve(m, o, t, st, d);
 }

@@ -27,6 +27,7 @@ typedef struct solve_args {
     int within;                  /* --within-assembly or --range assembly */
     int range_assembly;          /* --range assembly */
     int jit;                     /* --jit: the generated code, compiled and loaded */
+    int engine;                  /* --engine: 0 auto, 1 compiled, 2 interpreted */
     mech_outputs selected;       /* --outputs, parsed (opt.outputs points here) */
     mech_solve_options opt;
 } solve_args;
@@ -73,6 +74,7 @@ static const cmd_word levels[] = {
 static const cmd_word solvers[] = {{"auto", MECH_LINEAR_AUTO}, {"klu", MECH_LINEAR_KLU}, {NULL, 0}};
 static const cmd_word ranges[] = {{"assembly", 1}, {NULL, 0}};
 static const cmd_word unit_systems[] = {{"si", 0}, {"file", 1}, {NULL, 0}};
+static const cmd_word engines[] = {{"auto", 0}, {"compiled", 1}, {"interpreted", 2}, {NULL, 0}};
 
 #define AT(field) offsetof(solve_args, field)
 
@@ -154,11 +156,17 @@ static const cmd_opt options[] = {
              "coefficient of speed fluctuation CS (0 < CS < 1, e.g.\n"
              "0.02; w the driver speed) printed with the figures\n"
              "above; implies --forces"},
+    {.names = "--engine", .kind = CMD_OPT_WORD, .at = AT(engine), .words = engines,
+     .expect = "is auto, compiled or interpreted", .label = "--engine E",
+     .help = "compiled: solve with the code 'mech codegen' writes,\n"
+             "compiled by $CC (else cc) and loaded, the same table;\n"
+             "without a compiler, or where it cannot, the interpreter\n"
+             "solves (a note says why; docs/codegen.md); interpreted:\n"
+             "the interpreter; auto (default): compiled from 2 000 000\n"
+             "rows ($MECH_JIT_AUTO_ROWS), or from 20 000 when the cache\n"
+             "holds the solver; else interpreted; --stats says which"},
     {.names = "--jit", .kind = CMD_OPT_FLAG, .at = AT(jit), .flag = 1, .label = "--jit",
-     .help = "solve with the code 'mech codegen' writes, compiled by\n"
-             "$CC (else cc) and loaded; the same table; without a\n"
-             "compiler, or where it cannot, the interpreter solves\n"
-             "(a note says why; docs/codegen.md)"},
+     .help = "the same as --engine compiled"},
     {.names = "-v|--verbose", .kind = CMD_OPT_FLAG, .at = AT(verbose), .flag = 1,
      .label = "--verbose", .help = "say which blocks of equations are solved and why"},
     {.names = "-q|--quiet", .kind = CMD_OPT_FLAG, .at = AT(quiet), .flag = 1,
@@ -194,7 +202,8 @@ const cmd_spec cmd_solve_spec = {
              "                  [--sensitivity NAME,...] [--tolerances]\n"
              "                  [--forces] [--friction on|off|both]\n"
              "                  [--diagnostics] [--stats] [--speed-fluctuation CS]\n"
-             "                  [--verbose] [--all] [--jit] [--strict] [--units si|file]\n"
+             "                  [--verbose] [--all] [--engine auto|compiled|interpreted]\n"
+             "                  [--jit] [--strict] [--units si|file]\n"
              "                  [--within-assembly] [--range assembly]\n",
     .about = "Solve positions, velocities and accelerations of the mechanism at every\n"
              "driver position and write one CSV row per position: the driver position q,\n"
@@ -395,7 +404,9 @@ static int solve_loaded(solve_args *pa, mech_model *m)
     cmd_progress_init(&pr, "solve", "rows", a.quiet);
     a.opt.progress = cmd_progress_callback;
     a.opt.progress_ctx = &pr;
-    int rc = a.jit ? cmd_jit_solve(m, &a.opt, &t, &st, &d) : mech_solve(m, &a.opt, &t, &st, &d);
+    int engine = a.jit ? 1 : a.engine;
+    int rc = engine == 2 ? mech_solve(m, &a.opt, &t, &st, &d)
+                         : cmd_jit_solve(m, &a.opt, &t, &st, &d, engine == 0);
     cmd_progress_done(&pr);
     int suspect = a.strict ? cmd_strict_assembly(&d) : 0;
     mech_diag_print(&d, stderr);
@@ -415,8 +426,9 @@ static int solve_loaded(solve_args *pa, mech_model *m)
     }
     if (a.stats)
         print_stats(m, &st, a.units_file, stderr);
-    if (a.stats && a.jit)
-        fprintf(stderr, "  solver             %s\n", cmd_jit_how());
+    if (a.stats)
+        fprintf(stderr, "  solver             %s\n",
+                engine == 2 ? "interpreted (--engine interpreted)" : cmd_jit_how());
     if (a.stats || a.speed_fluctuation > 0.0)
         print_flywheel(&a, m, &t);
     code = cmd_exit_status(rc);

@@ -107,6 +107,26 @@ void jit_cache_close(jit_cache *c)
     c->usable = 0;
 }
 
+int jit_cache_empty(const jit_cache *c)
+{
+    if (!c->usable)
+        return 1;
+    int fd = openat(c->fd, ".", O_RDONLY | O_DIRECTORY | O_CLOEXEC);  /* its own offset */
+    DIR *dir = fd >= 0 ? fdopendir(fd) : NULL;
+    if (!dir) {
+        if (fd >= 0)
+            close(fd);
+        return 1;
+    }
+    int empty = 1;
+    for (struct dirent *e; empty && (e = readdir(dir));) {
+        size_t n = strlen(e->d_name);
+        empty = !(n > 4 && strcmp(e->d_name + n - 4, ".key") == 0);
+    }
+    closedir(dir);
+    return empty;
+}
+
 /* ---- entries ------------------------------------------------------------ */
 
 static void entry_name(char *buf, size_t size, uint64_t h, const char *ext)
