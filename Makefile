@@ -330,6 +330,7 @@ bench:
 	  build/bench/bench-scale build/bench && \
 	  MECH=build/bench/mech sh bench/bench_batch.sh && \
 	  MECH=build/bench/mech sh bench/bench_simulate.sh && \
+	  MECH=build/bench/mech sh bench/bench_output.sh && \
 	  build/bench/bench-sweep mechanisms/conveyor.yaml l1 55 65 && \
 	  build/bench/bench-fit tests/fit/fourbar.yaml && \
 	  build/bench/bench-alloc mechanisms/*.yaml; } 2>&1 | tee build/bench/report.txt

@@ -4,7 +4,7 @@
  *   ./api_example mechanisms/fourbar.yaml B.x B.vx coupler.omega
  *
  * prints "q [rad],B.x [m],..." then one row per driver position, each value
- * as %.17g (as `mech solve` writes its CSV, so the text is the same). */
+ * as %.17g (which reads back as the same double, as `mech solve`'s CSV). */
 #include <stdio.h>
 #include <stdlib.h>
 

@@ -108,6 +108,15 @@ int parallel_default_jobs(void);
 /* Seconds on the monotonic clock (differences only). */
 double clock_seconds(void);
 
+/* fmt.c: v as the shortest decimal that strtod reads back as v (the
+ * nearest of the shortest), laid out as %.17g; nan, inf, -0 as printf
+ * writes them. Returns the length (at most FMT_DOUBLE_MAX - 1).
+ * fmt_double_printf: the same text from printf's digits (slower; the
+ * tests' reference). */
+enum { FMT_DOUBLE_MAX = 32 };
+int fmt_double(double v, char out[FMT_DOUBLE_MAX]);
+int fmt_double_printf(double v, char out[FMT_DOUBLE_MAX]);
+
 /* ---- units.c: physical dimensions, units and quantity expressions. */
 enum { DIM_LENGTH, DIM_MASS, DIM_TIME, DIM_ANGLE, NDIMS };
 typedef struct dim {

@@ -250,8 +250,10 @@ static void format_row(const mech_sweep *s, const mech_variant *v, char *row)
                               shortest(v->params[k], cell, sizeof cell));
     n += (size_t)snprintf(row + n, ROW_SIZE - n, ",%s,%d", mech_variant_status_name(v->status),
                           v->rows);
-    for (int k = 0; k < mech_sweep_nmetrics(s); k++)
-        n += (size_t)snprintf(row + n, ROW_SIZE - n, ",%.17g", v->metrics[k]);
+    for (int k = 0; k < mech_sweep_nmetrics(s) && n + FMT_DOUBLE_MAX + 2 < ROW_SIZE; k++) {
+        row[n++] = ',';  /* the shortest text that reads back (fmt_double) */
+        n += (size_t)fmt_double(v->metrics[k], row + n);
+    }
     snprintf(row + n, ROW_SIZE - n, "\n");
 }
 

@@ -13,8 +13,8 @@
  * SIGHUP reads to remove them before the process dies (SIGKILL cannot be
  * caught: a stale temporary file is harmless, its name is random).
  *
- * Numbers are printed with 17 significant digits: reading them back gives
- * the same doubles. */
+ * Numbers are printed as the shortest decimal that reads back as the same
+ * double (fmt_double, src/base/fmt.c). */
 #define _XOPEN_SOURCE 700  /* realpath (glibc hides it under _POSIX_C_SOURCE alone) */
 #include <errno.h>
 #include <fcntl.h>
@@ -31,16 +31,28 @@
 #include "base.h"
 #include "output.h"
 
+/* The header, then each row built in a buffer (the numbers by fmt_double,
+ * the shortest text that reads back the same) and written at once. */
 static int write_rows(const mech_table *t, FILE *f)
 {
     for (int c = 0; c < t->ncolumns; c++)
         fprintf(f, "%s%s [%s]", c ? "," : "", t->columns[c].name, t->columns[c].unit);
     fputc('\n', f);
-    for (int r = 0; r < t->nrows; r++) {
-        for (int c = 0; c < t->ncolumns; c++)
-            fprintf(f, "%s%.17g", c ? "," : "", mech_table_get(t, r, c));
-        fputc('\n', f);
+    size_t cap = (size_t)t->ncolumns * FMT_DOUBLE_MAX + 2;
+    char *row = malloc(cap);
+    if (!row)
+        return -1;
+    for (int r = 0; r < t->nrows && !ferror(f); r++) {
+        size_t n = 0;
+        for (int c = 0; c < t->ncolumns; c++) {
+            if (c)
+                row[n++] = ',';
+            n += (size_t)fmt_double(mech_table_get(t, r, c), row + n);
+        }
+        row[n++] = '\n';
+        fwrite(row, 1, n, f);
     }
+    free(row);
     return ferror(f) ? -1 : 0;
 }
 
