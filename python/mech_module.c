@@ -4,7 +4,7 @@
  * A thin layer over libmech's public API (include/mech.h): it loads and
  * checks a file with parameter overrides, solves it with the options of
  * `mech solve`, and hands back the columns as numpy arrays (copied from the
- * table: the same doubles `mech solve` prints with %.17g). The GIL is
+ * table: the same doubles `mech solve` prints, as the shortest text that reads back). The GIL is
  * released while a file is loaded and solved: each call has its own model,
  * analysis and table, so threads may solve at once. Errors raise
  * mech.MechError with the library's diagnostics (file:line:column). */
