@@ -134,6 +134,11 @@ for f in tr tf ok; do
     fi
 done
 
+# '{points: [...]}' is the list's other spelling: the same table
+sed 's/^    profile: \(.*\)/    profile: {points: \1}/' "$tmp/tr.yaml" >"$tmp/trp.yaml"
+run "points map" 0 "$MECH" solve "$tmp/trp.yaml" -o "$tmp/trp.csv" &&
+    { cmp -s "$tmp/trp.csv" "$tmp/tr.csv" && pass || fail "points map: not the list's table"; }
+
 # the oscillating flat face from A to B: C's distance from its line is 40
 # mm; its rate and acceleration with the line's normal n = J (B - A) / |B - A|
 disc "$OSC_FLAT" '    follower: follower
@@ -211,6 +216,9 @@ printf 'x [mm],y [mm]\n40,0\n30,30\n0,40\n-30,30\n-40,zero\n' >"$tmp/p.csv"
 bad "csv not a number" "p.csv:6:2: error: not a number in the profile's y column" 's/^    profile: .*/    profile: {file: p.csv}/'
 printf 'a,b\n1,2\n' >"$tmp/p.csv"
 bad "csv columns" "error: cam 'disc': '.*p.csv' has no columns profile.x and profile.y (mech cam's) or x and y" 's/^    profile: .*/    profile: {file: p.csv}/'
+bad "profile both" "bad.yaml:[0-9]*:14: error: a profile is '{points: \[\[x, y\], ...\]}' or '{file: CSV}' (columns profile.x and profile.y, as mech cam writes, or x and y), not both" 's/^    profile: \(.*\)/    profile: {file: p.csv, points: \1}/'
+bad "profile neither" "bad.yaml:[0-9]*:14: error: a profile is '{points: \[\[x, y\], ...\]}' or '{file: CSV}'" 's/^    profile: .*/    profile: {}/'
+bad "profile key" "bad.yaml:[0-9]*:[0-9]*: error: unknown key 'pts'" 's/^    profile: .*/    profile: {pts: 1}/'
 bad3 "csv missing" "error: cam 'disc': the profile '.*nope.csv' cannot be read" 's/^    profile: .*/    profile: {file: nope.csv}/'
 printf 'x [s],y [mm]\n' >"$tmp/p.csv"
 bad "csv unit" "error: cam 'disc': the profile's x column of '.*p.csv' is in 's', not a length" 's/^    profile: .*/    profile: {file: p.csv}/'

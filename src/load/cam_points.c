@@ -287,22 +287,24 @@ static int check_points(loader *ld, const ynode *n, mech_cam *c)
 
 int cam_points_load(loader *ld, const ynode *n, mech_cam *c)
 {
-    int ok;
-    if (n->kind == YNODE_SEQ) {
-        ok = points_of_list(ld, n, c, &c->points, &c->npoints);
-    } else {
-        static const char *const keys[] = {"file"};
-        const ynode *f = load_want_kind(ld, n, YNODE_MAP, "'profile' (a list of [x, y] or "
-                                        "{file: CSV})") &&
-                                 load_check_keys(ld, n, keys, COUNT(keys), "profile")
-                             ? ymap_get(n, "file") : NULL;
-        if (f && !load_want_kind(ld, f, YNODE_SCALAR, "'file'"))
-            f = NULL;
-        else if (!f && n->kind == YNODE_MAP)
-            load_err(ld, n, "a profile from a file is '{file: CSV}' (columns profile.x and "
-                     "profile.y, as mech cam writes, or x and y)");
-        ok = f && points_of_csv(ld, f, c, &c->points, &c->npoints);
+    static const char *const keys[] = {"points", "file"};
+    const ynode *list = n, *f = NULL;
+    if (n->kind != YNODE_SEQ) {
+        if (!load_want_kind(ld, n, YNODE_MAP, "'profile' (a list of [x, y], {points: [...]} or "
+                            "{file: CSV})") ||
+            !load_check_keys(ld, n, keys, COUNT(keys), "profile"))
+            return 0;
+        list = ymap_get(n, "points"), f = ymap_get(n, "file");
+        if (!list == !f)
+            return load_err(ld, n, "a profile is '{points: [[x, y], ...]}' or '{file: CSV}' "
+                            "(columns profile.x and profile.y, as mech cam writes, or x and "
+                            "y)%s", list ? ", not both" : ""), 0;
+        if ((list && !load_want_kind(ld, list, YNODE_SEQ, "'points'")) ||
+            (f && !load_want_kind(ld, f, YNODE_SCALAR, "'file'")))
+            return 0;
     }
+    int ok = list ? points_of_list(ld, list, c, &c->points, &c->npoints)
+                  : points_of_csv(ld, f, c, &c->points, &c->npoints);
     return ok && check_points(ld, n, c);
 }
 
