@@ -272,9 +272,9 @@ static int check_points(loader *ld, const ynode *n, mech_cam *c)
                             i / 2 + 1), 0;
         size = fmax(size, fabs(c->points[i]));
     }
-    if (!(size < 1e6))
-        return load_err(ld, n, "cam '%s': a profile point is %.3g m from the origin: not a "
-                        "cam's", c->name, size), 0;
+    if (!(size < 1e6 && size > 1e-9))
+        return load_err(ld, n, "cam '%s': the profile's points reach %.3g m from the origin: "
+                        "not a cam's", c->name, size), 0;
     for (int i = 0; i < c->npoints; i++) {
         const double *a = &c->points[2 * i], *b = &c->points[2 * ((i + 1) % c->npoints)];
         if (hypot(b[0] - a[0], b[1] - a[1]) <= 1e-12 * size)
@@ -328,12 +328,15 @@ struct contact {
     gsl_root_fsolver *rt;
 };
 
+/* What GSL's solvers are given: finite (they abort on NaN or inf). */
+static double finite_or(double v, double otherwise) { return isfinite(v) ? v : otherwise; }
+
 static double dist_from_centre(double u, void *arg)
 {
     contact *k = arg;
     double p[2];
     curve_at(&k->cv, u, p);
-    return hypot(p[0] - k->oc[0], p[1] - k->oc[1]);
+    return finite_or(hypot(p[0] - k->oc[0], p[1] - k->oc[1]), 1e300);
 }
 
 /* The winding number of the polygon pts[n] around o: the centre inside. */
@@ -453,7 +456,7 @@ static double lift_leaving_at(double u, void *arg)
     contact *k = arg;
     double P[2];
     arm_point(k, u, P);
-    return -lift_leaving(k, P);  /* minimised */
+    return finite_or(-lift_leaving(k, P), -UNDEFINED);  /* minimised */
 }
 
 /* A knife's tip on its path: the signed distance of P from the path, and
@@ -470,7 +473,7 @@ static double knife_gap_at(double u, void *arg)
     contact *k = arg;
     double P[2];
     arm_point(k, u, P);
-    return knife_gap(k, P);
+    return finite_or(knife_gap(k, P), 0.0);
 }
 
 static double knife_lift(const contact *k, const double P[2])
