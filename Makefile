@@ -300,9 +300,9 @@ test-san:
 # Fuzzing with clang's libFuzzer (tests/fuzz/README.md): fuzz runs
 # FUZZ_SECONDS (default 60); fuzz-replay only the regression inputs.
 fuzz:
-	FUZZ_BUILD=$(BUILD)/fuzz FUZZ_CFLAGS="$(HDF5_CFLAGS) $(MINPACK_CFLAGS)" FUZZ_LIBS="$(SUNDIALS_LIBS) $(HDF5_LIBS) $(MINPACK_LIBS)" sh tests/fuzz/run.sh
+	FUZZ_BUILD=$(BUILD)/fuzz FUZZ_CFLAGS="$(HDF5_CFLAGS) $(MINPACK_CFLAGS) $(GSL_CFLAGS)" FUZZ_LIBS="$(SUNDIALS_LIBS) $(HDF5_LIBS) $(MINPACK_LIBS) $(GSL_LIBS)" sh tests/fuzz/run.sh
 fuzz-replay:
-	FUZZ_BUILD=$(BUILD)/fuzz FUZZ_CFLAGS="$(HDF5_CFLAGS) $(MINPACK_CFLAGS)" FUZZ_LIBS="$(SUNDIALS_LIBS) $(HDF5_LIBS) $(MINPACK_LIBS)" sh tests/fuzz/run.sh replay
+	FUZZ_BUILD=$(BUILD)/fuzz FUZZ_CFLAGS="$(HDF5_CFLAGS) $(MINPACK_CFLAGS) $(GSL_CFLAGS)" FUZZ_LIBS="$(SUNDIALS_LIBS) $(HDF5_LIBS) $(MINPACK_LIBS) $(GSL_LIBS)" sh tests/fuzz/run.sh replay
 
 # mech under valgrind on every mechanism: no invalid accesses, no leaks.
 test-valgrind: $(BUILD)/mech
