@@ -56,6 +56,7 @@ check "mech solve, a cam driving a four-bar" solve mechanisms/cams/cam-fourbar.y
 check "mech cam, the profile and outlines" cam mechanisms/cams/translating-roller.yaml -o "$tmp/p.csv" --svg "$tmp/p.svg" --dxf "$tmp/p.dxf"
 check "mech solve --forces, a cam held by a spring" solve tests/cams/forces-fourbar.yaml -o "$tmp/camf.csv"
 check "mech animate, a cam turning" animate mechanisms/cams/translating-roller.yaml -o "$tmp/cam.svg"
+check "mech solve --forces, a cam given by points (GSL's splines)" solve tests/cams/points.yaml --forces -o "$tmp/pts.csv"
 check "mech simulate (BDF)" simulate tests/dynamics/pendulum.yaml --to 1 --step 0.05 -o "$tmp/sim.csv"
 check "mech simulate (two free cranks, Adams)" simulate mechanisms/dynamics/five-bar-free.yaml --to 0.5 --method adams -o "$tmp/sim.csv"
 check "mech simulate --stop-at-rest" simulate tests/dynamics/pendulum.yaml --stop-at-rest -o "$tmp/sim.csv"
