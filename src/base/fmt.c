@@ -1,8 +1,8 @@
 /* src/base/fmt.c: a double as the shortest decimal that reads back as the
  * same double (strtod), the nearest such when several are as short, laid
  * out as printf's %.17g lays out a number (positional from 1e-4 to below
- * 1e17, else d.ddde+XX): the numbers of the result tables (output.c,
- * docs/cli.md "Numbers").
+ * 1e17, else d.ddde+XX): the numbers of the result tables (output.c), of
+ * mech sweep's rows and of mech compare's messages (docs/cli.md).
  *
  * Debian ships no C library for this (Ryu and Dragonbox are C++ or not
  * packaged), so it is done here, exactly, with integers. A double v = m
@@ -10,15 +10,16 @@
  * below a power of two); every decimal strictly between them (or on them,
  * m even: strtod rounds a tie to the even m) reads back as v. Scaled by
  * 10^p so that v 10^p has 17 or 18 digits, these three are
- * (4m -+ 2) 5^p / 2^s with s = 2 - e - p, exact in 128 bits while 0 <= p
- * <= 30 and s >= 0 (about 1e-14 <= |v| < 1e16): the integers A <= B that
+ * (4m -+ 2) 5^p / 2^s with s = 2 - e - p, exact in 192 bits while 0 <= p
+ * <= 55 and s >= 0 (about 1e-39 <= |v| < 1e16): the integers A <= B that
  * bound the decimals c 10^t in the interval come from shifts, and the
  * largest t for which some c is in [A / 10^t, B / 10^t] gives the fewest
  * digits; of those c, the nearest to v (a tie: the even one). Outside that
  * range (very small or large magnitudes, subnormals) the digits come from
  * printf's correctly rounded %.*e at 1, 2, ... 17 digits, the first that
- * reads back: slower, the same result. tests/unit/test_fmt.c holds the two
- * against each other and strtod on a million values. */
+ * reads back: slower, the same result (the first precision that reads back
+ * ends in a digit other than 0). tests/unit/test_fmt.c holds the two
+ * against each other and strtod on 300 000 values. */
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -168,8 +169,6 @@ static int digits_by_printf(double v, char digits[20], int *x)
         if (*p >= '0' && *p <= '9')
             digits[n++] = *p;
     *x = *p == 'e' ? atoi(p + 1) : 0;
-    while (n > 1 && digits[n - 1] == '0')  /* 1.0e+10 at two digits: not shorter */
-        n--;
     return n;
 }
 

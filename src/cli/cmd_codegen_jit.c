@@ -592,17 +592,14 @@ long cmd_jit_auto_rows(void)
     return rows && *rows && !*end && n > 0 ? n : 2000000;
 }
 
-/* --engine auto: 1 (why in how) to keep the interpreter: options the
- * generated code does not follow, or a run too short to pay for the
- * compiler while the cache holds no solver; 0 to go on. *worth: the run is
- * long enough to compile. */
-static int auto_keeps_interpreter(const mech_model *m, const mech_solve_options *o, int *worth)
+/* --engine auto, a run of nq rows: 1 (why in how) to keep the
+ * interpreter: options the generated code does not follow, or a run too
+ * short to pay for the compiler while the cache holds no solver; 0 to go
+ * on. *worth: the run is long enough to compile. */
+static int auto_keeps_interpreter(const mech_solve_options *o, int nq, int *worth)
 {
     const char *opt = unsupported(o);
     long at = cmd_jit_auto_rows();
-    int nq = 0;
-    double *q = positions(m, o, &nq);
-    free(q);
     *worth = at > 0 && nq >= at;
     long hit_at = at / 100 > 1 ? at / 100 : 1;  /* loading a cached solver: about 3 ms */
     if (opt)
@@ -625,12 +622,16 @@ int cmd_jit_solve(const mech_model *m, const mech_solve_options *o, mech_table *
                   mech_solve_stats *st, mech_diag *d, int automatic)
 {
     char note[700] = "";
-    int worth = 1;
+    int worth = 1, nq = 0, bad = -1;
     how[0] = '\0';
-    if (automatic && auto_keeps_interpreter(m, o, &worth))
+    double *q = positions(m, o, &nq);
+    if (automatic && auto_keeps_interpreter(o, nq, &worth)) {
+        free(q);
         return mech_solve(m, o, t, st, d);
+    }
     const char *opt = unsupported(o);
     if (opt) {
+        free(q);
         snprintf(how, sizeof how, "interpreted (--jit does not follow %s)", opt);
         fprintf(stderr, "mech solve: note: --jit does not follow %s: the interpreter solves the "
                 "sweep\n", opt);
@@ -643,12 +644,11 @@ int cmd_jit_solve(const mech_model *m, const mech_solve_options *o, mech_table *
     if (mech_analysis_new(m, o, &a, &ad) != MECH_OK) {
         snprintf(how, sizeof how, "interpreted (the analysis failed)");
         mech_diag_free(&ad);
+        free(q);
         return mech_solve(m, o, t, st, d);  /* it says what is wrong */
     }
     jit j;
     memset(&j, 0, sizeof j);
-    int nq = 0, bad = -1;
-    double *q = positions(m, o, &nq);
     memset(st, 0, sizeof *st);
     st->min_rcond = INFINITY;  /* as the interpreter (sweep.c): row 0 sets it */
     st->failure_q = NAN;       /* no failure (a failing sweep is the interpreter's) */

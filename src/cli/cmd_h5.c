@@ -17,23 +17,17 @@
 #include "cli.h"
 #include "output.h"
 
-/* x as the shortest "%.Ng" that reads back as x (as mech sweep writes a
- * parameter; nan and inf as printf spells them), a whole number below
- * 10^15 with all its digits (an index: 10, not 1e+01), into buf: its
- * length */
+/* x as mech sweep writes a number (fmt_double: the fewest digits that read
+ * back, whole numbers below 1e17 with all their digits, nan and inf as
+ * printf spells them) into buf: its length, 0 when it does not fit */
 static size_t put_number(char *buf, size_t size, double x)
 {
-    int n = 0;
-    if (x == floor(x) && fabs(x) < 1e15) {
-        n = snprintf(buf, size, "%.0f", x);
-        return n > 0 && (size_t)n < size ? (size_t)n : 0;
-    }
-    for (int p = 1; p <= 17; p++) {
-        n = snprintf(buf, size, "%.*g", p, x);
-        if (strtod(buf, NULL) == x)
-            break;
-    }
-    return n > 0 && (size_t)n < size ? (size_t)n : 0;
+    char text[FMT_DOUBLE_MAX];
+    size_t n = (size_t)fmt_double(x, text);
+    if (n >= size)
+        return 0;
+    memcpy(buf, text, n + 1);
+    return n;
 }
 
 /* Row r of t as a line of its canonical CSV form, with its newline, into

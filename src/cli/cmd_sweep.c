@@ -207,18 +207,6 @@ static void put_cell(FILE *f, const char *s)
     fputc('"', f);
 }
 
-/* The shortest "%.Ng" of x that reads back as x: 0.04, not
- * 0.040000000000000001 (the value is exact either way). */
-static const char *shortest(double x, char *buf, size_t size)
-{
-    for (int p = 1; p <= 17; p++) {
-        snprintf(buf, size, "%.*g", p, x);
-        if (strtod(buf, NULL) == x)
-            break;
-    }
-    return buf;
-}
-
 static void write_header(const mech_sweep *s, FILE *f)
 {
     char cell[256];
@@ -243,11 +231,12 @@ enum { ROW_SIZE = 32 * (SWEEP_MAX_AXES + SWEEP_MAX_METRICS + 4) };
 /* Variant v's row, with its newline, into row[ROW_SIZE]. */
 static void format_row(const mech_sweep *s, const mech_variant *v, char *row)
 {
-    char cell[64];
+    char cell[FMT_DOUBLE_MAX];  /* the fewest digits that read back: 0.04 */
     size_t n = (size_t)snprintf(row, ROW_SIZE, "%ld", v->index);
-    for (int k = 0; k < mech_sweep_nparams(s); k++)
-        n += (size_t)snprintf(row + n, ROW_SIZE - n, ",%s",
-                              shortest(v->params[k], cell, sizeof cell));
+    for (int k = 0; k < mech_sweep_nparams(s); k++) {
+        fmt_double(v->params[k], cell);
+        n += (size_t)snprintf(row + n, ROW_SIZE - n, ",%s", cell);
+    }
     n += (size_t)snprintf(row + n, ROW_SIZE - n, ",%s,%d", mech_variant_status_name(v->status),
                           v->rows);
     for (int k = 0; k < mech_sweep_nmetrics(s) && n + FMT_DOUBLE_MAX + 2 < ROW_SIZE; k++) {

@@ -68,6 +68,16 @@ static void trace_point(const mech_model *m, const mech_cam *c, const double s[3
     }
 }
 
+double cam_face(const mech_model *m, const mech_cam *c, double w[2])
+{
+    const mech_link *fl = &m->links[c->follower];
+    const mech_point *pf = &fl->points[c->follower_pivot[0]];
+    const mech_point *a = &fl->points[c->face[0]], *b = &fl->points[c->face[1]];
+    double wl = hypot(b->x - a->x, b->y - a->y);
+    w[0] = (b->x - a->x) / wl, w[1] = (b->y - a->y) / wl;
+    return (a->x - pf->x) * -w[1] + (a->y - pf->y) * w[0];
+}
+
 /* An oscillating flat face (section 3 of docs/cams.md): the face's line
  * p . nu = d in the arm's frame from O, nu = R(psi) J w, d = (P - O) . nu
  * + k; seen from the cam, a line whose normal turns at phi' = rise s' -
@@ -81,11 +91,9 @@ static void oscillating_face(const mech_model *m, const mech_cam *c, const doubl
     const mech_point *pf = &fl->points[c->follower_pivot[0]];
     const mech_point *pa = &m->links[c->arm].points[c->follower_pivot[1]];
     const mech_point *o = &m->links[c->arm].points[c->cam_pivot[1]];
-    const mech_point *a = &fl->points[c->face[0]], *b = &fl->points[c->face[1]];
-    double wl = hypot(b->x - a->x, b->y - a->y), w0[2] = {(b->x - a->x) / wl, (b->y - a->y) / wl};
-    double jw0[2], w[2], nu[2], jnu[2], dv[2] = {pa->x - o->x, pa->y - o->y};
-    perp(w0, jw0);
-    double k = (a->x - pf->x) * jw0[0] + (a->y - pf->y) * jw0[1];
+    const mech_point *a = &fl->points[c->face[0]];
+    double w0[2], w[2], nu[2], jnu[2], dv[2] = {pa->x - o->x, pa->y - o->y};
+    double k = cam_face(m, c, w0);
     double r = c->rise, psi = c->c0 + r * s[0], p1 = r * s[1], p2 = r * s[2];
     rotate(psi, w0, w);
     perp(w, nu);

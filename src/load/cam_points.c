@@ -1,5 +1,5 @@
 /* src/load/cam_points.c: a cam given by its profile's points (docs/cams.md,
- * section 7). The points are joined by the periodic cubic spline in their
+ * section 9). The points are joined by the periodic cubic spline in their
  * chord length (GSL's cspline_periodic: a closed curve with continuous
  * curvature). The base circle is the curve's least distance from the cam's
  * centre. The follower's lift is found by contact at every 0.1 deg of the
@@ -560,11 +560,9 @@ static int contact_init(contact *k, const mech_model *m, const mech_cam *c)
         k->q[0] = pa->x - o->x, k->q[1] = pa->y - o->y;
         double qa = atan2(k->q[1], k->q[0]);
         if (c->contact == CAM_FLAT_FACED) {
-            const mech_point *a = &fl->points[c->face[0]], *b = &fl->points[c->face[1]];
-            double wl = hypot(b->x - a->x, b->y - a->y);
-            double jw[2] = {-(b->y - a->y) / wl, (b->x - a->x) / wl};
-            k->be = atan2(jw[1], jw[0]);
-            k->k = (a->x - pf->x) * jw[0] + (a->y - pf->y) * jw[1];
+            double w[2];
+            k->k = cam_face(m, c, w);
+            k->be = atan2(w[0], -w[1]);  /* the angle of J w */
             double d = hypot(k->q[0], k->q[1]) * cos(c->c0 + k->be - qa) + k->k;
             k->sigma = d < 0.0 ? -1.0 : 1.0;
             k->far = c->rise * ((k->sigma > 0 ? qa : qa + PI) - k->be - c->c0);
@@ -665,20 +663,16 @@ static int lift_program(const double *s, int n, mech_program *p)
     return ok;
 }
 
-/* A law of the cam's angle (the law's variable) that is program p. */
+/* A law of the cam's angle (the law's variable) that is program p (owned
+ * by it from then on, also when NULL is returned out of memory). */
 static struct mech_law *law_of_program(mech_program *p)
 {
     struct mech_law *l = law_new('t');
-    struct mech_program **slot = xcalloc(1, sizeof *slot);
-    const rt_program **rslot = xcalloc(1, sizeof *rslot);
-    if (!l || !slot || !rslot) {
+    if (!l || !law_take_program(l, p)) {
         law_free(l);
-        free(slot);
-        free((void *)rslot);
+        program_free(p);
         return NULL;
     }
-    slot[0] = p, rslot[0] = &p->rt;
-    l->progs = slot, l->rtprogs = rslot, l->nprogs = 1;
     int t = law_add_node(l, LAW_T, -1, -1, 0.0);
     l->root = t >= 0 ? law_add_node(l, LAW_PROGRAM, t, 0, 0.0) : -1;
     if (l->root < 0) {
@@ -703,12 +697,12 @@ int cam_points_program(loader *ld, mech_cam *c)
     if (ok && !lift_program(s, LIFT_SAMPLES, p))
         ok = (diag_error(ld->d, ld->file, c->mark, "out of memory"), 0);
     free(s);
-    if (ok && !(c->program = law_of_program(p)))
-        ok = (diag_error(ld->d, ld->file, c->mark, "out of memory"), 0);
     if (!ok) {
         program_free(p);
         return 0;
     }
+    if (!(c->program = law_of_program(p)))  /* p is the law's, or freed */
+        return diag_error(ld->d, ld->file, c->mark, "out of memory"), 0;
     snprintf(c->program->name, sizeof c->program->name, "s_%s", c->name);
     return 1;
 }

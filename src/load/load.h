@@ -705,6 +705,9 @@ void load_sweep_drivers(loader *ld, const ynode *sweep, const ynode *drivers);
  * into *out (the law of t, its last node the program). 1, or 0 reported. */
 int load_program(loader *ld, const ynode *map, quantity q, const char *driver,
                  struct mech_law **out);
+/* Program p as law l's only program (progs[0]; l owns it from then on): 1,
+ * or 0 out of memory (p not taken). */
+int law_take_program(struct mech_law *l, struct mech_program *p);
 /* The same; of_cam: a cam's program (load_cams.c), whose variable is the
  * law's own, the cam angle (no 'of' or 'speed'). */
 int load_program_as(loader *ld, const ynode *map, quantity q, const char *who, int of_cam,
@@ -821,6 +824,10 @@ typedef struct cam_point {
                             follower's line, m; else 0 */
 } cam_point;
 void cam_geometry(const mech_model *m, const mech_cam *c, double x, cam_point *g);
+/* An oscillating flat face in the follower's frame: its unit direction w
+ * (from its first point to its second); returns k = (A - P) . J w, its
+ * line's signed distance from the follower's pivot P. */
+double cam_face(const mech_model *m, const mech_cam *c, double w[2]);
 /* cam_points.c: a cam given by its profile's points (docs/cams.md 7).
  * 'profile: [[x, y], ...]' or '{file: CSV}' into c->points (1, or 0 reported);
  * the least distance of their closed curve from the cam's centre into

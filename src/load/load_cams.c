@@ -272,13 +272,9 @@ static void place_oscillating(loader *ld, mech_cam *c)
 static void place_face(loader *ld, mech_cam *c)
 {
     const mech_model *m = ld->m;
-    const mech_link *fl = &m->links[c->follower];
-    const mech_point *pf = &fl->points[c->follower_pivot[0]];
     const mech_point *pa = &m->links[c->arm].points[c->follower_pivot[1]];
     const mech_point *o = &m->links[c->arm].points[c->cam_pivot[1]];
-    const mech_point *a = &fl->points[c->face[0]], *b = &fl->points[c->face[1]];
-    double wl = hypot(b->x - a->x, b->y - a->y), wx = (b->x - a->x) / wl, wy = (b->y - a->y) / wl;
-    double k = (a->x - pf->x) * -wy + (a->y - pf->y) * wx;
+    double w[2], k = cam_face(m, c, w), wx = w[0], wy = w[1];
     double dx = pa->x - o->x, dy = pa->y - o->y, dl = hypot(dx, dy);
     double om = atan2(wx, -wy), ga = atan2(dy, dx), guess = guess_on_arm(m, c), best = NAN;
     for (int side = -1; side <= 1; side += 2) {

@@ -302,6 +302,23 @@ static int cam_variable(struct mech_law *l, quantity *xq)
     return (l->root = law_add_node(l, LAW_T, -1, -1, 0.0)) >= 0;
 }
 
+int law_take_program(struct mech_law *l, mech_program *p)
+{
+    struct mech_program **slot = xcalloc(1, sizeof *slot);
+    const rt_program **rslot = xcalloc(1, sizeof *rslot);
+    if (!slot || !rslot) {
+        free(slot);
+        free((void *)rslot);
+        return 0;
+    }
+    slot[0] = p;
+    rslot[0] = &p->rt;
+    l->progs = slot;
+    l->rtprogs = rslot;
+    l->nprogs = 1;
+    return 1;
+}
+
 int load_program(loader *ld, const ynode *map, quantity q, const char *who,
                  struct mech_law **out)
 {
@@ -329,25 +346,11 @@ int load_program_as(loader *ld, const ynode *map, quantity q, const char *who, i
                                  "law: LAW}, {dwell: SPAN}, {return: ...})"), 0;
     struct mech_law *l = law_new('t');
     mech_program *p = xcalloc(1, sizeof *p);
-    struct mech_program **slot = xcalloc(1, sizeof *slot);
-    if (!l || !p || !slot) {
+    if (!l || !p || !law_take_program(l, p)) {
         law_free(l);
         free(p);
-        free(slot);
         return load_nomem(ld, map), 0;
     }
-    const rt_program **rslot = xcalloc(1, sizeof *rslot);
-    if (!rslot) {
-        law_free(l);
-        free(p);
-        free(slot);
-        return load_nomem(ld, map), 0;
-    }
-    slot[0] = p;
-    rslot[0] = &p->rt;
-    l->progs = slot;
-    l->rtprogs = rslot;
-    l->nprogs = 1;
     quantity xq = Q_TIME;
     int ok = (of_cam ? cam_variable(l, &xq) || (load_nomem(ld, map), 0)
                      : load_variable(ld, map, who, l, p, &xq)) &&

@@ -643,25 +643,6 @@ static const char *plural(size_t n)
     return n == 1 ? "" : "s";
 }
 
-/* v with the fewest digits that read back as v ("0.1", not "0.10000000000000001"),
- * but at least its integer digits below 1e17 ("100", not "1e+02"). */
-static const char *shortest(double v, char *buf, size_t size)
-{
-    if (isnan(v)) {
-        snprintf(buf, size, "nan");
-        return buf;
-    }
-    int digits = 1;
-    if (fabs(v) >= 1 && fabs(v) < 1e17)
-        digits = (int)floor(log10(fabs(v))) + 1;
-    for (; digits <= 17; digits++) {
-        snprintf(buf, size, "%.*g", digits, v);
-        if (strtod(buf, NULL) == v)
-            break;
-    }
-    return buf;
-}
-
 static int text_width(int w, const char *s)
 {
     size_t n = strlen(s);
@@ -727,15 +708,14 @@ static void print_first(const cmp *c, FILE *f)
         if (c->cols[i].first_bad != NO_ROW && (!best || c->cols[i].first_bad < best->first_bad))
             best = &c->cols[i];
     if (best) {
-        char x[32], y[32];
+        char x[FMT_DOUBLE_MAX], y[FMT_DOUBLE_MAX];  /* the fewest digits that read back */
         size_t row = best->first_bad;
         const char *tx = compare_cell_text(c->out, row, (size_t)best->o);
         const char *ty = compare_cell_text(c->golden, row, best->g);
+        fmt_double(c->out->values[row * c->out->ncols + (size_t)best->o], x);
+        fmt_double(c->golden->values[row * c->golden->ncols + best->g], y);
         fprintf(f, " (first: %s at row %zu: %s vs %s)", c->golden->names[best->g], row + 1,
-                tx ? tx : shortest(c->out->values[row * c->out->ncols + (size_t)best->o], x,
-                                   sizeof x),
-                ty ? ty : shortest(c->golden->values[row * c->golden->ncols + best->g], y,
-                                   sizeof y));
+                tx ? tx : x, ty ? ty : y);
         return;
     }
     for (size_t i = 0; i < c->ncols; i++) {
