@@ -272,12 +272,17 @@ static void local_links(text *t, const mech_model *m, const ynode *root, const p
  * solved first row's angles and displacements. */
 static void local_initial(text *t, const mech_model *m, const pose *p)
 {
+    int *locked_of = load_locked_sliders(m);
+    if (!locked_of) {
+        t->failed = 1;
+        return;
+    }
     put(t, "initial:                 # the drawn assembly, at the driver's first value\n");
     for (int li = 1; li < m->nlinks; li++) {
         int driven = 0;
         for (int k = 0; k < m->ndrivers; k++)
             driven |= m->drivers[k].kind == MECH_DRIVE_ANGLE && m->drivers[k].index == li;
-        if (driven || load_locked_slider_of(m, li) >= 0)
+        if (driven || locked_of[li] >= 0)
             continue;
         put(t, "  %s: ", m->links[li].name);
         put_num(t, col(p, m->links[li].name, "angle"), p->ang);
@@ -293,6 +298,7 @@ static void local_initial(text *t, const mech_model *m, const pose *p)
         put_num(t, col(p, m->joints[j].name, "s"), p->len);
         put(t, "\n");
     }
+    free(locked_of);
 }
 
 /* ---- local -> drawn -------------------------------------------------- */
@@ -335,15 +341,16 @@ static void drawn_links(text *t, const mech_model *m, const ynode *root, const p
                         const char *file)
 {
     const ynode *links = ymap_get(root, "links");
+    int *locked_of = load_locked_sliders(m);
     put(t, "links:\n");
     for (int li = 1; li < m->nlinks; li++) {
         const mech_link *l = &m->links[li];
-        int *order = calloc((size_t)l->npoints + 1, sizeof *order);
+        int *order = locked_of ? calloc((size_t)l->npoints + 1, sizeof *order) : NULL;
         if (!order) {
             t->failed = 1;
-            return;
+            break;
         }
-        if (!drawn_order(l, order) && load_locked_slider_of(m, li) < 0)
+        if (!drawn_order(l, order) && locked_of[li] < 0)
             fprintf(stderr, "%s: warning: link '%s' has no point at its frame's origin with "
                     "another on its x axis: its angle in the drawn form is the direction "
                     "from '%s' to '%s'\n", file, l->name, l->points[order[0]].name,
@@ -376,6 +383,7 @@ static void drawn_links(text *t, const mech_model *m, const ynode *root, const p
         }
         free(order);
     }
+    free(locked_of);
 }
 
 /* ---- the joints: a slider's angle, local <-> global ---------------- */

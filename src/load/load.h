@@ -725,7 +725,7 @@ int load_drawn_at(const loader *ld, int id, double xy[2]);
  * the joints, the driver and `initial:`), the drawn driver value (the
  * start of the sweep), and the guesses that cannot act, warned about. */
 void load_guesses_from_points(loader *ld);
-int load_locked_slider_of(const mech_model *m, int link);  /* joint index, or -1 */
+int *load_locked_sliders(const mech_model *m);  /* [links] joint index or -1; free() it */
 void load_branches(loader *ld, const ynode *seq);
 void load_loops(loader *ld, const ynode *seq);
 

@@ -21,15 +21,23 @@ typedef struct placing {
     unsigned char *turned;   /* [links] the angle is known */
     unsigned char *slid;     /* [joints] the displacement is known */
     int *pguess_of;          /* [points] index into ld->pguess, or -1 */
+    int *locked_of;          /* [links] load_locked_sliders */
 } placing;
 
-int load_locked_slider_of(const mech_model *m, int link)
+/* [links] the locked slider whose block each link is (the first such joint),
+ * or -1; one pass over the joints, so that callers looping over links stay
+ * linear in the size (a chain of 10^4 loops). NULL when out of memory. */
+int *load_locked_sliders(const mech_model *m)
 {
-    for (int j = 0; j < m->njoints; j++)
-        if (m->joints[j].kind == MECH_JOINT_SLIDER && m->joints[j].locked &&
-            m->joints[j].link[0] == link)
-            return j;
-    return -1;
+    int *of = xcalloc((size_t)m->nlinks + 1, sizeof *of);
+    if (!of)
+        return NULL;
+    for (int l = 0; l < m->nlinks; l++)
+        of[l] = -1;
+    for (int j = m->njoints - 1; j >= 0; j--)
+        if (m->joints[j].kind == MECH_JOINT_SLIDER && m->joints[j].locked)
+            of[m->joints[j].link[0]] = j;
+    return of;
 }
 
 static void add_guess(loader *ld, int is_slider, int index, double value, mech_mark at)
@@ -147,7 +155,7 @@ static void propagate(placing *pl)
     for (int changed = 1; changed;) {
         changed = 0;
         for (int li = 1; li < m->nlinks; li++) {
-            int j = load_locked_slider_of(m, li);
+            int j = pl->locked_of[li];
             if (!pl->turned[li] && j >= 0 && pl->turned[m->joints[j].link[1]]) {
                 pl->angle[li] = pl->angle[m->joints[j].link[1]];  /* turns with its guide */
                 pl->turned[li] = 1;
@@ -333,8 +341,9 @@ void load_guesses_from_points(loader *ld)
     pl.angle = xcalloc(nl, sizeof *pl.angle);
     pl.turned = xcalloc(nl, 1);
     pl.slid = xcalloc((size_t)m->njoints + 1, 1);
+    pl.locked_of = load_locked_sliders(m);
     if (pl.pos && pl.placed && pl.from_guess && pl.pguess_of && pl.used && pl.angle &&
-        pl.turned && pl.slid) {
+        pl.turned && pl.slid && pl.locked_of) {
         for (size_t i = 0; i < np; i++)
             pl.pguess_of[i] = -1;
         double q0 = m->has_start ? m->start_q : m->has_driver ? m->driver.values[0] : 0.0;
@@ -351,7 +360,7 @@ void load_guesses_from_points(loader *ld)
         diag_nomem(ld->d, ld->file, (mech_mark){0, 0});
     }
     void *blocks[] = {pl.pos, pl.placed, pl.from_guess, pl.pguess_of, pl.used, pl.angle,
-                      pl.turned, pl.slid};
+                      pl.turned, pl.slid, pl.locked_of};
     for (size_t i = 0; i < COUNT(blocks); i++)
         free(blocks[i]);
 }

@@ -230,8 +230,11 @@ void load_initial(loader *ld, const ynode *map)
     if (!load_check_map(ld, map, NULL, 0, "'initial'", "initial guess for"))
         return;
     m->guesses = xcalloc(map->n, sizeof *m->guesses);
-    if (!m->guesses)
+    int *locked_of = load_locked_sliders(m);
+    if (!m->guesses || !locked_of) {
+        free(locked_of);
         return (void)load_nomem(ld, map);
+    }
     for (size_t i = 0; i < map->n; i++) {
         const ynode *k = map->items[2 * i], *v = map->items[2 * i + 1];
         const char *name = load_get_name(ld, k, "initial guess name");
@@ -247,7 +250,7 @@ void load_initial(loader *ld, const ynode *map)
             load_err(ld, k, "'%s' is the driver; its angle comes from 'driver'", name);
         else if (li > 0) {
             g->index = li;
-            if (load_locked_slider_of(m, li) >= 0)
+            if (locked_of[li] >= 0)
                 diag_warning(ld->d, ld->file, k->mark, "the initial guess for '%s' has no "
                              "effect: a block on a locked slider turns with its guide", name);
             if (load_get_quantity(ld, v, Q_ANGLE, "initial angle", &g->value))
@@ -276,6 +279,7 @@ void load_initial(loader *ld, const ynode *map)
             free(names);
         }
     }
+    free(locked_of);
 }
 
 /* A branch condition whose turn A -> B -> C can never be strictly ccw or cw:
