@@ -68,6 +68,9 @@ mech_variant_status fail_variant_status(mech_fail_kind k);
 
 /* ---- util.c: checked allocation and small string helpers. */
 void *xcalloc(size_t n, size_t size);           /* NULL on overflow or failure */
+/* xcalloc for blocks of 8 MiB and more (result tables): huge-page aligned
+ * and advised (util.c); free() it. */
+void *xcalloc_large(size_t n, size_t size);
 /* For tests of the out-of-memory paths: when > 0, it counts down at every
  * xcalloc, xrealloc_array and xstrdup of this thread, and the one that
  * brings it to 0 fails (later ones succeed). Thread-local: a test that sets

@@ -1,7 +1,9 @@
 /* src/base/util.c: checked allocation and string helpers. */
+#define _DEFAULT_SOURCE 1 /* madvise, MADV_HUGEPAGE */
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mman.h>
 
 #include "base.h"
 
@@ -20,6 +22,30 @@ void *xcalloc(size_t n, size_t size)
     if (n == 0 || size == 0)
         n = size = 1;
     return calloc(n, size);
+}
+
+/* A result table of 10^6 rows is some 300 MB, first touched row by row as
+ * the sweep fills it: with 4 KiB pages that is 80 000 page faults (about
+ * 0.7 s of system time, more than writing the CSV costs) and as many TLB
+ * misses. Such a block is aligned to 2 MiB and offered to the kernel's
+ * transparent huge pages (Linux; where it has no such advice, or declines
+ * it, the block is an ordinary one). */
+void *xcalloc_large(size_t n, size_t size)
+{
+    const size_t huge = (size_t)2 << 20;
+    if (n == 0 || size == 0 || n > SIZE_MAX / size || n * size < 4 * huge)
+        return xcalloc(n, size);
+    if (fail_now() || n * size > SIZE_MAX - huge)
+        return NULL;
+    size_t bytes = (n * size + huge - 1) / huge * huge;
+    void *p = NULL;
+    if (posix_memalign(&p, huge, bytes) != 0)
+        return NULL;
+#ifdef MADV_HUGEPAGE
+    (void)madvise(p, bytes, MADV_HUGEPAGE); /* advice only: a refusal changes nothing */
+#endif
+    memset(p, 0, bytes);
+    return p;
 }
 
 void *xrealloc_array(void *p, size_t n, size_t size)

@@ -271,7 +271,7 @@ int columns_make_table(const column_layout *cl, mech_table *t, int nrows)
             return MECH_ENOMEM;
         }
     }
-    t->values = xcalloc((size_t)nrows * (size_t)cl->ncols + 1, sizeof *t->values);
+    t->values = xcalloc_large((size_t)nrows * (size_t)cl->ncols + 1, sizeof *t->values);
     return t->values ? MECH_OK : MECH_ENOMEM;
 }
 
