@@ -344,8 +344,9 @@ void report_put_animation(FILE *f, const report_input *in)
         fputs("<tr><td>", f);
         plot_put_text(f, t->columns[c].name);
         double v = in->nframes > 0 ? mech_table_get(t, in->frame_rows[0], c) : NAN;
-        if (isfinite(v))
-            fprintf(f, "</td><td class=\"num\" id=\"v%d\">%.17g</td><td>", c, v);
+        char num[FMT_DOUBLE_MAX];
+        if (isfinite(v) && fmt_double(v, num) > 0)
+            fprintf(f, "</td><td class=\"num\" id=\"v%d\">%s</td><td>", c, num);
         else
             fprintf(f, "</td><td class=\"num\" id=\"v%d\">n/a</td><td>", c);
         plot_put_text(f, t->columns[c].unit);

@@ -267,7 +267,9 @@ void report_put_json_string(FILE *f, const char *s)
 void report_put_json(FILE *f, const report_input *in)
 {
     const mech_table *t = in->t;
-    fprintf(f, "{\"duration\":%.17g,\"columns\":[", in->duration);
+    char num[FMT_DOUBLE_MAX];
+    fmt_double(in->duration, num);  /* finite: a solved sweep's length */
+    fprintf(f, "{\"duration\":%s,\"columns\":[", num);
     for (int c = 0; c < t->ncolumns; c++) {
         fputs(c ? ",\n{\"name\":" : "{\"name\":", f);
         report_put_json_string(f, t->columns[c].name);
@@ -281,9 +283,10 @@ void report_put_json(FILE *f, const report_input *in)
         fprintf(f, "%s[%d", k ? ",\n" : "\n", r);
         for (int c = 0; c < t->ncolumns; c++) {
             double v = mech_table_get(t, r, c);
-            if (isfinite(v))
-                fprintf(f, ",%.17g", v);
-            else
+            if (isfinite(v)) {
+                fmt_double(v, num);
+                fprintf(f, ",%s", num);
+            } else
                 fputs(",null", f);
         }
         fputc(']', f);
