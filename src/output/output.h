@@ -136,7 +136,7 @@ int compare_read_h5(const char *path, compare_table *t, mech_diag *d);
 void compare_table_free(compare_table *t);  /* accepts an empty table */
 /* output_h5.c: a table read back (or made from text, mech sweep's) as
  * HDF5, as output_write_h5 writes a solver's; a column with a text cell
- * is a dataset of strings (numbers in it as %.17g). */
+ * is a dataset of strings (numbers in it as the CSV writes them). */
 int output_write_h5_table(const compare_table *t, const char *path, const char *const *keys,
                           const char *const *values, int nattrs, mech_diag *d);
 /* The root attributes names[0..n) of the HDF5 file at path, each a string

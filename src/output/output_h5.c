@@ -122,14 +122,14 @@ static int col_is_text(const h5_job *j, int c)
 }
 
 /* Column c's cells as strings into v[nrows]: the words, and a number as
- * %.17g into text[nrows * 32]. */
+ * the CSV writes it (fmt_double) into text[nrows * FMT_DOUBLE_MAX]. */
 static void text_cells(const h5_job *j, int c, const char **v, char *text)
 {
     for (size_t r = 0; r < j->ct->nrows; r++) {
         v[r] = compare_cell_text(j->ct, r, (size_t)c);
         if (!v[r]) {
-            snprintf(text + 32 * r, 32, "%.17g", cell(j, (long)r, c));
-            v[r] = text + 32 * r;
+            fmt_double(cell(j, (long)r, c), text + FMT_DOUBLE_MAX * r);
+            v[r] = text + FMT_DOUBLE_MAX * r;
         }
     }
 }
@@ -141,7 +141,7 @@ static int put_column(hid_t file, const h5_job *j, int c, double *buf)
     hsize_t n = (hsize_t)job_nrows(j);
     int text = col_is_text(j, c);
     const char **strs = text ? calloc(n + 1, sizeof *strs) : NULL;
-    char *arena = text ? malloc(32 * n + 1) : NULL;
+    char *arena = text ? malloc((size_t)FMT_DOUBLE_MAX * n + 1) : NULL;
     hid_t type = text ? string_type() : H5T_IEEE_F64LE;
     if (text && (!strs || !arena || type < 0)) {
         free(strs);
