@@ -325,6 +325,7 @@ bench:
 	  build/bench/bench-solve mechanisms/*.yaml bench/files/*.yaml && \
 	  build/bench/bench-hand mechanisms && \
 	  MECH=build/bench/mech BUILD=build/bench sh bench/bench_codegen.sh && \
+	  MECH=build/bench/mech sh bench/bench_compile.sh && \
 	  sh bench/bench_ratio.sh build/bench/bench-hand && \
 	  build/bench/bench-accuracy mechanisms build/bench && \
 	  build/bench/bench-scale build/bench && \
