@@ -33,7 +33,9 @@ void *xcalloc(size_t n, size_t size)
 void *xcalloc_large(size_t n, size_t size)
 {
     const size_t huge = (size_t)2 << 20;
-    if (n == 0 || size == 0 || n > SIZE_MAX / size || n * size < 4 * huge)
+    if (size && n > SIZE_MAX / size)
+        return NULL;  /* as calloc, without a sanitizer's report of the overflow */
+    if (n == 0 || size == 0 || n * size < 4 * huge)
         return xcalloc(n, size);
     if (fail_now() || n * size > SIZE_MAX - huge)
         return NULL;
