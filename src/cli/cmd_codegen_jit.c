@@ -593,12 +593,12 @@ long cmd_jit_auto_rows(void)
 }
 
 /* --engine auto, a run of nq rows: 1 (why in how) to keep the
- * interpreter: options the generated code does not follow, or a run too
- * short to pay for the compiler while the cache holds no solver; 0 to go
- * on. *worth: the run is long enough to compile. */
-static int auto_keeps_interpreter(const mech_solve_options *o, int nq, int *worth)
+ * interpreter: options the generated code does not follow (opt, from
+ * unsupported), or a run too short to pay for the compiler while the
+ * cache holds no solver; 0 to go on. *worth: the run is long enough to
+ * compile. */
+static int auto_keeps_interpreter(const char *opt, int nq, int *worth)
 {
-    const char *opt = unsupported(o);
     long at = cmd_jit_auto_rows();
     *worth = at > 0 && nq >= at;
     long hit_at = at / 100 > 1 ? at / 100 : 1;  /* loading a cached solver: about 3 ms */
@@ -625,11 +625,11 @@ int cmd_jit_solve(const mech_model *m, const mech_solve_options *o, mech_table *
     int worth = 1, nq = 0, bad = -1;
     how[0] = '\0';
     double *q = positions(m, o, &nq);
-    if (automatic && auto_keeps_interpreter(o, nq, &worth)) {
+    const char *opt = unsupported(o);
+    if (automatic && auto_keeps_interpreter(opt, nq, &worth)) {
         free(q);
         return mech_solve(m, o, t, st, d);
     }
-    const char *opt = unsupported(o);
     if (opt) {
         free(q);
         snprintf(how, sizeof how, "interpreted (--jit does not follow %s)", opt);

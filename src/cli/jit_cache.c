@@ -107,22 +107,38 @@ void jit_cache_close(jit_cache *c)
     c->usable = 0;
 }
 
+/* The cache directory opened for listing (its own descriptor, so its
+ * offset is not c->fd's), or NULL. */
+static DIR *open_listing(const jit_cache *c)
+{
+    int fd = openat(c->fd, ".", O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    DIR *dir = fd >= 0 ? fdopendir(fd) : NULL;
+    if (!dir && fd >= 0)
+        close(fd);
+    return dir;
+}
+
+/* 1 with *h when name is an entry's key file, HASH.key (16 hex digits). */
+static int key_file(const char *name, uint64_t *h)
+{
+    unsigned long long v;
+    char tail[8];
+    if (strlen(name) != 20 || sscanf(name, "%16llx.%3s", &v, tail) != 2 ||
+        strcmp(tail, "key") != 0)
+        return 0;
+    *h = (uint64_t)v;
+    return 1;
+}
+
 int jit_cache_empty(const jit_cache *c)
 {
-    if (!c->usable)
+    DIR *dir = c->usable ? open_listing(c) : NULL;
+    if (!dir)
         return 1;
-    int fd = openat(c->fd, ".", O_RDONLY | O_DIRECTORY | O_CLOEXEC);  /* its own offset */
-    DIR *dir = fd >= 0 ? fdopendir(fd) : NULL;
-    if (!dir) {
-        if (fd >= 0)
-            close(fd);
-        return 1;
-    }
     int empty = 1;
-    for (struct dirent *e; empty && (e = readdir(dir));) {
-        size_t n = strlen(e->d_name);
-        empty = !(n > 4 && strcmp(e->d_name + n - 4, ".key") == 0);
-    }
+    uint64_t h;
+    for (struct dirent *e; empty && (e = readdir(dir));)
+        empty = !key_file(e->d_name, &h);
     closedir(dir);
     return empty;
 }
@@ -240,13 +256,9 @@ static void remove_entry(const jit_cache *c, uint64_t h)
  * bound (the newest entry stays), and temporary files of killed runs. */
 static void trim(const jit_cache *c, uint64_t keep)
 {
-    int fd = openat(c->fd, ".", O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-    DIR *dir = fd >= 0 ? fdopendir(fd) : NULL;
-    if (!dir) {
-        if (fd >= 0)
-            close(fd);
+    DIR *dir = open_listing(c);
+    if (!dir)
         return;
-    }
     cache_entry *e = NULL;
     size_t n = 0, cap = 0;
     long long total = 0;
@@ -254,8 +266,8 @@ static void trim(const jit_cache *c, uint64_t keep)
     clock_gettime(CLOCK_REALTIME, &now);
     for (struct dirent *d; (d = readdir(dir)) != NULL;) {
         struct stat s, so;
-        unsigned long long h;
-        char tail[8], sname[40];
+        uint64_t h;
+        char sname[40];
         if (fstatat(c->fd, d->d_name, &s, AT_SYMLINK_NOFOLLOW) != 0)
             continue;
         if (strncmp(d->d_name, ".tmp-", 5) == 0) {
@@ -263,8 +275,7 @@ static void trim(const jit_cache *c, uint64_t keep)
                 unlinkat(c->fd, d->d_name, 0);
             continue;
         }
-        if (strlen(d->d_name) != 20 || sscanf(d->d_name, "%16llx.%3s", &h, tail) != 2 ||
-                strcmp(tail, "key") != 0)
+        if (!key_file(d->d_name, &h))
             continue;
         entry_name(sname, sizeof sname, h, "so");
         long long bytes = s.st_size + (fstatat(c->fd, sname, &so, AT_SYMLINK_NOFOLLOW) == 0
