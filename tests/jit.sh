@@ -289,4 +289,50 @@ grep -q "mech solve: note: the compiled solver: no C compiler ran ('false' .*the
     cmp -s "$tmp/a8.csv" "$tmp/c-interp.csv" && pass || fail "auto: a failing compiler: $(cat "$tmp/auto.err")"
 [ -z "$(ls "$tmp/jt")" ] && pass || fail "auto: files left in TMPDIR: $(ls "$tmp/jt")"
 
+# ---- mech batch chooses as mech solve does, on its worker threads -----------
+# three files on three threads: the four-bar, the same four-bar under another
+# name and path, the double crank; with MECH_JIT_AUTO_ROWS=50 each is long
+# enough to compile, but one structure compiles once (the other file waits
+# for the build and loads it from the cache); the tables are the
+# interpreter's byte for byte
+mkdir -p "$tmp/bj" "$tmp/bj-i" "$tmp/bj-c"
+cp mechanisms/fourbar.yaml "$tmp/bj/fourbar-copy.yaml"
+bfiles="mechanisms/fourbar.yaml $tmp/bj/fourbar-copy.yaml mechanisms/double-crank.yaml"
+rm -rf "$adir"
+rm -f "$tmp/cc.log"
+"$MECH" batch -q -j 3 --engine interpreted --out-dir "$tmp/bj-i" $bfiles >/dev/null 2>"$tmp/bj.err" ||
+    fail "batch --engine interpreted: $(cat "$tmp/bj.err")"
+env -u MECH_JIT_AUTO MECH_JIT_AUTO_ROWS=50 MECH_CACHE_DIR="$adir" TMPDIR=$tmp/jt CC=$tmp/cc-log \
+    "$MECH" batch -j 3 --out-dir "$tmp/bj-c" $bfiles >"$tmp/bj.out" 2>"$tmp/bj.err"
+bstatus=$?
+[ "$bstatus" = 0 ] && [ "$(grep -c "solver compiled (auto: " "$tmp/bj.err")" = 3 ] &&
+    [ "$(grep -c "solver compiled (auto: from the cache" "$tmp/bj.err")" = 1 ] &&
+    [ "$(wc -l <"$tmp/cc.log")" = 2 ] && pass ||
+    fail "batch: three files, two structures: exit $bstatus, $(wc -l <"$tmp/cc.log") compiler runs: $(cat "$tmp/bj.err")"
+bsame=1
+for n in fourbar fourbar-copy double-crank; do
+    cmp -s "$tmp/bj-i/$n.csv" "$tmp/bj-c/$n.csv" || bsame=0
+done
+[ $bsame = 1 ] && pass || fail "batch: the compiled tables differ from the interpreter's"
+[ -z "$(ls "$tmp/jt")" ] && pass || fail "batch: files left in TMPDIR: $(ls "$tmp/jt")"
+# the default: short runs interpreted, no compiler, no message
+rm -f "$tmp/cc.log"
+env -u MECH_JIT_AUTO MECH_CACHE_DIR="$adir" TMPDIR=$tmp/jt CC=$tmp/cc-log \
+    "$MECH" batch -j 3 $bfiles >/dev/null 2>"$tmp/bj.err" && [ ! -e "$tmp/cc.log" ] &&
+    ! grep -q "solver" "$tmp/bj.err" && pass || fail "batch: short runs compiled: $(cat "$tmp/bj.err")"
+# --engine compiled with a compiler that fails: each file's note, the
+# interpreter's tables, exit 0
+rm -rf "$adir" "$tmp/bj-c"
+env -u MECH_JIT_AUTO MECH_CACHE_DIR="$adir" TMPDIR=$tmp/jt CC=false \
+    "$MECH" batch -j 3 --engine compiled --out-dir "$tmp/bj-c" $bfiles >/dev/null 2>"$tmp/bj.err"
+bstatus=$?
+[ "$bstatus" = 0 ] &&
+    grep -q "^$tmp/bj/fourbar-copy.yaml: note: --jit: no C compiler ran ('false'" "$tmp/bj.err" &&
+    [ "$(grep -c "note: --jit: no C compiler ran" "$tmp/bj.err")" = 3 ] &&
+    cmp -s "$tmp/bj-i/double-crank.csv" "$tmp/bj-c/double-crank.csv" && pass ||
+    fail "batch --engine compiled, no compiler: exit $bstatus: $(cat "$tmp/bj.err")"
+"$MECH" batch --engine fast mechanisms/fourbar.yaml >/dev/null 2>"$tmp/bj.err"
+[ $? = 2 ] && grep -q "engine.*auto, compiled or interpreted" "$tmp/bj.err" && pass ||
+    fail "batch --engine fast: $(cat "$tmp/bj.err")"
+
 summary

@@ -234,6 +234,20 @@ extern const cmd_word cmd_friction_words[];
      .label = "-j, --jobs N",                                                            \
      .help = "worker threads (default: the processors this process may\n"                 \
              "run on: its CPU affinity, as set by taskset or Slurm)"}
+/* --engine auto|compiled|interpreted (solve, batch; a CMD_OPT_WORD into an
+ * int): 0 auto, 1 compiled, 2 interpreted (cmd_jit_solve). */
+extern const cmd_word cmd_engine_words[];
+#define CMD_ENGINE_ENTRY(at_)                                                            \
+    {.names = "--engine", .kind = CMD_OPT_WORD, .at = (at_), .words = cmd_engine_words,   \
+     .expect = "is auto, compiled or interpreted", .label = "--engine E",                \
+     .help = "compiled: solve with the code 'mech codegen' writes,\n"                     \
+             "compiled by $CC (else cc) and loaded, the same table;\n"                    \
+             "without a compiler, or where it cannot, the interpreter\n"                  \
+             "solves (a note says why; docs/codegen.md); interpreted:\n"                  \
+             "the interpreter; auto (default): compiled from 2 000 000\n"                 \
+             "rows ($MECH_JIT_AUTO_ROWS), or from 20 000 when the cache\n"                \
+             "holds the solver; else interpreted (solve's --stats and\n"                   \
+             "batch's messages say which)"}
 /* --from A --to B [--steps N]: "--from and --to go together" unless both
  * or neither are given (returns -1 to go on, else the exit status). */
 int cmd_check_range_pair(const char *command, const char *from, const char *to);
@@ -305,18 +319,21 @@ int cmd_report(int argc, char **argv);
 extern const cmd_spec cmd_codegen_spec;
 int cmd_codegen(int argc, char **argv);
 /* `mech solve --jit` (cmd_codegen_jit.c): mech_solve through the generated
- * code, compiled and loaded; the interpreter, with a note, where it cannot.
- * automatic (--engine auto, the default): compiled only where it pays off:
- * at least cmd_jit_auto_rows() rows, or a hundredth of them and a cached
- * solver of the structure; the interpreter otherwise, silently (--stats
- * says which). */
+ * code, compiled and loaded; the interpreter, with a note ("WHO: note: ..."
+ * on notes), where it cannot. automatic (--engine auto, the default):
+ * compiled only where it pays off: at least cmd_jit_auto_rows() rows, or a
+ * hundredth of them and a cached solver of the structure; the interpreter
+ * otherwise, silently (--stats says which). Threads may call it at once
+ * (mech batch): one compiles at a time, the others wait and may then find
+ * its solver in the cache. */
 int cmd_jit_solve(const mech_model *m, const mech_solve_options *o, mech_table *t,
-                  mech_solve_stats *st, mech_diag *d, int automatic);
+                  mech_solve_stats *st, mech_diag *d, int automatic, FILE *notes,
+                  const char *who);
 /* The rows from which --engine auto compiles: $MECH_JIT_AUTO_ROWS, else
  * 2 000 000; -1 when MECH_JIT_AUTO=off (never by itself). */
 long cmd_jit_auto_rows(void);
-/* How the last cmd_jit_solve ran, for --stats: "compiled (...)", or why
- * the interpreter did ("" before any). */
+/* How this thread's last cmd_jit_solve ran, for --stats: "compiled (...)",
+ * or why the interpreter did ("" before any). */
 const char *cmd_jit_how(void);
 
 /* The cache of compiled solvers (jit_cache.c, docs/codegen.md): a

@@ -55,6 +55,7 @@ typedef struct batch {
     compare_options cmp;
     int forces;
     int strict;               /* --strict: a suspect assembly fails the file */
+    int engine;               /* --engine: 0 auto, 1 compiled, 2 interpreted */
     int skip_existing;
     cmd_progress progress;    /* files done, on standard error */
     int quiet;
@@ -161,7 +162,10 @@ static void run_job(const batch *b, job *jb)
         mech_solve_options o;
         mech_solve_options_default(&o);
         o.forces = b->forces;
-        rc = mech_solve(m, &o, &t, &st, &d);
+        rc = b->engine == 2 ? mech_solve(m, &o, &t, &st, &d)
+             : cmd_jit_solve(m, &o, &t, &st, &d, b->engine == 0, out, jb->path);
+        if (b->engine != 2 && strncmp(cmd_jit_how(), "compiled", 8) == 0)
+            fprintf(out, "%s: solver %s\n", jb->path, cmd_jit_how());
         if (b->strict && cmd_strict_assembly(&d) > 0 && rc == MECH_OK)
             rc = MECH_ESOLVE;
     }
@@ -574,6 +578,7 @@ typedef struct batch_opts {
     int nthreads, quiet;
     cmd_shard shard;          /* --shard K/M */
     int unsolvable_ok, forces, skip_existing, strict;
+    int engine;               /* --engine: 0 auto, 1 compiled, 2 interpreted */
     const char *files_from;   /* --files-from LIST */
     const char *table;        /* -o TABLE */
     const char *out_dir, *golden_dir;
@@ -623,6 +628,7 @@ static const cmd_opt options[] = {
     {.names = "--forces", .kind = CMD_OPT_FLAG, .at = AT(forces), .flag = 1, .label = "--forces",
      .help = "also the force analysis, for every file"},
     CMD_STRICT_ENTRY(AT(strict)),
+    CMD_ENGINE_ENTRY(AT(engine)),
     {.names = "-q|--quiet", .kind = CMD_OPT_FLAG, .at = AT(quiet), .flag = 1,
      .flags = CMD_RUN_ONLY, .label = "-q, --quiet",
      .help = "no progress report (a bar on a terminal, else a line every\n"
@@ -635,7 +641,8 @@ const cmd_spec cmd_batch_spec = {
     .summary = "solve many files on worker threads, with golden comparisons",
     .usage = "usage: mech batch FILE... [-j N] [--out-dir DIR] [--golden DIR] [--shard K/M]\n"
              "                  [--rtol R] [--atol A] [--forces] [-q] [--files-from LIST]\n"
-             "                  [--skip-existing] [--unsolvable-ok] [--strict] [-o TABLE]\n",
+             "                  [--skip-existing] [--unsolvable-ok] [--strict] [-o TABLE]\n"
+             "                  [--engine auto|compiled|interpreted]\n",
     .about = "Solve many mechanism files on N worker threads, each exactly as 'mech solve\n"
              "FILE' would, and print a summary table: file, status, steps, worst residual,\n"
              "time per step, and the golden comparison. A failing file does not stop or\n"
@@ -669,6 +676,7 @@ static int parse_batch_args(int argc, char **argv, batch *b, batch_opts *bo)
     b->cmp.atol = bo->atol;
     b->forces = bo->forces;
     b->strict = bo->strict;
+    b->engine = bo->engine;
     b->skip_existing = bo->skip_existing;
     return -1;
 }

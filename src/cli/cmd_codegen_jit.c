@@ -16,6 +16,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
+#include <pthread.h>
 #include <signal.h>
 #include <spawn.h>
 #include <stdio.h>
@@ -93,8 +94,15 @@ static const char *const wrapper[] = {
     "}",
     NULL};
 
-/* How the last sweep ran (cmd_jit_how). */
-static char how[700];
+/* How the last sweep of this thread ran (cmd_jit_how): mech batch solves
+ * its files on several threads. */
+static _Thread_local char how[700];
+
+/* One build at a time in the process (mech batch's threads): the guard
+ * below (the private directory, the compiler's pid, the signal actions) is
+ * the process's, and a second file of the same structure then finds the
+ * first one's solver in the cache instead of compiling it again. */
+static pthread_mutex_t build_lock = PTHREAD_MUTEX_INITIALIZER;
 
 const char *cmd_jit_how(void)
 {
@@ -234,10 +242,10 @@ static void guard_end(void)
 {
     sigset_t set, old;
     guarded_set(&set);
-    sigprocmask(SIG_BLOCK, &set, &old);
+    pthread_sigmask(SIG_BLOCK, &set, &old);
     remove_guarded_dir();
     restore_actions();
-    sigprocmask(SIG_SETMASK, &old, NULL);
+    pthread_sigmask(SIG_SETMASK, &old, NULL);
 }
 
 /* mkdtemp in tmp, its file names set for the handler in the same step. */
@@ -245,13 +253,13 @@ static int guard_mkdtemp(const char *tmp)
 {
     sigset_t set, old;
     guarded_set(&set);
-    sigprocmask(SIG_BLOCK, &set, &old);
+    pthread_sigmask(SIG_BLOCK, &set, &old);
     snprintf(guard.dir, sizeof guard.dir, "%s/mech-jit.XXXXXX", tmp);
     int ok = mkdtemp(guard.dir) != NULL;
     for (int i = 0; ok && i < JIT_FILES; i++)
         snprintf(guard.files[i], sizeof guard.files[i], "%s/%s", guard.dir, jit_file_names[i]);
     guard.live = ok;
-    sigprocmask(SIG_SETMASK, &old, NULL);
+    pthread_sigmask(SIG_SETMASK, &old, NULL);
     return ok ? 0 : -1;
 }
 
@@ -314,14 +322,14 @@ static pid_t spawn_compiler(cc_command *c)
     posix_spawn_file_actions_adddup2(&fa, 1, 2);
     posix_spawnattr_init(&at);
     guarded_set(&set);
-    sigprocmask(SIG_BLOCK, &set, &old);
+    pthread_sigmask(SIG_BLOCK, &set, &old);
     posix_spawnattr_setsigmask(&at, &old);
     posix_spawnattr_setpgroup(&at, 0);
     posix_spawnattr_setflags(&at, POSIX_SPAWN_SETPGROUP | POSIX_SPAWN_SETSIGMASK);
     int e = posix_spawnp(&pid, c->argv[0], &fa, &at, c->argv, environ);
     if (e == 0)
         guard.compiler = pid;
-    sigprocmask(SIG_SETMASK, &old, NULL);
+    pthread_sigmask(SIG_SETMASK, &old, NULL);
     posix_spawnattr_destroy(&at);
     posix_spawn_file_actions_destroy(&fa);
     errno = e;
@@ -433,7 +441,7 @@ static int build_in_dir(jit *j, const mech_model *m, const mech_solve_options *o
     codegen g;
     mech_diag d;
     mech_diag_init(&d);
-    codegen_options co = {"jit", NULL, o->all_blocks, o->forces, o->friction};
+    codegen_options co = {"jit", NULL, o->all_blocks, o->forces, o->friction, 1};
     int rc = codegen_init(&g, m, &co, &d);
     if (rc != MECH_OK) {
         snprintf(note, size, "the code generator: %s",
@@ -504,10 +512,12 @@ static int jit_build(jit *j, const mech_model *m, const mech_solve_options *o,
     const char *tmp = getenv("TMPDIR");
     if (!tmp || !*tmp || strlen(tmp) > 400)
         tmp = "/tmp";
+    pthread_mutex_lock(&build_lock);
     guard_begin();
     int rc = guard_mkdtemp(tmp) == 0 ? build_in_dir(j, m, o, st, cached_only, note, size)
              : (snprintf(note, size, "cannot make a temporary directory in %s", tmp), -1);
     guard_end();
+    pthread_mutex_unlock(&build_lock);
     return rc;
 }
 
@@ -619,7 +629,8 @@ static int auto_keeps_interpreter(const char *opt, int nq, int *worth)
 }
 
 int cmd_jit_solve(const mech_model *m, const mech_solve_options *o, mech_table *t,
-                  mech_solve_stats *st, mech_diag *d, int automatic)
+                  mech_solve_stats *st, mech_diag *d, int automatic, FILE *notes,
+                  const char *who)
 {
     char note[700] = "";
     int worth = 1, nq = 0, bad = -1;
@@ -633,8 +644,8 @@ int cmd_jit_solve(const mech_model *m, const mech_solve_options *o, mech_table *
     if (opt) {
         free(q);
         snprintf(how, sizeof how, "interpreted (--jit does not follow %s)", opt);
-        fprintf(stderr, "mech solve: note: --jit does not follow %s: the interpreter solves the "
-                "sweep\n", opt);
+        fprintf(notes, "%s: note: --jit does not follow %s: the interpreter solves the "
+                "sweep\n", who, opt);
         return mech_solve(m, o, t, st, d);
     }
     double t0 = clock_seconds();
@@ -691,7 +702,7 @@ int cmd_jit_solve(const mech_model *m, const mech_solve_options *o, mech_table *
         return mech_solve(m, o, t, st, d);
     }
     snprintf(how, sizeof how, "interpreted (%s: %.600s)", automatic ? "auto" : "--jit", note);
-    fprintf(stderr, "mech solve: note: %s: %s; the interpreter solves the sweep\n",
+    fprintf(notes, "%s: note: %s: %s; the interpreter solves the sweep\n", who,
             automatic ? "the compiled solver" : "--jit", note);
     return mech_solve(m, o, t, st, d);
 }

@@ -74,7 +74,6 @@ static const cmd_word levels[] = {
 static const cmd_word solvers[] = {{"auto", MECH_LINEAR_AUTO}, {"klu", MECH_LINEAR_KLU}, {NULL, 0}};
 static const cmd_word ranges[] = {{"assembly", 1}, {NULL, 0}};
 static const cmd_word unit_systems[] = {{"si", 0}, {"file", 1}, {NULL, 0}};
-static const cmd_word engines[] = {{"auto", 0}, {"compiled", 1}, {"interpreted", 2}, {NULL, 0}};
 
 #define AT(field) offsetof(solve_args, field)
 
@@ -156,15 +155,7 @@ static const cmd_opt options[] = {
              "coefficient of speed fluctuation CS (0 < CS < 1, e.g.\n"
              "0.02; w the driver speed) printed with the figures\n"
              "above; implies --forces"},
-    {.names = "--engine", .kind = CMD_OPT_WORD, .at = AT(engine), .words = engines,
-     .expect = "is auto, compiled or interpreted", .label = "--engine E",
-     .help = "compiled: solve with the code 'mech codegen' writes,\n"
-             "compiled by $CC (else cc) and loaded, the same table;\n"
-             "without a compiler, or where it cannot, the interpreter\n"
-             "solves (a note says why; docs/codegen.md); interpreted:\n"
-             "the interpreter; auto (default): compiled from 2 000 000\n"
-             "rows ($MECH_JIT_AUTO_ROWS), or from 20 000 when the cache\n"
-             "holds the solver; else interpreted; --stats says which"},
+    CMD_ENGINE_ENTRY(AT(engine)),
     {.names = "--jit", .kind = CMD_OPT_FLAG, .at = AT(jit), .flag = 1, .label = "--jit",
      .help = "the same as --engine compiled"},
     {.names = "-v|--verbose", .kind = CMD_OPT_FLAG, .at = AT(verbose), .flag = 1,
@@ -406,7 +397,8 @@ static int solve_loaded(solve_args *pa, mech_model *m)
     a.opt.progress_ctx = &pr;
     int engine = a.jit ? 1 : a.engine;
     int rc = engine == 2 ? mech_solve(m, &a.opt, &t, &st, &d)
-                         : cmd_jit_solve(m, &a.opt, &t, &st, &d, engine == 0);
+                         : cmd_jit_solve(m, &a.opt, &t, &st, &d, engine == 0, stderr,
+                                         "mech solve");
     cmd_progress_done(&pr);
     int suspect = a.strict ? cmd_strict_assembly(&d) : 0;
     mech_diag_print(&d, stderr);

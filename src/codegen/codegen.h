@@ -28,6 +28,9 @@ typedef struct codegen_options {
     int all_blocks;          /* 1: solve every unknown, not only those the outputs need */
     int forces;              /* 1: the kinetostatics too, -1: not, 0: as the file's outputs say */
     int friction;            /* MECH_FRICTION_ON, _OFF or _BOTH (with forces) */
+    int anonymous;           /* 1: the comments name neither the file nor its title, so
+                                that files of one mechanism give one source (mech solve
+                                --jit's cache) */
 } codegen_options;
 
 typedef struct codegen {
