@@ -95,13 +95,13 @@ echo "factorisations per step; the excess is spread over the general code path's
 echo "work: docs/performance.md, \"Why target 1 is not met\")"
 # Target 2's instruction profile: a chain of 10 000 four-bars (bench-scale
 # --yaml), mech solve 12 against 4 steps of 2.5 deg inside
-# mech_analysis_solve (set-up, row 0 and the state's allocation cancel);
+# analysis_solve, the sweep of mech_solve (set-up, row 0 and the state's allocation cancel);
 # bench-scale's table gives the time and memory against the targets.
 BIN=$(dirname "$HAND")
 if [ -x "$BIN/mech" ] && [ -x "$BIN/bench-scale" ] && "$BIN/bench-scale" --yaml 10000 > "$TMP/chain.yaml"; then
-    a=$(PROFILE=a collect mech_analysis_solve "$BIN/mech" solve "$TMP/chain.yaml" --from 60 --to 90 \
+    a=$(PROFILE=a collect analysis_solve "$BIN/mech" solve "$TMP/chain.yaml" --from 60 --to 90 \
         --steps 12 -o "$TMP/chain.csv")
-    b=$(PROFILE=b collect mech_analysis_solve "$BIN/mech" solve "$TMP/chain.yaml" --from 60 --to 70 \
+    b=$(PROFILE=b collect analysis_solve "$BIN/mech" solve "$TMP/chain.yaml" --from 60 --to 70 \
         --steps 4 -o "$TMP/chain.csv")
     if [ -n "$a" ] && [ -n "$b" ]; then
         echo "issue 21, target 2 (instructions): chain of 10 000 four-bars, mech solve, per loop and"
