@@ -179,15 +179,15 @@ struct mech_system {
                                   ("length of E - B in link 'tray' = 564.97 mm"), or NULL
                                   for a parameter */
     sys_coef *coef;            /* [nvars - SYS_NVARS(n)] what each leaf is */
-    tape tp;                   /* compiled evaluator of every row */
+    tape tp;                   /* compiled evaluator of every row, by the first sys_eval_* */
     double *reg;               /* [tp.nreg] its registers, for sys_eval_* (so those
                                   are not for threads sharing the system; the solver
                                   compiles its own tape and keeps registers per state) */
 };
 
 /* The equations of m with the leaves lv (mech_system_new: no parameter
- * chosen). Only the system with no leaves compiles its own tape (sys_eval_*);
- * the solver plan compiles a polar system's. */
+ * chosen). Only the system with no leaves has its own tape, compiled by the
+ * first sys_eval_*; the solver plan compiles a polar system's. */
 int sys_new_with(const mech_model *m, const sys_leaves *lv, mech_system **out, mech_diag *d);
 
 /* system_coef.c: the leaves (point_base, the chosen parameters and their
@@ -205,10 +205,15 @@ int sys_coef_var(const mech_system *s, const loop_term *t, int is_angle);
 void sys_body_vector(const mech_model *m, const loop_term *t, double *dx, double *dy, double *r,
                      double *a);
 
-/* Evaluation through the tape (no allocation). The velocity and
- * acceleration phases reuse the position phase's registers, so they must
- * follow a position evaluation at the same x and q. */
+/* Evaluation through the system's tape (compiled by the first call; no
+ * allocation after it; NaN when it cannot be: out of memory, or a system
+ * with leaves). The velocity and acceleration phases reuse the position
+ * phase's registers, so they must follow a position evaluation at the same
+ * x and q. */
 void sys_eval_position(mech_system *s, const double *x, double q, double *f, double *Jx);
+/* The system's tape s->tp and registers s->reg, compiled if not yet: 0, or
+ * -1 (out of memory, or a system with leaves). */
+int sys_compile_tape(mech_system *s);
 void sys_eval_velocity_rhs(mech_system *s, double qdot, double *rhs);
 void sys_eval_accel_rhs(mech_system *s, const double *xdot, double qdot, double qddot,
                         double *rhs);

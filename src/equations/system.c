@@ -659,8 +659,7 @@ int sys_new_with(const mech_model *m, const sys_leaves *lv, mech_system **out, m
         goto fail;
     rc = MECH_ENOMEM;
     vars = xcalloc((size_t)s->nvars, sizeof *vars);
-    if (!vars || s->ex.failed || build_jacobian(s, vars) < 0 || build_rates(s, vars) < 0 ||
-        (lv->nparams == 0 && lv->form == SYS_LEAF_POLAR && compile(s) < 0))
+    if (!vars || s->ex.failed || build_jacobian(s, vars) < 0 || build_rates(s, vars) < 0)
         goto fail;
     free(vars);
     *out = s;
@@ -675,8 +674,34 @@ fail:
 
 int mech_system_size(const mech_system *s) { return s ? s->n : 0; }
 
+/* The system's own tape, compiled by the first sys_eval_* (only tests
+ * call them: the solver compiles its plan's tape, and this one would be a
+ * second copy of the same equations at the set-up's peak): 0, or -1 (out
+ * of memory, or a system with leaves, whose tape is the plan's). */
+int sys_compile_tape(mech_system *s)
+{
+    if (s->reg)
+        return 0;
+    if (s->form != SYS_LEAF_POLAR || s->nparams != 0 || !s->f || compile(s) < 0) {
+        tape_free(&s->tp);
+        return -1;
+    }
+    return 0;
+}
+
+static void fill_nan(double *v, int n)
+{
+    for (int i = 0; v && i < n; i++)
+        v[i] = NAN;
+}
+
 void sys_eval_position(mech_system *s, const double *x, double q, double *f, double *Jx)
 {
+    if (sys_compile_tape(s) < 0) {
+        fill_nan(f, s->m);
+        fill_nan(Jx, s->nnz);
+        return;
+    }
     const tape *t = &s->tp;
     double *reg = s->reg;
     for (int i = 0; i < s->n; i++)
@@ -692,6 +717,10 @@ void sys_eval_position(mech_system *s, const double *x, double q, double *f, dou
 
 void sys_eval_velocity_rhs(mech_system *s, double qdot, double *rhs)
 {
+    if (sys_compile_tape(s) < 0) {
+        fill_nan(rhs, s->m);
+        return;
+    }
     const tape *t = &s->tp;
     double *reg = s->reg;
     tape_set_var(t, reg, SYS_VAR_QDOT(s->n), qdot);
@@ -702,6 +731,10 @@ void sys_eval_velocity_rhs(mech_system *s, double qdot, double *rhs)
 
 void sys_eval_accel_rhs(mech_system *s, const double *xdot, double qdot, double qddot, double *rhs)
 {
+    if (sys_compile_tape(s) < 0) {
+        fill_nan(rhs, s->m);
+        return;
+    }
     const tape *t = &s->tp;
     double *reg = s->reg;
     for (int i = 0; i < s->n; i++)

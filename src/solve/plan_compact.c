@@ -39,7 +39,7 @@ void solver_plan_compact(solver_plan *sp)
         free(sym[k]);
     s->f = s->Jx = s->fq = s->vel = s->acc = s->link_angle = s->slide = NULL;
     s->reg = NULL;
-    tape_free(&s->tp);  /* the system's tape: sys_eval_* are not used by the sweep */
+    tape_free(&s->tp);  /* the system's tape, if a sys_eval_* compiled it */
     free(s->Jp);        /* the whole Jacobian's pattern: the plan has its solved part */
     free(s->Ji);
     s->Jp = s->Ji = NULL;

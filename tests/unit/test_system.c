@@ -211,6 +211,7 @@ static void check_hoisted(const char *path)
 {
     mech_model *m = load_path(path);
     mech_system *s = build(m);
+    cr_assert_eq(sys_compile_tape(s), 0);
     int n = s->n, nv = SYS_NVARS(n);
     tape *t = &s->tp;
     double *reg = s->reg;
@@ -256,6 +257,7 @@ static void check_fused(const char *path)
 {
     mech_model *m = load_path(path);
     mech_system *s = build(m);
+    cr_assert_eq(sys_compile_tape(s), 0);
     int n = s->n, nv = SYS_NVARS(n);
     tape *t = &s->tp;
     double *vars = calloc((size_t)nv, sizeof *vars);
