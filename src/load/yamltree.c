@@ -159,12 +159,34 @@ static int on_open(builder *b, const yaml_event_t *ev, ynode_kind kind)
     return 0;
 }
 
+/* Small mappings (a point's x and y, a joint's few keys: most of a large
+ * file's) compare their keys pairwise, with no allocation. */
+enum { FEW_KEYS = 16 };
+
+static void mark_duplicate_few(ynode *map)
+{
+    for (size_t i = 1; i < map->n; i++) {
+        ynode *k = map->items[2 * i];
+        for (size_t j = 0; j < i && k->kind == YNODE_SCALAR; j++) {
+            const ynode *e = map->items[2 * j];
+            if (e->kind == YNODE_SCALAR && strcmp(e->text, k->text) == 0) {
+                k->dup_of = map->items[2 * j];
+                break;
+            }
+        }
+    }
+}
+
 /* Mark each repeated scalar key of a closed mapping with its first use. A
  * hash of the keys keeps a mapping of 10^5 links linear. */
 static int mark_duplicate_keys(ynode *map)
 {
     if (map->kind != YNODE_MAP || map->n < 2)
         return 0;
+    if (map->n <= FEW_KEYS) {
+        mark_duplicate_few(map);
+        return 0;
+    }
     name_map seen = {0};
     int rc = 0;
     for (size_t i = 0; i < map->n && rc == 0; i++) {
