@@ -173,6 +173,11 @@ double blocklu_rcond_whole(blocklu *b)
     return rt_blocks_rcond_whole(&b->plan->rb, b->v, b->piv, b->colnorm, b->w);
 }
 
+int blocklu_rcond_bounds(blocklu *b, double *rcond, double *rcond_whole)
+{
+    return rt_blocks_rcond_bounds(&b->plan->rb, b->v, b->piv, b->anorm, b->w, rcond, rcond_whole);
+}
+
 double blocklu_rcond(blocklu *b)
 {
     return rt_blocks_rcond(&b->plan->rb, b->v, b->piv, b->anorm, b->w + 4 * b->plan->n);

@@ -160,7 +160,8 @@ static void note_stats(cont *c, double q)
     mech_solve_stats *st = c->st;
     if (sv->resid > st->worst_residual)
         st->worst_residual = sv->resid;
-    if (sv->rcond < st->min_rcond) {
+    /* a bound at or above the smallest so far cannot lower it */
+    if (sv->rcond < st->min_rcond && solver_rcond(sv) < st->min_rcond) {
         st->min_rcond = sv->rcond;
         st->worst_rcond_q = q;
     }

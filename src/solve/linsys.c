@@ -142,6 +142,13 @@ void linsys_condition(linsys *ls, double *Ax, double *rcond_blocks, double *rcon
         *rcond_whole = rw;
 }
 
+int linsys_condition_bounds(linsys *ls, double *rcond_blocks, double *rcond_whole)
+{
+    if (!ls->factored || ls->plan->use_klu)
+        return -1;
+    return blocklu_rcond_bounds(&ls->blu, rcond_blocks, rcond_whole);
+}
+
 double linsys_pivot_ratio(linsys *ls)
 {
     if (!ls->factored)

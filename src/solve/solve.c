@@ -531,6 +531,7 @@ int solver_init(solver *sv, const solver_plan *sp)
 {
     memset(sv, 0, sizeof *sv);
     sv->p = sp;
+    sv->rcond_exact = 1;  /* nothing bounded yet */
     sv->published = -1;
     sv->tape_q = NAN;
     size_t n1 = (size_t)sp->n + 1, ns = (size_t)sp->ns + 1, nr = (size_t)sp->nr + 1;
@@ -618,6 +619,7 @@ RT_INLINE void equilibrate(solver *sv)
 /* Factor the Jacobian of the last evaluation, columns equilibrated. */
 static int factor(solver *sv)
 {
+    sv->factorisations++;
     equilibrate(sv);
     return linsys_factor(&sv->ls, sv->Ax);
 }
@@ -627,6 +629,38 @@ static int factor(solver *sv)
 static double condition(solver *sv)
 {
     linsys_condition(&sv->ls, sv->Ax, &sv->rcond, &sv->rcond_whole);
+    sv->rcond_exact = 1;
+    return sv->rcond;
+}
+
+/* The condition at a converged position, for Newton's status (singular
+ * below min_rcond) and the next position's rounding floor (xtol =
+ * max(1e-2 tol, eps / rcond_whole)): lower bounds of both without solves
+ * when they already give the exact values' status and floor (the bounds
+ * are at most the exact values, roundings included: rt_blocklu.h,
+ * rt_blocks_rcond_bounds; docs/codegen.md, "The condition at a solution",
+ * as the generated code does), else the exact values. Least squares and
+ * KLU: the exact values. */
+static double condition_at_solution(solver *sv)
+{
+    const solver_plan *sp = sv->p;
+    double worst, whole;
+    int bounded = sp->aug ? -1 : linsys_condition_bounds(&sv->ls, &worst, &whole);
+    if (bounded == 0 || (bounded == 1 && worst >= sp->opt.min_rcond && whole > 0.0 &&
+                         DBL_EPSILON / fmax(whole, 1e-300) <= 1e-2 * sp->opt.tol)) {
+        sv->rcond = worst;  /* bounded 0: one block of at most 2 x 2, its exact values */
+        sv->rcond_whole = whole;
+        sv->rcond_exact = !bounded;
+        sv->rcond_factorisation = sv->factorisations;
+        return worst;
+    }
+    return condition(sv);
+}
+
+double solver_rcond(solver *sv)
+{
+    if (!sv->rcond_exact && sv->rcond_factorisation == sv->factorisations)
+        condition(sv);
     return sv->rcond;
 }
 
@@ -682,7 +716,10 @@ static void newton_solve(void *c, const double *b, double *dx)
     linear_solve(((newton_ctx *)c)->sv, b, dx);
 }
 
-static double newton_rcond_at_solution(void *c) { return condition(((newton_ctx *)c)->sv); }
+static double newton_rcond_at_solution(void *c)
+{
+    return condition_at_solution(((newton_ctx *)c)->sv);
+}
 
 static const rt_newton_ops newton_ops = {newton_evaluate, newton_factor, newton_rcond_whole,
                                          newton_solve, newton_rcond_at_solution};

@@ -82,6 +82,9 @@ double blocklu_rcond(blocklu *b);
  * solves): with many blocks in a chain it can be far smaller than the
  * blocks', since errors pass from block to block. */
 double blocklu_rcond_whole(blocklu *b);
+/* Lower bounds of both without their solves (rt_blocks_rcond_bounds):
+ * 1 when a bound stands for an exact value, 0 when both are exact. */
+int blocklu_rcond_bounds(blocklu *b, double *rcond, double *rcond_whole);
 /* Smallest |pivot| / largest column 1-norm of its block, over the blocks
  * (cheap: no solves; tiny at an exactly singular matrix). */
 double blocklu_pivot_ratio(const blocklu *b);
@@ -139,6 +142,11 @@ int linsys_factor(linsys *ls, double *Ax);
  * the position is singular, the second how far rounding reaches (NULL:
  * not wanted, saves whole solves). */
 void linsys_condition(linsys *ls, double *Ax, double *rcond_blocks, double *rcond_whole);
+/* Lower bounds of both with the current dense block factors
+ * (blocklu_rcond_bounds): 1 when a bound stands for an exact value, 0 when
+ * both are the exact values (one block of at most 2 x 2), -1 when none
+ * were computed (KLU, or not factored). */
+int linsys_condition_bounds(linsys *ls, double *rcond_blocks, double *rcond_whole);
 /* Smallest pivot against the largest column (dense blocks: per block, of
  * the block's columns; KLU: klu_rcond). Not a condition estimate, but tiny
  * (about eps) at an exactly singular matrix; 0 when not factored. */
@@ -303,6 +311,11 @@ typedef struct solver {
                                   (the worst diagonal block's) */
     double rcond_whole;        /* the whole Jacobian's (the rounding floor of Newton's
                                   step): far smaller along a chain of blocks */
+    int rcond_exact;           /* 0: rcond and rcond_whole are lower bounds that gave the
+                                  exact values' status and rounding floor
+                                  (condition_at_solution); solver_rcond makes them exact */
+    unsigned factorisations;   /* counts factor(): the bounds' factors are still there */
+    unsigned rcond_factorisation; /* the factorisation the bounds were taken from */
 
     double *pos, *vel, *acc;   /* [n+1] variable values (n = driver), SI */
     double *x;                 /* [ns] current solved unknowns */
@@ -369,6 +382,11 @@ void solver_accel_shifted(solver *sv, const double *ashift);
  * pos, vel, acc and update the link frames. */
 void solver_publish(solver *sv, double q, double qd, double qdd);  /* again: no work */
 
+/* sv->rcond, exact: from the factors of the position it was bounded at,
+ * when they are still the current ones (else the bound stays: a lower
+ * bound of it). For what reports the value (--stats' smallest, the rcond
+ * column, notes); the solve's decisions need only the bound. */
+double solver_rcond(solver *sv);
 /* Sign of det of the factored matrix (+1, -1, 0 singular): a change between
  * two positions means the sweep crossed a singular one. */
 int solver_det_sign(solver *sv);

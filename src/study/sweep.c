@@ -351,7 +351,7 @@ static void note_refined(run *r, double q)
               "the step to %s = %s was refined into %d steps (reciprocal condition "
               "there %.2g): a difficult position, near a singular one or a fast change",
               diagnose_driver_word(m), diagnose_q_text(m, q, qb, sizeof qb),
-              r->c.row_substeps + 1, r->c.sv.rcond);
+              r->c.row_substeps + 1, solver_rcond(&r->c.sv));
 }
 
 /* A value that is not a finite number is never passed off as a result:
@@ -400,6 +400,8 @@ static int fill_row(run *r, double q)
     solver_publish(&c->sv, q, c->qd, c->qdd);
     if (r->a->want_forces && solve_forces(r, q) != MECH_OK)
         return ROW_STOP;
+    if (r->a->opt.diagnostics)
+        solver_rcond(&c->sv);  /* the rcond column: exact */
     row_sources rs = {&c->sv, r->a->want_forces ? &r->fc : NULL, c->row_iters, c->row_substeps};
     columns_fill(&r->a->cols, &rs, out);
     if (analysis_check_finite(r->a, q, out, r->d) != MECH_OK) {
