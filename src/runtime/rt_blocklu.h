@@ -65,7 +65,7 @@ RT_INLINE double rt_scale_into(const double *e, int n, double *out, const int *d
  * swap. Returns the local column of a zero pivot, or -1. A zero
  * multiplier's update (x - 0 t) is skipped: the same values but for the
  * sign of a zero, and force blocks are sparse. */
-RT_KERNEL int rt_block_factor_general(double *a, int k, int *piv, int *swaps)
+RT_INLINE int rt_block_factor_loops(double *a, int k, int *piv, int *swaps)
 {
     int rows[RT_MAX_BLOCK];
     RT_UNROLL for (int j = 0; j < k; j++) {
@@ -104,6 +104,24 @@ RT_KERNEL int rt_block_factor_general(double *a, int k, int *piv, int *swaps)
     return -1;
 }
 
+/* ... out of line for libmech (its sizes vary), and for 3 x 3 and 4 x 4
+ * blocks with the size a constant, which the compiler unrolls: the same
+ * operations in the same order, with less of the loops' overhead */
+RT_KERNEL int rt_block_factor_general(double *a, int k, int *piv, int *swaps)
+{
+    return rt_block_factor_loops(a, k, piv, swaps);
+}
+
+RT_KERNEL int rt_block_factor_3(double *a, int *piv, int *swaps)
+{
+    return rt_block_factor_loops(a, 3, piv, swaps);
+}
+
+RT_KERNEL int rt_block_factor_4(double *a, int *piv, int *swaps)
+{
+    return rt_block_factor_loops(a, 4, piv, swaps);
+}
+
 /* ... blocks of one and two equations (most of them: one loop's two
  * unknowns) unrolled: the loops' overhead is most of the work at this size */
 RT_INLINE int rt_block_factor(double *a, int k, int *piv, int *swaps)
@@ -128,11 +146,15 @@ RT_INLINE int rt_block_factor(double *a, int k, int *piv, int *swaps)
         a[3] -= a[1] * a[2];
         return a[3] != 0.0 ? -1 : 1;
     }
+    if (k == 3)
+        return rt_block_factor_3(a, piv, swaps);
+    if (k == 4)
+        return rt_block_factor_4(a, piv, swaps);
     return rt_block_factor_general(a, k, piv, swaps);
 }
 
 /* y := (P^T L U)^-1 y with rt_block_factor's factors. */
-RT_KERNEL void rt_block_solve_general(const double *a, int k, const int *piv, double *y)
+RT_INLINE void rt_block_solve_loops(const double *a, int k, const int *piv, double *y)
 {
     RT_UNROLL for (int j = 0; j < k; j++) {  /* y = P y */
         double t = y[piv[j]];
@@ -149,6 +171,21 @@ RT_KERNEL void rt_block_solve_general(const double *a, int k, const int *piv, do
     }
 }
 
+RT_KERNEL void rt_block_solve_general(const double *a, int k, const int *piv, double *y)
+{
+    rt_block_solve_loops(a, k, piv, y);
+}
+
+RT_KERNEL void rt_block_solve_3(const double *a, const int *piv, double *y)
+{
+    rt_block_solve_loops(a, 3, piv, y);
+}
+
+RT_KERNEL void rt_block_solve_4(const double *a, const int *piv, double *y)
+{
+    rt_block_solve_loops(a, 4, piv, y);
+}
+
 RT_INLINE void rt_block_solve(const double *a, int k, const int *piv, double *y)
 {
     if (k == 1) {
@@ -162,6 +199,10 @@ RT_INLINE void rt_block_solve(const double *a, int k, const int *piv, double *y)
         double y1 = (y[1] - a[1] * y[0]) / a[3];
         y[0] = (y[0] - a[2] * y1) / a[0];
         y[1] = y1;
+    } else if (k == 3) {
+        rt_block_solve_3(a, piv, y);
+    } else if (k == 4) {
+        rt_block_solve_4(a, piv, y);
     } else {
         rt_block_solve_general(a, k, piv, y);
     }
