@@ -231,6 +231,7 @@ define SUITES
 	$(TIMED) files $(SUITE_ENV) sh tests/files.sh
 	$(TIMED) signals $(SUITE_ENV) sh tests/signals.sh
 	$(TIMED) golden $(SUITE_ENV) sh tests/golden.sh
+	$(TIMED) rcond $(SUITE_ENV) sh tests/rcond.sh
 	$(TIMED) sweep $(SUITE_ENV) $(SAN_ENV) sh tests/sweep.sh
 	$(TIMED) sweep_random $(SUITE_ENV) $(SAN_ENV) sh tests/sweep_random.sh
 	$(TIMED) merge $(SUITE_ENV) $(SAN_ENV) sh tests/merge.sh

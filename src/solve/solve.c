@@ -455,6 +455,8 @@ int solver_plan_init_with(solver_plan *sp, const mech_model *m, const mech_solve
         sp->opt.tol = 1e-12;
     if (!(sp->opt.min_rcond > 0.0))
         sp->opt.min_rcond = 1e-6;
+    const char *rc_env = getenv("MECH_RCOND");
+    sp->exact_rcond = rc_env && strcmp(rc_env, "exact") == 0;
     if (kin_tree_build(&sp->tree, sp->sys) != MECH_OK)
         return diag_nomem(d, m->file, (mech_mark){0, 0});
     int rows = sp->sys->m;
@@ -645,7 +647,8 @@ static double condition_at_solution(solver *sv)
 {
     const solver_plan *sp = sv->p;
     double worst, whole;
-    int bounded = sp->aug ? -1 : linsys_condition_bounds(&sv->ls, &worst, &whole);
+    int bounded = sp->aug || sp->exact_rcond ? -1
+                  : linsys_condition_bounds(&sv->ls, &worst, &whole);
     if (bounded == 0 || (bounded == 1 && worst >= sp->opt.min_rcond && whole > 0.0 &&
                          DBL_EPSILON / fmax(whole, 1e-300) <= 1e-2 * sp->opt.tol)) {
         sv->rcond = worst;  /* bounded 0: one block of at most 2 x 2, its exact values */

@@ -273,6 +273,8 @@ typedef struct solver_plan {
     int ns;                    /* unknowns solved */
     int nr;                    /* equations solved: ns, or more with redundant ones */
     int aug;                   /* 1: least squares ([I J; J^T 0]), redundant constraints */
+    int exact_rcond;           /* MECH_RCOND=exact: no bounds first (condition_at_solution),
+                                  to check that they decide as the exact values do */
     int *col;                  /* [ns] unknown of each solved column */
     int *row;                  /* [nr] equation of each solved row */
     int nblocks, nblocks_solved;
