@@ -646,8 +646,12 @@ static double condition(solver *sv)
 static double condition_at_solution(solver *sv)
 {
     const solver_plan *sp = sv->p;
-    double worst, whole;
-    int bounded = sp->aug || sp->exact_rcond ? -1
+    double worst, whole, floor_at = DBL_EPSILON / (1e-2 * sp->opt.tol);
+    /* where the last position needed the exact values (a long chain's
+       whole-matrix condition is below floor_at all along), the bounds
+       would be computed for nothing */
+    int worth = sv->rcond_whole >= floor_at && sv->rcond >= sp->opt.min_rcond;
+    int bounded = sp->aug || sp->exact_rcond || !worth ? -1
                   : linsys_condition_bounds(&sv->ls, &worst, &whole);
     if (bounded == 0 || (bounded == 1 && worst >= sp->opt.min_rcond && whole > 0.0 &&
                          DBL_EPSILON / fmax(whole, 1e-300) <= 1e-2 * sp->opt.tol)) {
