@@ -481,6 +481,15 @@ static void target_row(const char *what, const char *goal, const char *measured,
            met ? "" : cause);
 }
 
+/* target_row with the measured value printed by fmt (one double). */
+static void target_value(const char *what, const char *goal, const char *fmt, double value,
+                         int met, const char *cause)
+{
+    char m[64];
+    snprintf(m, sizeof m, fmt, value);
+    target_row(what, goal, m, met, cause);
+}
+
 /* issue 21, target 2, per loop: CPU time (what this process used, not the
  * other processes of a loaded machine), its growth with N, and the resident
  * memory of the sweep; for a target not met, the cause from what this run
@@ -499,25 +508,25 @@ static void target_table(const int *Ns, const result *r)
     snprintf(cause, sizeof cause, "per loop 2 evaluations, 2 factorisations, 4 block solves "
              "(Newton, rates) and 3 for the whole-matrix condition estimate; instructions and "
              "their kinds: bench_ratio.sh's chain row; CPU time moves with the load");
-    snprintf(m, sizeof m, "%.3f us", cpu4);
-    target_row("CPU per step, N = 10 000", "<= 0.25 us", m, cpu4 <= 0.25, cause);
-    snprintf(m, sizeof m, "%.3f us", cpu5);
-    target_row("CPU per step, N = 100 000", "<= 0.25 us", m, cpu5 <= 0.25, cause);
-    snprintf(m, sizeof m, "%.2f", cpu5 / cpu3);
+    target_value("CPU per step, N = 10 000", "<= 0.25 us", "%.3f us", cpu4, cpu4 <= 0.25,
+                 cause);
+    target_value("CPU per step, N = 100 000", "<= 0.25 us", "%.3f us", cpu5, cpu5 <= 0.25,
+                 cause);
     snprintf(cause, sizeof cause, "beyond the caches: the tape, registers, factors and "
              "frames of every loop stream from memory each step (%.1f KiB per loop)", heap5);
-    target_row("linear: CPU per loop, 10^5 over 10^3", "<= 1.25", m, cpu5 / cpu3 <= 1.25, cause);
-    snprintf(m, sizeof m, "%.2f KiB", kib5);
+    target_value("linear: CPU per loop, 10^5 over 10^3", "<= 1.25", "%.2f", cpu5 / cpu3,
+                 cpu5 / cpu3 <= 1.25, cause);
     snprintf(cause, sizeof cause, "heap %.2f KiB: model %.2f (the file's links, points, joints, "
              "names), analysis %.2f (solver tape %.2f: %.0f instructions; pattern, BTF, spanning "
              "tree, unknowns' names), sweep state %.2f (%.0f registers, x and 6 rate/work "
              "vectors, 2x2 factors, link frames, predictor history)", heap5, r5->kib_model,
              r5->kib_analysis, r5->kib_tape, r5->ins_loop, r5->kib_state, r5->reg_loop);
-    target_row("resident in the sweep, N = 100 000", "<= 1 KiB", m, kib5 <= 1.0, cause);
+    target_value("resident in the sweep, N = 100 000", "<= 1 KiB", "%.2f KiB", kib5,
+                 kib5 <= 1.0, cause);
     snprintf(m, sizeof m, "%.2f KiB", r5->rss_mb * 1024.0 / Ns[4]);
     printf("%-42s %-10s %-11s %-8s %s\n", "(peak resident, N = 100 000: set-up)", "-", m, "",
-           "the expression DAG and the system's tape until the solver's tape is compiled, "
-           "freed after (plan_compact.c)");
+           "the loader's tree, the expression DAG and the solver's tape until it is "
+           "compiled, freed after (plan_compact.c)");
 }
 
 /* issue 33, target 4: at most 0.3 us of CPU per loop per step at N = 10^4
@@ -529,25 +538,24 @@ static void target_table_33(const int *Ns, const result *r)
     const result *r4 = &r[3], *r5 = &r[4];
     double cpu4 = r4->cpu_us_step / Ns[3], cpu5 = r5->cpu_us_step / Ns[4];
     double peak5 = r5->rss_mb * 1024.0 / Ns[4], held5 = r5->sweep_mb * 1024.0 / Ns[4];
-    char m[64], cause[600];
+    char cause[600];
     printf("issue 33, target 4: chains of N four-bars, per loop\n");
     printf("%-42s %-10s %-11s %-8s %s\n", "target", "goal", "measured", "", "cause");
     snprintf(cause, sizeof cause, "the interpreter's step per loop: 2 tape evaluations, 2 "
              "block factorisations, 4 block solves and the whole-matrix condition estimate "
              "(callgrind: bench_ratio.sh's chain row), against 0.17-0.22 us by hand");
-    snprintf(m, sizeof m, "%.3f us", cpu4);
-    target_row("CPU per loop per step, N = 10 000", "<= 0.3 us", m, cpu4 <= 0.3, cause);
-    snprintf(m, sizeof m, "%.3f us", cpu5);
-    target_row("CPU per loop per step, N = 100 000", "<= 0.3 us", m, cpu5 <= 0.3, cause);
-    snprintf(m, sizeof m, "%.2f", cpu5 / cpu4);
+    target_value("CPU per loop per step, N = 10 000", "<= 0.3 us", "%.3f us", cpu4, cpu4 <= 0.3,
+                 cause);
+    target_value("CPU per loop per step, N = 100 000", "<= 0.3 us", "%.3f us", cpu5, cpu5 <= 0.3,
+                 cause);
     snprintf(cause, sizeof cause, "beyond the caches at 10^5 (%.1f KiB held per loop)", held5);
-    target_row("linear: CPU per loop, 10^5 over 10^4", "<= 1.25", m, cpu5 / cpu4 <= 1.25, cause);
-    snprintf(m, sizeof m, "%.2f KiB", peak5);
-    snprintf(cause, sizeof cause, "the set-up's peak: the expression DAG's nodes and hash "
-             "table (28%% under massif) and the tapes' arrays (27%%) live until the solver's "
-             "tape is compiled; %.2f KiB per loop held in the sweep", held5);
-    target_row("peak resident, N = 100 000, set-up included", "<= 2 KiB", m, peak5 <= 2.0,
-               cause);
+    target_value("linear: CPU per loop, 10^5 over 10^4", "<= 1.25", "%.2f", cpu5 / cpu4,
+                 cpu5 / cpu4 <= 1.25, cause);
+    snprintf(cause, sizeof cause, "the set-up's peak: the loader's tree and the model, then "
+             "the expression DAG's nodes and hash table and the solver's tape until it is "
+             "compiled (massif); %.2f KiB per loop held in the sweep", held5);
+    target_value("peak resident, N = 100 000, set-up included", "<= 2 KiB", "%.2f KiB", peak5,
+                 peak5 <= 2.0, cause);
 }
 
 int main(int argc, char **argv)
