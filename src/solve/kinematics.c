@@ -172,6 +172,13 @@ static inline void fresh_cs(kin_state *st, int l)
     }
 }
 
+void kin_offer_cs(kin_state *st, int l, double th, double c, double s)
+{
+    st->cth[l] = th;
+    st->F[l].c = c;
+    st->F[l].s = s;
+}
+
 void kin_on_link(const kin_state *st, int l, const double *r, double *p, double *v, double *a)
 {
     rt_on_link(&st->F[l], r[0], r[1], p, v, a);

@@ -12,6 +12,7 @@
 #include <btf.h>
 #include <float.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -262,6 +263,45 @@ done:
 
 /* Where the per-step code reads and writes the tape's registers, looked up
  * once here instead of through the node and variable maps at every step. */
+/* Where the tape computes cos and sin of a link's angle itself (a body
+ * vector along the link's x axis), the link frame takes them from its
+ * registers (solver_publish) instead of calling sincos again: the same
+ * function of the same argument, so the same values. */
+static int frame_registers(solver_plan *sp)
+{
+    const tape *t = &sp->tp;
+    const expr_ctx *c = &sp->sys->ex;
+    int nlinks = sp->sys->model->nlinks;
+    sp->csreg = xcalloc(4 * (size_t)nlinks + 1, sizeof *sp->csreg);
+    if (!sp->csreg)
+        return -1;
+    sp->ncs = 0;
+    for (int l = 0; l < nlinks; l++) {
+        int var = sp->tree.angle_var[l], *r = sp->csreg + 4 * sp->ncs;
+        ex v = var >= 0 ? expr_find(c, EX_VAR, var, -1, -1, 0.0) : -1;
+        ex cs = v >= 0 ? expr_find(c, EX_COS, -1, v, -1, 0.0) : -1;
+        ex sn = v >= 0 ? expr_find(c, EX_SIN, -1, v, -1, 0.0) : -1;
+        r[0] = l;
+        r[1] = var >= 0 && var < t->nvars ? t->var_reg[var] : -1;
+        r[2] = cs >= 0 && (size_t)cs < t->nnodes ? t->node_reg[cs] : -1;
+        r[3] = sn >= 0 && (size_t)sn < t->nnodes ? t->node_reg[sn] : -1;
+        if (v >= 0 && r[1] >= 0 && r[2] >= 0 && r[3] >= 0)
+            sp->ncs++;
+    }
+    return 0;
+}
+
+/* Of frame_registers' list, the frames kin_update computes cos and sin of
+ * (kin_tree_finish has chosen them). */
+static void frame_registers_used(solver_plan *sp)
+{
+    int k = 0;
+    for (int i = 0; sp->csreg && i < sp->ncs; i++)
+        if (sp->tree.keep_cs[sp->csreg[4 * i]])
+            memmove(sp->csreg + 4 * k++, sp->csreg + 4 * i, 4 * sizeof *sp->csreg);
+    sp->ncs = k;
+}
+
 static int root_registers(solver_plan *sp)
 {
     const tape *t = &sp->tp;
@@ -283,7 +323,7 @@ static int root_registers(solver_plan *sp)
         sp->xreg[i] = t->var_reg[sp->col[i]];
         sp->xdreg[i] = t->var_reg[SYS_VAR_XDOT(n, sp->col[i])];
     }
-    return 0;
+    return frame_registers(sp);
 }
 
 /* ---- the numbers ---------------------------------------------------------- */
@@ -494,6 +534,7 @@ int solver_plan_init_with(solver_plan *sp, const mech_model *m, const mech_solve
     free(row_on);
     free(col_on);
     kin_tree_finish(&sp->tree);  /* the active links are chosen */
+    frame_registers_used(sp);
     if (rc == MECH_OK && solver_numbers_alloc(sp) < 0)
         rc = MECH_ENOMEM;
     if (rc == MECH_OK)
@@ -522,7 +563,7 @@ void solver_plan_free(solver_plan *sp)
     mech_system_free(&sp->sys);
     void *blocks[] = {sp->col, sp->row, sp->Ap, sp->Ai, sp->Ax0, sp->jpos, sp->proot,
                       sp->vroot, sp->aroot, sp->preg, sp->vreg, sp->areg, sp->xreg,
-                      sp->xdreg};
+                      sp->xdreg, sp->csreg};
     free_all(blocks, COUNT_OF(blocks));
     memset(sp, 0, sizeof *sp);
 }
@@ -828,6 +869,22 @@ void solver_accel_shifted(solver *sv, const double *ashift)
 
 /* xdot = x_q qd and xddot = x_qq qd^2 + x_q qdd (the loop equations do not
  * depend on time explicitly). */
+/* cos and sin of the link angles that the tape's registers hold for the
+ * angle being published (the last position evaluation's: its variable's
+ * register holds the same double), given to the frames. */
+static void offer_frames(solver *sv)
+{
+    const solver_plan *sp = sv->p;
+    for (int i = 0; i < sp->ncs; i++) {
+        const int *r = sp->csreg + 4 * i;
+        uint64_t a, b;  /* the same bits (not ==: -0 and 0 have other sines) */
+        memcpy(&a, &sv->pos[sp->tree.angle_var[r[0]]], sizeof a);
+        memcpy(&b, &sv->reg[r[1]], sizeof b);
+        if (a == b)
+            kin_offer_cs(&sv->ks, r[0], sv->reg[r[1]], sv->reg[r[2]], sv->reg[r[3]]);
+    }
+}
+
 void solver_publish(solver *sv, double q, double qd, double qdd)
 {
     const solver_plan *sp = sv->p;
@@ -847,6 +904,7 @@ void solver_publish(solver *sv, double q, double qd, double qdd)
         sv->vel[c] = sv->xq[i] * qd;
         sv->acc[c] = sv->xqq[i] * qd * qd + sv->xq[i] * qdd;
     }
+    offer_frames(sv);
     kin_update(&sp->tree, &sv->ks, sv->pos,
                sp->level & MECH_WANT_VELOCITY ? sv->vel : NULL,
                sp->level & MECH_WANT_ACCELERATION ? sv->acc : NULL);

@@ -240,6 +240,9 @@ void kin_point(const kin_tree *t, const kin_state *st, int name_id, double *p, d
 
 /* Point r (link frame) of link l: position p, velocity v, acceleration a. */
 void kin_on_link(const kin_state *st, int l, const double *r, double *p, double *v, double *a);
+/* c = cos th and s = sin th of link l, computed elsewhere (the solver's
+ * tape): the next kin_update at angle th uses them instead of its own. */
+void kin_offer_cs(kin_state *st, int l, double th, double c, double s);
 
 /* ==== solve ==== */
 /* solve.c: the numerical core of the sweep and the forces: the plan
@@ -288,6 +291,10 @@ typedef struct solver_plan {
     tape tp;                   /* evaluator of the solved rows only (no registers) */
     ex *proot, *vroot, *aroot; /* roots of the three phases */
     int *preg, *vreg, *areg;   /* [nr + nnzJ], [nr], [nr] their registers in tp */
+    int *csreg;                /* [4 ncs] the link frames whose cos and sin of the angle
+                                  the tape computes: the link, the registers of its
+                                  angle's variable, of cos and of sin (solver_publish) */
+    int ncs;
     int *xreg, *xdreg;         /* [ns] register of each solved unknown and of its rate
                                   (-1: the tape does not read it) */
     double *unit;              /* number [ns]: 1 for an angle, lref for a slide (step sizes) */

@@ -48,6 +48,18 @@ static int grow_table(expr_ctx *c)
     return 0;
 }
 
+/* The node (op, var, a, b, v) if the DAG holds it, else -1 (nothing made). */
+ex expr_find(const expr_ctx *c, expr_op op, int var, ex a, ex b, double v)
+{
+    if (c->failed || c->tcap == 0)
+        return -1;
+    for (size_t i = hash_node(op, var, a, b, v) & (c->tcap - 1); c->table[i] >= 0;
+         i = (i + 1) & (c->tcap - 1))
+        if (same_node(&c->nodes[c->table[i]], op, var, a, b, v))
+            return c->table[i];
+    return -1;
+}
+
 /* The unique node (op, var, a, b, v): found, or made. */
 static ex intern(expr_ctx *c, expr_op op, int var, ex a, ex b, double v)
 {

@@ -61,6 +61,11 @@ int expr_init(expr_ctx *c);
 void expr_free(expr_ctx *c);
 
 ex expr_const(expr_ctx *c, double v);
+/* The node (op, var, a, b, v) if the DAG already holds it, else -1: what
+ * the constructors below would return for it, without making it (operands
+ * as the constructors store them: -1 where unused, value 0 but for
+ * EX_CONST). */
+ex expr_find(const expr_ctx *c, expr_op op, int var, ex a, ex b, double v);
 ex expr_var(expr_ctx *c, int var);
 ex expr_add(expr_ctx *c, ex a, ex b);
 ex expr_sub(expr_ctx *c, ex a, ex b);
