@@ -278,12 +278,11 @@ void kin_refresh_all(const kin_tree *t, kin_state *st)
 void kin_point(const kin_tree *t, const kin_state *st, int name_id, double *p, double *v,
                double *a)
 {
-    double vb[2], ab[2];
     int l = t->point_link[name_id];
     if (l < 0) {  /* not reachable from the ground: mech_check rejects this */
         p[0] = p[1] = NAN;
         l = 0;
     }
     const mech_point *pt = &t->model->links[l].points[t->point_index[name_id]];
-    rt_on_link(&st->F[l], pt->x, pt->y, p, v ? v : vb, a ? a : ab);
+    rt_on_link(&st->F[l], pt->x, pt->y, p, v, a);  /* v, a NULL: not computed */
 }

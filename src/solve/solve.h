@@ -235,6 +235,8 @@ void kin_tree_finish(kin_tree *t);
  * keep_cs): before kin_point on any link (diagnostics). The frames of links
  * not placed stay as they were. */
 void kin_refresh_all(const kin_tree *t, kin_state *st);
+/* The position p of point name_id, its velocity v and acceleration a (v, a
+ * may be NULL: not computed; the branch conditions need positions only). */
 void kin_point(const kin_tree *t, const kin_state *st, int name_id, double *p, double *v,
                double *a);
 
