@@ -261,8 +261,6 @@ done:
     return rc;
 }
 
-/* Where the per-step code reads and writes the tape's registers, looked up
- * once here instead of through the node and variable maps at every step. */
 /* Where the tape computes cos and sin of a link's angle itself (a body
  * vector along the link's x axis), the link frame takes them from its
  * registers (solver_publish) instead of calling sincos again: the same
@@ -302,6 +300,8 @@ static void frame_registers_used(solver_plan *sp)
     sp->ncs = k;
 }
 
+/* Where the per-step code reads and writes the tape's registers, looked up
+ * once here instead of through the node and variable maps at every step. */
 static int root_registers(solver_plan *sp)
 {
     const tape *t = &sp->tp;
