@@ -235,7 +235,8 @@ extern const cmd_word cmd_friction_words[];
      .help = "worker threads (default: the processors this process may\n"                 \
              "run on: its CPU affinity, as set by taskset or Slurm)"}
 /* --engine auto|compiled|interpreted (solve, batch; a CMD_OPT_WORD into an
- * int): 0 auto, 1 compiled, 2 interpreted (cmd_jit_solve). */
+ * int, cmd_jit_solve's engine). */
+enum { CMD_ENGINE_AUTO, CMD_ENGINE_COMPILED, CMD_ENGINE_INTERPRETED };
 extern const cmd_word cmd_engine_words[];
 #define CMD_ENGINE_ENTRY(at_)                                                            \
     {.names = "--engine", .kind = CMD_OPT_WORD, .at = (at_), .words = cmd_engine_words,   \
@@ -318,16 +319,17 @@ extern const cmd_spec cmd_report_spec;
 int cmd_report(int argc, char **argv);
 extern const cmd_spec cmd_codegen_spec;
 int cmd_codegen(int argc, char **argv);
-/* `mech solve --jit` (cmd_codegen_jit.c): mech_solve through the generated
- * code, compiled and loaded; the interpreter, with a note ("WHO: note: ..."
- * on notes), where it cannot. automatic (--engine auto, the default):
- * compiled only where it pays off: at least cmd_jit_auto_rows() rows, or a
- * hundredth of them and a cached solver of the structure; the interpreter
- * otherwise, silently (--stats says which). Threads may call it at once
- * (mech batch): one compiles at a time, the others wait and may then find
- * its solver in the cache. */
+/* mech_solve by the engine --engine chose (cmd_codegen_jit.c, for mech solve
+ * and mech batch). CMD_ENGINE_COMPILED (--jit): through the generated code,
+ * compiled and loaded; the interpreter, with a note ("WHO: note: ..." on
+ * notes), where it cannot. CMD_ENGINE_AUTO (the default): compiled only
+ * where it pays off: at least cmd_jit_auto_rows() rows, or a hundredth of
+ * them and a cached solver of the structure; the interpreter otherwise,
+ * silently. CMD_ENGINE_INTERPRETED: mech_solve. cmd_jit_how says which.
+ * Threads may call it at once (mech batch): one compiles at a time, the
+ * others wait and may then find its solver in the cache. */
 int cmd_jit_solve(const mech_model *m, const mech_solve_options *o, mech_table *t,
-                  mech_solve_stats *st, mech_diag *d, int automatic, FILE *notes,
+                  mech_solve_stats *st, mech_diag *d, int engine, FILE *notes,
                   const char *who);
 /* The rows from which --engine auto compiles: $MECH_JIT_AUTO_ROWS, else
  * 2 000 000; -1 when MECH_JIT_AUTO=off (never by itself). */

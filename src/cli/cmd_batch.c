@@ -55,7 +55,7 @@ typedef struct batch {
     compare_options cmp;
     int forces;
     int strict;               /* --strict: a suspect assembly fails the file */
-    int engine;               /* --engine: 0 auto, 1 compiled, 2 interpreted */
+    int engine;               /* --engine: CMD_ENGINE_* */
     int skip_existing;
     cmd_progress progress;    /* files done, on standard error */
     int quiet;
@@ -162,9 +162,8 @@ static void run_job(const batch *b, job *jb)
         mech_solve_options o;
         mech_solve_options_default(&o);
         o.forces = b->forces;
-        rc = b->engine == 2 ? mech_solve(m, &o, &t, &st, &d)
-             : cmd_jit_solve(m, &o, &t, &st, &d, b->engine == 0, out, jb->path);
-        if (b->engine != 2 && strncmp(cmd_jit_how(), "compiled", 8) == 0)
+        rc = cmd_jit_solve(m, &o, &t, &st, &d, b->engine, out, jb->path);
+        if (strncmp(cmd_jit_how(), "compiled", 8) == 0)
             fprintf(out, "%s: solver %s\n", jb->path, cmd_jit_how());
         if (b->strict && cmd_strict_assembly(&d) > 0 && rc == MECH_OK)
             rc = MECH_ESOLVE;
@@ -578,7 +577,7 @@ typedef struct batch_opts {
     int nthreads, quiet;
     cmd_shard shard;          /* --shard K/M */
     int unsolvable_ok, forces, skip_existing, strict;
-    int engine;               /* --engine: 0 auto, 1 compiled, 2 interpreted */
+    int engine;               /* --engine: CMD_ENGINE_* */
     const char *files_from;   /* --files-from LIST */
     const char *table;        /* -o TABLE */
     const char *out_dir, *golden_dir;

@@ -629,11 +629,15 @@ static int auto_keeps_interpreter(const char *opt, int nq, int *worth)
 }
 
 int cmd_jit_solve(const mech_model *m, const mech_solve_options *o, mech_table *t,
-                  mech_solve_stats *st, mech_diag *d, int automatic, FILE *notes,
+                  mech_solve_stats *st, mech_diag *d, int engine, FILE *notes,
                   const char *who)
 {
     char note[700] = "";
-    int worth = 1, nq = 0, bad = -1;
+    int worth = 1, nq = 0, bad = -1, automatic = engine == CMD_ENGINE_AUTO;
+    if (engine == CMD_ENGINE_INTERPRETED) {
+        snprintf(how, sizeof how, "interpreted (--engine interpreted)");
+        return mech_solve(m, o, t, st, d);
+    }
     how[0] = '\0';
     double *q = positions(m, o, &nq);
     const char *opt = unsupported(o);

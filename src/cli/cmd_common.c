@@ -138,8 +138,9 @@ int cmd_apply_range(const char *command, const char *from, const char *to, int s
     return -1;
 }
 
-const cmd_word cmd_engine_words[] = {{"auto", 0}, {"compiled", 1}, {"interpreted", 2},
-                                     {NULL, 0}};
+const cmd_word cmd_engine_words[] = {{"auto", CMD_ENGINE_AUTO},
+                                     {"compiled", CMD_ENGINE_COMPILED},
+                                     {"interpreted", CMD_ENGINE_INTERPRETED}, {NULL, 0}};
 
 int cmd_strict_assembly(mech_diag *d)
 {

@@ -27,7 +27,7 @@ typedef struct solve_args {
     int within;                  /* --within-assembly or --range assembly */
     int range_assembly;          /* --range assembly */
     int jit;                     /* --jit: the generated code, compiled and loaded */
-    int engine;                  /* --engine: 0 auto, 1 compiled, 2 interpreted */
+    int engine;                  /* --engine: CMD_ENGINE_* */
     mech_outputs selected;       /* --outputs, parsed (opt.outputs points here) */
     mech_solve_options opt;
 } solve_args;
@@ -395,10 +395,8 @@ static int solve_loaded(solve_args *pa, mech_model *m)
     cmd_progress_init(&pr, "solve", "rows", a.quiet);
     a.opt.progress = cmd_progress_callback;
     a.opt.progress_ctx = &pr;
-    int engine = a.jit ? 1 : a.engine;
-    int rc = engine == 2 ? mech_solve(m, &a.opt, &t, &st, &d)
-                         : cmd_jit_solve(m, &a.opt, &t, &st, &d, engine == 0, stderr,
-                                         "mech solve");
+    int rc = cmd_jit_solve(m, &a.opt, &t, &st, &d, a.jit ? CMD_ENGINE_COMPILED : a.engine,
+                           stderr, "mech solve");
     cmd_progress_done(&pr);
     int suspect = a.strict ? cmd_strict_assembly(&d) : 0;
     mech_diag_print(&d, stderr);
@@ -416,11 +414,10 @@ static int solve_loaded(solve_args *pa, mech_model *m)
                 t.nrequested, t.nrows == 0 ? (a.out ? "no output file written" : "no output written")
                 : a.out ? "the rows solved are written" : "the rows solved follow");
     }
-    if (a.stats)
+    if (a.stats) {
         print_stats(m, &st, a.units_file, stderr);
-    if (a.stats)
-        fprintf(stderr, "  solver             %s\n",
-                engine == 2 ? "interpreted (--engine interpreted)" : cmd_jit_how());
+        fprintf(stderr, "  solver             %s\n", cmd_jit_how());
+    }
     if (a.stats || a.speed_fluctuation > 0.0)
         print_flywheel(&a, m, &t);
     code = cmd_exit_status(rc);
