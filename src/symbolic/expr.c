@@ -48,20 +48,24 @@ static int grow_table(expr_ctx *c)
     return 0;
 }
 
-/* The hash table's slot of node (op, var, a, b, v): where it is, or the
- * empty slot where it would go (c->tcap > 0). */
-static size_t probe(const expr_ctx *c, expr_op op, int var, ex a, ex b, double v)
+/* Node (op, var, a, b, v) found in the hash table (c->tcap > 0), or -1
+ * with *slot the empty slot where it would go. */
+static inline ex probe(const expr_ctx *c, expr_op op, int var, ex a, ex b, double v,
+                       size_t *slot)
 {
     size_t i = hash_node(op, var, a, b, v) & (c->tcap - 1);
-    while (c->table[i] >= 0 && !same_node(&c->nodes[c->table[i]], op, var, a, b, v))
-        i = (i + 1) & (c->tcap - 1);
-    return i;
+    for (; c->table[i] >= 0; i = (i + 1) & (c->tcap - 1))
+        if (same_node(&c->nodes[c->table[i]], op, var, a, b, v))
+            return c->table[i];
+    *slot = i;
+    return -1;
 }
 
 /* The node (op, var, a, b, v) if the DAG holds it, else -1 (nothing made). */
 ex expr_find(const expr_ctx *c, expr_op op, int var, ex a, ex b, double v)
 {
-    return c->failed || c->tcap == 0 ? -1 : c->table[probe(c, op, var, a, b, v)];
+    size_t slot;
+    return c->failed || c->tcap == 0 ? -1 : probe(c, op, var, a, b, v, &slot);
 }
 
 /* The unique node (op, var, a, b, v): found, or made. */
@@ -71,9 +75,10 @@ static ex intern(expr_ctx *c, expr_op op, int var, ex a, ex b, double v)
         return 0;
     if (2 * (c->count + 1) > c->tcap && grow_table(c) < 0)
         goto oom;
-    size_t i = probe(c, op, var, a, b, v);
-    if (c->table[i] >= 0)
-        return c->table[i];
+    size_t i;
+    ex found = probe(c, op, var, a, b, v, &i);
+    if (found >= 0)
+        return found;
     if (c->count == c->cap) {
         size_t cap = c->cap ? 2 * c->cap : 1024;
         expr_node *n = cap > INT32_MAX ? NULL : xrealloc_array(c->nodes, cap, sizeof *n);
