@@ -12,10 +12,12 @@
 # Run from the repository root:  MECH=build/mech sh tests/rcond.sh
 NAME=rcond . tests/lib.sh
 
-# same FILE [OPTIONS]: the two runs agree
+# same WANT FILE [OPTIONS]: the two runs agree, and exit with status WANT
+# (- any: the hard and failing files), so that two runs that both fail
+# alike do not pass for a comparison
 same() {
-    file=$1
-    shift
+    want=$1 file=$2
+    shift 2
     "$MECH" solve "$file" -q --stats "$@" -o "$tmp/bound.csv" >/dev/null 2>"$tmp/bound.err"
     b=$?
     MECH_RCOND=exact "$MECH" solve "$file" -q --stats "$@" -o "$tmp/exact.csv" >/dev/null 2>"$tmp/exact.err"
@@ -26,7 +28,9 @@ same() {
     hb=0 he=0
     [ -e "$tmp/bound.csv" ] && hb=1
     [ -e "$tmp/exact.csv" ] && he=1
-    if [ "$b" != "$e" ]; then
+    if [ "$want" != - ] && [ "$e" != "$want" ]; then
+        fail "$file $*: exit $e, expected $want: $(head -n 1 "$tmp/exact.err")"
+    elif [ "$b" != "$e" ]; then
         fail "$file $*: exit $b with the bounds, $e exact"
     elif [ $hb != $he ]; then
         fail "$file $*: a table written by one run only"
@@ -44,31 +48,32 @@ files="mechanisms/*.yaml mechanisms/*/*.yaml bench/files/*.yaml tests/hard/*.yam
 [ "${MECH_QUICK:-}" = 1 ] && files="mechanisms/*.yaml tests/hard/*.yaml tests/solve/*.yaml"
 for f in $files; do
     [ -f "$f" ] || continue
-    same "$f" --diagnostics
-    same "$f"  # --stats' smallest rcond without the column's exact values
+    case $f in tests/*) want=- ;; *) want=0 ;; esac
+    same $want "$f" --diagnostics
+    same $want "$f"  # --stats' smallest rcond without the column's exact values
 done
 # a tighter tolerance moves the rounding floor's threshold (eps / rcond_whole
 # against 1e-2 tol: rcond_whole 0.22 instead of 0.022), so the exact values
 # are needed on more rows
 for f in mechanisms/conveyor.yaml mechanisms/stirling.yaml mechanisms/jansen.yaml tests/hard/toggle-fourbar.yaml; do
-    same "$f" --tol 1e-13
+    same 0 "$f" --tol 1e-13
 done
 # a looser tolerance (floor threshold rcond_whole 2.2e-4): the bounds serve
 # on nearly every row, the smallest rcond's too, which --stats must report
 # exactly
 for f in mechanisms/conveyor.yaml mechanisms/stirling.yaml mechanisms/quick-return.yaml mechanisms/watt-six-bar.yaml; do
-    same "$f" --tol 1e-10
+    same 0 "$f" --tol 1e-10
 done
-# a looser singular limit, near the rows' conditions
-same mechanisms/stirling.yaml --min-rcond 0.04
-same mechanisms/conveyor.yaml --min-rcond 0.02
-# between the conveyor's smallest exact rcond (0.0199) and its bound there
-# (about 1.17 times smaller): the exact value, not the bound, says regular
-same mechanisms/conveyor.yaml --min-rcond 0.019
-same mechanisms/conveyor.yaml --min-rcond 0.019 --tol 1e-10
+# a singular limit above the rows' smallest conditions (Stirling 0.0336, the
+# conveyor 0.0199): singular, the same position either way
+same 1 mechanisms/stirling.yaml --min-rcond 0.04
+same 1 mechanisms/conveyor.yaml --min-rcond 0.02
+# just below the conveyor's smallest: regular
+same 0 mechanisms/conveyor.yaml --min-rcond 0.019
+same 0 mechanisms/conveyor.yaml --min-rcond 0.019 --tol 1e-10
 # between the bound at the conveyor's least-conditioned row (0.0198756667)
 # and its exact value there (0.0198756865): regular, as the exact value
 # says (a bound kept below the limit would stop the sweep as singular)
-same mechanisms/conveyor.yaml --min-rcond 0.01987567 --tol 1e-10
+same 0 mechanisms/conveyor.yaml --min-rcond 0.01987567 --tol 1e-10
 
 summary
