@@ -234,7 +234,7 @@ extern const cmd_word cmd_friction_words[];
      .label = "-j, --jobs N",                                                            \
      .help = "worker threads (default: the processors this process may\n"                 \
              "run on: its CPU affinity, as set by taskset or Slurm)"}
-/* --engine auto|compiled|interpreted (solve, batch; a CMD_OPT_WORD into an
+/* --engine auto|compiled|interpreted (solve, batch, sweep; a CMD_OPT_WORD into an
  * int, cmd_jit_solve's engine). */
 enum { CMD_ENGINE_AUTO, CMD_ENGINE_COMPILED, CMD_ENGINE_INTERPRETED };
 extern const cmd_word cmd_engine_words[];
@@ -247,8 +247,9 @@ extern const cmd_word cmd_engine_words[];
              "solves (a note says why; docs/codegen.md); interpreted:\n"                  \
              "the interpreter; auto (default): compiled from 2 000 000\n"                 \
              "rows ($MECH_JIT_AUTO_ROWS), or from 20 000 when the cache\n"                \
-             "holds the solver; else interpreted (solve's --stats and\n"                   \
-             "batch's messages say which)"}
+             "holds the solver; else interpreted (solve's --stats,\n"                     \
+             "batch's messages and sweep's summary say which; a sweep\n"                  \
+             "counts the rows of all its variants and compiles once)"}
 /* --from A --to B [--steps N]: "--from and --to go together" unless both
  * or neither are given (returns -1 to go on, else the exit status). */
 int cmd_check_range_pair(const char *command, const char *from, const char *to);
@@ -331,6 +332,20 @@ int cmd_codegen(int argc, char **argv);
 int cmd_jit_solve(const mech_model *m, const mech_solve_options *o, mech_table *t,
                   mech_solve_stats *st, mech_diag *d, int engine, FILE *notes,
                   const char *who);
+/* mech sweep's variants by one compiled solver (cmd_codegen_jit.c): those
+ * solved through the sweep's one analysis (variant_regs.c) go to
+ * cmd_jit_variants_engine's sweep_engine (sweep_set_engine). engine:
+ * CMD_ENGINE_AUTO (compiled when the variants' rows in all pay for it, as
+ * cmd_jit_solve) or CMD_ENGINE_COMPILED; variants: this run's count;
+ * notes: where a note goes when --engine compiled cannot. NULL out of
+ * memory. cmd_jit_variants_how says which solver, and for how many
+ * variants each (after the run). */
+typedef struct cmd_jit_variants cmd_jit_variants;
+cmd_jit_variants *cmd_jit_variants_new(int engine, long variants, FILE *notes);
+struct sweep_engine;
+const struct sweep_engine *cmd_jit_variants_engine(cmd_jit_variants *v);
+const char *cmd_jit_variants_how(cmd_jit_variants *v, long *compiled, long *interpreted);
+void cmd_jit_variants_free(cmd_jit_variants **v);
 /* The rows from which --engine auto compiles: $MECH_JIT_AUTO_ROWS, else
  * 2 000 000; -1 when MECH_JIT_AUTO=off (never by itself). */
 long cmd_jit_auto_rows(void);

@@ -19,6 +19,7 @@
 #include <pthread.h>
 #include <signal.h>
 #include <spawn.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -41,20 +42,28 @@ static const char *const wrapper[] = {
     "size_t jit_state_size(void);",
     "int jit_nout(void);",
     "const char *const *jit_names(void);",
-    "int jit_row(void *vs, double q, double qd, double qdd, int first, double *out, double *info);",
+    "int jit_row(void *vs, const void *num, double q, double qd, double qdd, int first,",
+    "            double *out, double *info, double *x);",
     "",
     "size_t jit_state_size(void) { return sizeof(jit_state); }",
     "int jit_nout(void) { return JIT_NOUT; }",
     "const char *const *jit_names(void) { return jit_column_names; }",
     "",
-    "/* Row q: 0 solved (out, info set), a status of jit_solve, or -1 where the",
-    " * interpreter's continuation would not accept its first step. */",
-    "int jit_row(void *vs, double q, double qd, double qdd, int first, double *out, double *info)",
+    "/* Row q: 0 solved (out, info, x set), a status of jit_solve, or -1 where the",
+    " * interpreter's continuation would not accept its first step. num: a sweep's",
+    " * variant's numbers (struct rt_numbers) for the first row of a solver built",
+    " * for them, else unused. */",
+    "int jit_row(void *vs, const void *num, double q, double qd, double qdd, int first,",
+    "            double *out, double *info, double *x)",
     "{",
     "    jit_state *s = vs;",
     "    int st;",
+    "    (void)num;",
     "    if (first) {",
     "        jit_init(s);",
+    "#if CG_NUMBERS",
+    "        jit_numbers(s, (const struct rt_numbers *)num);",
+    "#endif",
     "        st = jit_solve(s, q, qd, qdd);",
     "    } else {",
     "        double xpred[NX + 1], move;",
@@ -79,6 +88,8 @@ static const char *const wrapper[] = {
     "        return st;",
     "    for (int c = 0; c < JIT_NOUT; c++)",
     "        out[c] = s->out[c];",
+    "    for (int i = 0; i < NX; i++)",
+    "        x[i] = s->x[i];",
     "    info[0] = s->iterations;",
     "    info[1] = s->residual;",
     "    /* info[2] in: the smallest rcond so far; s->rcond is a lower bound of the",
@@ -114,15 +125,20 @@ typedef struct jit {
     size_t (*state_size)(void);
     int (*nout)(void);
     const char *const *(*names)(void);
-    int (*row)(void *, double, double, double, int, double *, double *);
+    int (*row)(void *, const void *, double, double, double, int, double *, double *,
+               double *);
 } jit;
 
-/* Why the options keep the sweep with the interpreter, or NULL. */
-static const char *unsupported(const mech_solve_options *o)
+/* Why the options or the file keep the sweep with the interpreter, or
+ * NULL. q0: the first driver position. A drawn file is assembled at its
+ * drawing's driver value and followed from there to q0 (continuation.c
+ * cont_start), which the generated code does not do. */
+static const char *unsupported(const mech_model *m, const mech_solve_options *o, double q0)
 {
     mech_solve_options d;
     mech_solve_options_default(&d);
-    return o->outputs ? "--outputs"
+    return m->has_start && m->start_q != q0 ? "a drawing's driver value other than the first"
+           : o->outputs ? "--outputs"
            : o->diagnostics ? "--diagnostics"
            : o->limit_rows ? "--range assembly"
            : o->tol != d.tol ? "--tol"
@@ -435,28 +451,40 @@ static int compile(cc_command *cp, char *note, size_t size)
 
 /* Generate, compile and load the solver of m in the private directory: 0,
  * or -1 with why in note. */
-static int build_in_dir(jit *j, const mech_model *m, const mech_solve_options *o,
-                        mech_solve_stats *st, int cached_only, char *note, size_t size)
+/* What a build is of: model m with options o; with leaves (a sweep's
+ * variants), the generated code reads their numbers (codegen_options). */
+typedef struct jit_spec {
+    const mech_model *m;
+    const mech_solve_options *o;
+    const sys_leaves *leaves;
+    codegen *keep;             /* non-NULL: the code generator's analysis is kept here
+                                  (codegen_numbers_fill), else freed */
+} jit_spec;
+
+static int build_in_dir(jit *j, const jit_spec *sp, mech_solve_stats *st, int cached_only,
+                        char *note, size_t size)
 {
-    codegen g;
+    codegen local, *g = sp->keep ? sp->keep : &local;
     mech_diag d;
     mech_diag_init(&d);
-    codegen_options co = {"jit", NULL, o->all_blocks, o->forces, o->friction, 1};
-    int rc = codegen_init(&g, m, &co, &d);
+    const mech_solve_options *o = sp->o;
+    codegen_options co = {"jit", NULL, o->all_blocks, o->forces, o->friction, 1, sp->leaves};
+    int rc = codegen_init(g, sp->m, &co, &d);
     if (rc != MECH_OK) {
         snprintf(note, size, "the code generator: %s",
                  d.count > 0 ? d.entries[d.count - 1].message : "failed");
-        codegen_free(&g);
+        codegen_free(g);
         mech_diag_free(&d);
         return -1;
     }
     mech_diag_free(&d);
-    st->nunknowns = g.sp.n;  /* the plan's sizes, as mech_solve reports them */
-    st->nsolved = g.sp.ns;
-    st->nblocks = g.sp.nblocks;
-    st->nblocks_solved = g.sp.nblocks_solved;
-    rc = write_text(guard.files[F_GEN], &g);
-    codegen_free(&g);
+    st->nunknowns = g->sp.n;  /* the plan's sizes, as mech_solve reports them */
+    st->nsolved = g->sp.ns;
+    st->nblocks = g->sp.nblocks;
+    st->nblocks_solved = g->sp.nblocks_solved;
+    rc = write_text(guard.files[F_GEN], g);
+    if (!sp->keep)
+        codegen_free(g);
     if (rc != 0 || write_text(guard.files[F_JIT], NULL) != 0)
         return snprintf(note, size, "cannot write the generated code in %s", guard.dir), -1;
     cc_command c;
@@ -506,15 +534,15 @@ static int build_in_dir(jit *j, const mech_model *m, const mech_solve_options *o
 /* Build the solver of m in a private directory of $TMPDIR (else /tmp),
  * removed before returning, also on a signal meanwhile: 0, or -1 with why
  * in note (-2: cached_only and the cache has none). */
-static int jit_build(jit *j, const mech_model *m, const mech_solve_options *o,
-                     mech_solve_stats *st, int cached_only, char *note, size_t size)
+static int jit_build(jit *j, const jit_spec *sp, mech_solve_stats *st, int cached_only,
+                     char *note, size_t size)
 {
     const char *tmp = getenv("TMPDIR");
     if (!tmp || !*tmp || strlen(tmp) > 400)
         tmp = "/tmp";
     pthread_mutex_lock(&build_lock);
     guard_begin();
-    int rc = guard_mkdtemp(tmp) == 0 ? build_in_dir(j, m, o, st, cached_only, note, size)
+    int rc = guard_mkdtemp(tmp) == 0 ? build_in_dir(j, sp, st, cached_only, note, size)
              : (snprintf(note, size, "cannot make a temporary directory in %s", tmp), -1);
     guard_end();
     pthread_mutex_unlock(&build_lock);
@@ -534,15 +562,52 @@ static double *positions(const mech_model *m, const mech_solve_options *o, int *
     return v;
 }
 
-/* The sweep by the loaded code into t (its header already made): 0, or -1
- * with why in note (t's rows are then to be discarded). A row with a value
- * that is not finite ends the sweep before it, as in the interpreter:
- * *bad is its index (else -1) and t holds the rows before it. */
-static int jit_sweep(const jit *j, const mech_model *m, const mech_analysis *a, const double *q,
-                     int nq, mech_table *t, mech_solve_stats *st, int *bad, char *note,
+/* One sweep by the loaded code: of model m's analysis a (the driver's
+ * speed and acceleration are m's) at the positions q[nq]; num: a sweep
+ * variant's numbers (codegen_numbers), or NULL. smp keeps the positions
+ * the interpreter keeps for the assembly's checks (analysis_assembly_check). */
+typedef struct jit_run {
+    const jit *j;
+    const void *num;
+    const mech_model *m;
+    const mech_analysis *a;
+    const double *q;
+    int nq;
+    assembly_samples smp;
+} jit_run;
+
+static const char *row_failure(int rc)
+{
+    return rc < 0    ? "would take another step than the interpreter's continuation"
+           : rc == 1 ? "found no assembly"
+           : rc == 2 ? "found a singular position"
+           : rc == 3 ? "found a branch condition false"
+                     : "could not solve the forces";
+}
+
+static void row_stats(mech_solve_stats *st, const double *info, double q)
+{
+    st->iterations += (long)info[0];
+    st->max_iterations = (int)info[0] > st->max_iterations ? (int)info[0] : st->max_iterations;
+    st->worst_residual = fmax(st->worst_residual, info[1]);
+    if (info[2] < st->min_rcond) {
+        st->min_rcond = info[2];
+        st->worst_rcond_q = q;
+    }
+    st->worst_power_residual = fmax(st->worst_power_residual, info[3]);
+    if ((int)info[4] > st->max_friction_iterations)
+        st->max_friction_iterations = (int)info[4];
+}
+
+/* The sweep r into t (its header already made): 0, or -1 with why in note
+ * (t's rows are then to be discarded). A row with a value that is not
+ * finite ends the sweep before it, as in the interpreter: *bad is its
+ * index (else -1) and t holds the rows before it. */
+static int jit_sweep(jit_run *r, mech_table *t, mech_solve_stats *st, int *bad, char *note,
                      size_t size)
 {
-    int nout = j->nout();
+    const jit *j = r->j;
+    int nout = j->nout(), ns = analysis_solver_plan(r->a)->ns;
     const char *const *names = j->names();
     *bad = -1;
     if (nout != t->ncolumns)
@@ -553,43 +618,34 @@ static int jit_sweep(const jit *j, const mech_model *m, const mech_analysis *a, 
             return snprintf(note, size, "column %d is %s, mech solve's %s", c + 1, names[c],
                             t->columns[c].name), -1;
     void *s = calloc(1, j->state_size());
+    double *x = xcalloc((size_t)ns + 1, sizeof *x);
     free(t->values);  /* the header's room for no rows */
-    t->values = xcalloc((size_t)nq * (size_t)nout + 1, sizeof *t->values);
-    if (!s || !t->values) {
-        free(s);
-        return snprintf(note, size, "out of memory"), -1;
-    }
+    t->values = xcalloc((size_t)r->nq * (size_t)nout + 1, sizeof *t->values);
+    int rc = !s || !x || !t->values || assembly_samples_init(&r->smp, ns, r->nq) != 0;
+    if (rc)
+        snprintf(note, size, "out of memory");
     double info[5];
-    for (int i = 0; i < nq; i++) {
+    for (int i = 0; !rc && i < r->nq; i++) {
         double *out = t->values + (size_t)i * (size_t)nout;
         info[2] = st->min_rcond;
-        int rc = j->row(s, q[i], m->driver.speed, m->driver.accel, i == 0, out, info);
+        rc = j->row(s, r->num, r->q[i], r->m->driver.speed, r->m->driver.accel, i == 0, out,
+                    info, x);
         if (rc != 0) {
-            free(s);
-            return snprintf(note, size, "the generated code %s at row %d", rc < 0
-                            ? "would take another step than the interpreter's continuation"
-                            : rc == 1 ? "found no assembly" : rc == 2 ? "found a singular position"
-                            : rc == 3 ? "found a branch condition false"
-                                      : "could not solve the forces", i + 1), -1;
+            snprintf(note, size, "the generated code %s at row %d", row_failure(rc), i + 1);
+            break;
         }
-        if (analysis_check_finite(a, q[i], out, NULL) != MECH_OK) {
+        if (analysis_check_finite(r->a, r->q[i], out, NULL) != MECH_OK) {
             *bad = i;  /* sweep.c's fill_row: the row is not added, the sweep stops */
             break;
         }
-        st->iterations += (long)info[0];
-        st->max_iterations = (int)info[0] > st->max_iterations ? (int)info[0] : st->max_iterations;
-        st->worst_residual = fmax(st->worst_residual, info[1]);
-        if (info[2] < st->min_rcond) {
-            st->min_rcond = info[2];
-            st->worst_rcond_q = q[i];
-        }
-        st->worst_power_residual = fmax(st->worst_power_residual, info[3]);
-        if ((int)info[4] > st->max_friction_iterations)
-            st->max_friction_iterations = (int)info[4];
+        if (i >= r->smp.next_row)
+            assembly_take(&r->smp, i, r->q[i], x);
+        row_stats(st, info, r->q[i]);
         t->nrows = i + 1;
     }
     free(s);
-    return 0;
+    free(x);
+    return rc ? -1 : 0;
 }
 
 long cmd_jit_auto_rows(void)
@@ -607,7 +663,7 @@ long cmd_jit_auto_rows(void)
  * unsupported), or a run too short to pay for the compiler while the
  * cache holds no solver; 0 to go on. *worth: the run is long enough to
  * compile. */
-static int auto_keeps_interpreter(const char *opt, int nq, int *worth)
+static int auto_keeps_interpreter(const char *opt, long nq, int *worth)
 {
     long at = cmd_jit_auto_rows();
     *worth = at > 0 && nq >= at;
@@ -622,7 +678,7 @@ static int auto_keeps_interpreter(const char *opt, int nq, int *worth)
     int empty = jit_cache_empty(&cache);
     jit_cache_close(&cache);
     if (!*worth && (empty || nq < hit_at))
-        return snprintf(how, sizeof how, "interpreted (auto: %d rows, fewer than the %ld from "
+        return snprintf(how, sizeof how, "interpreted (auto: %ld rows, fewer than the %ld from "
                         "which compiling pays off%s)", nq, at, nq < hit_at ? ""
                         : "; no compiled solver in the cache"), 1;
     return 0;
@@ -640,7 +696,7 @@ int cmd_jit_solve(const mech_model *m, const mech_solve_options *o, mech_table *
     }
     how[0] = '\0';
     double *q = positions(m, o, &nq);
-    const char *opt = unsupported(o);
+    const char *opt = q ? unsupported(m, o, q[0]) : NULL;
     if (automatic && auto_keeps_interpreter(opt, nq, &worth)) {
         free(q);
         return mech_solve(m, o, t, st, d);
@@ -667,11 +723,13 @@ int cmd_jit_solve(const mech_model *m, const mech_solve_options *o, mech_table *
     memset(st, 0, sizeof *st);
     st->min_rcond = INFINITY;  /* as the interpreter (sweep.c): row 0 sets it */
     st->failure_q = NAN;       /* no failure (a failing sweep is the interpreter's) */
-    int ok = q && jit_build(&j, m, o, st, automatic && !worth, note, sizeof note) == 0;
+    jit_spec spec = {m, o, NULL, NULL};
+    int ok = q && jit_build(&j, &spec, st, automatic && !worth, note, sizeof note) == 0;
     double t1 = clock_seconds();
+    jit_run run = {&j, NULL, m, a, q, nq, {0}};
     if (ok && mech_analysis_header(a, t) == MECH_OK) {
         t->nrequested = nq;
-        ok = jit_sweep(&j, m, a, q, nq, t, st, &bad, note, sizeof note) == 0;
+        ok = jit_sweep(&run, t, st, &bad, note, sizeof note) == 0;
     } else if (ok) {
         ok = 0;
         snprintf(note, sizeof note, "out of memory");
@@ -684,10 +742,14 @@ int cmd_jit_solve(const mech_model *m, const mech_solve_options *o, mech_table *
     for (size_t i = 0; ok && i < ad.count; i++)  /* warnings and notes: it was built */
         diag_copy(d, &ad.entries[i]);
     mech_diag_free(&ad);
-    /* the interpreter's error for the row that is not finite, after its notes */
+    /* the interpreter's error for the row that is not finite, after its notes,
+       then the assembly's warnings */
     int status = ok && bad >= 0
                  ? analysis_check_finite(a, q[bad], t->values + (size_t)bad * (size_t)t->ncolumns, d)
                  : MECH_OK;
+    if (ok && analysis_assembly_check(a, &run.smp, d) != 0)
+        status = diag_nomem(d, m->file, (mech_mark){0, 0});
+    assembly_samples_free(&run.smp);
     free(q);
     if (j.so)
         dlclose(j.so);
@@ -709,4 +771,136 @@ int cmd_jit_solve(const mech_model *m, const mech_solve_options *o, mech_table *
     fprintf(notes, "%s: note: %s: %s; the interpreter solves the sweep\n", who,
             automatic ? "the compiled solver" : "--jit", note);
     return mech_solve(m, o, t, st, d);
+}
+
+/* ---- one compiled solver for a sweep's variants (mech sweep) ------------- */
+
+struct cmd_jit_variants {
+    sweep_engine ops;          /* what mech_sweep_run calls (sweep_set_engine) */
+    pthread_mutex_t lock;
+    int engine;                /* CMD_ENGINE_AUTO or CMD_ENGINE_COMPILED */
+    long variants;             /* in this run */
+    FILE *notes;
+    int decided, ready;        /* the first variant decided; the solver is loaded */
+    jit j;
+    codegen g;                 /* the solver's analysis (codegen_numbers_fill) */
+    char how[700];
+    atomic_long compiled, interpreted;
+};
+
+/* The first variant through the base decides, for all: compiled when the
+ * sweep's rows in all pay for it (as cmd_jit_solve, the rows of every
+ * variant), the base built with its leaves into one solver that reads each
+ * variant's numbers. Under v->lock. */
+static void variants_decide(cmd_jit_variants *v, const variant_base *b, const mech_analysis *view)
+{
+    int nq = 0, worth = 1, automatic = v->engine == CMD_ENGINE_AUTO;
+    const double *q = analysis_positions(view, &nq);
+    const mech_model *m = vbase_model(b);
+    mech_solve_options o;
+    mech_solve_options_default(&o);
+    o.forces = vbase_forces(b);
+    const char *opt = nq > 0 ? unsupported(m, &o, q[0]) : NULL;
+    v->decided = 1;
+    if (automatic && auto_keeps_interpreter(opt, v->variants * nq, &worth)) {
+        snprintf(v->how, sizeof v->how, "%s", how);
+        return;
+    }
+    if (opt) {
+        snprintf(v->how, sizeof v->how, "interpreted (--engine compiled does not follow %s)",
+                 opt);
+        fprintf(v->notes, "mech sweep: note: --engine compiled does not follow %s: the "
+                "interpreter solves the variants\n", opt);
+        return;
+    }
+    char note[700] = "";
+    mech_solve_stats st;
+    memset(&st, 0, sizeof st);
+    jit_spec spec = {m, &o, vbase_leaves(b), &v->g};
+    v->ready = jit_build(&v->j, &spec, &st, automatic && !worth, note, sizeof note) == 0;
+    char built[sizeof how];
+    snprintf(built, sizeof built, "%s", v->ready ? how : note);
+    snprintf(v->how, sizeof v->how, "%s (%s%.640s)", v->ready ? "compiled" : "interpreted",
+             automatic ? "auto: " : "", built);
+    if (!v->ready && !(automatic && !worth))
+        fprintf(v->notes, "mech sweep: note: the compiled solver: %s; the interpreter solves "
+                "the variants\n", note);
+}
+
+/* sweep_engine.solve: variant mv through view by the compiled solver, or
+ * VBASE_INTERPRET where it cannot follow the interpreter's rows (the
+ * interpreter then solves that variant, and says what it finds). */
+static int variants_solve(void *ctx, const variant_base *b, const mech_analysis *view,
+                          const mech_model *mv, mech_table *t, mech_diag *d)
+{
+    cmd_jit_variants *v = ctx;
+    pthread_mutex_lock(&v->lock);
+    if (!v->decided)
+        variants_decide(v, b, view);
+    pthread_mutex_unlock(&v->lock);
+    codegen_numbers num;
+    if (!v->ready || codegen_numbers_fill(&v->g, view, mv, &num) != 0) {
+        atomic_fetch_add(&v->interpreted, 1);
+        return VBASE_INTERPRET;
+    }
+    mech_solve_stats st;
+    memset(&st, 0, sizeof st);
+    st.min_rcond = INFINITY;
+    int nq = 0, bad = -1;
+    const double *q = analysis_positions(view, &nq);
+    jit_run run = {&v->j, &num.n, mv, view, q, nq, {0}};
+    char note[200];
+    int ok = mech_analysis_header(view, t) == MECH_OK &&
+             jit_sweep(&run, t, &st, &bad, note, sizeof note) == 0 && bad < 0;
+    codegen_numbers_free(&num);
+    if (ok) {
+        t->nrequested = nq;
+        ok = analysis_assembly_check(view, &run.smp, d) == 0;
+    }
+    assembly_samples_free(&run.smp);
+    if (!ok) {  /* the interpreter's rows, errors and notes instead */
+        mech_table_free(t);
+        memset(t, 0, sizeof *t);
+        atomic_fetch_add(&v->interpreted, 1);
+        return VBASE_INTERPRET;
+    }
+    atomic_fetch_add(&v->compiled, 1);
+    return MECH_OK;
+}
+
+cmd_jit_variants *cmd_jit_variants_new(int engine, long variants, FILE *notes)
+{
+    cmd_jit_variants *v = xcalloc(1, sizeof *v);
+    if (!v)
+        return NULL;
+    v->ops = (sweep_engine){variants_solve, v};
+    pthread_mutex_init(&v->lock, NULL);
+    v->engine = engine;
+    v->variants = variants;
+    v->notes = notes;
+    snprintf(v->how, sizeof v->how, "interpreted (no variant went through the sweep's one "
+             "analysis)");
+    return v;
+}
+
+const sweep_engine *cmd_jit_variants_engine(cmd_jit_variants *v) { return &v->ops; }
+
+const char *cmd_jit_variants_how(cmd_jit_variants *v, long *compiled, long *interpreted)
+{
+    *compiled = atomic_load(&v->compiled);
+    *interpreted = atomic_load(&v->interpreted);
+    return v->how;
+}
+
+void cmd_jit_variants_free(cmd_jit_variants **pv)
+{
+    cmd_jit_variants *v = pv ? *pv : NULL;
+    if (!v)
+        return;
+    if (v->j.so)
+        dlclose(v->j.so);
+    codegen_free(&v->g);
+    pthread_mutex_destroy(&v->lock);
+    free(v);
+    *pv = NULL;
 }

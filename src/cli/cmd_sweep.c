@@ -20,6 +20,7 @@ typedef struct sweep_args {
     cmd_shard shard;            /* --shard K/M */
     long index_offset;          /* --index-offset N (-1: not given) */
     int quiet, resume, unsolvable_ok;
+    int engine;                 /* --engine: CMD_ENGINE_* */
 } sweep_args;
 
 /* The messages of the sweep's library calls: its own arguments' errors as
@@ -141,6 +142,7 @@ static const cmd_opt options[] = {
      .flags = CMD_RUN_ONLY, .label = "-q, --quiet",
      .help = "no progress report (a bar on a terminal, else a line every\n"
              "5 s)"},
+    CMD_ENGINE_ENTRY(AT(engine)),
     CMD_HELP_ENTRY,
     {NULL}};
 
@@ -149,7 +151,7 @@ const cmd_spec cmd_sweep_spec = {
     .summary = "solve a grid of variants of one mechanism, one summary row each",
     .usage = "usage: mech sweep FILE --vary NAME=FROM:TO:COUNT [--vary ...]\n"
              "                  [--list NAME=A,B,...] [--metric M ...] [-o OUT.csv] [-j N]\n"
-             "                  [--shard K/M] [--forces]\n"
+             "                  [--shard K/M] [--forces] [--engine auto|compiled|interpreted]\n"
              "       mech sweep FILE --random N [--seed S] [--metric M ...] [options as above]\n"
              "                  [--index-offset N] [--resume] [--unsolvable-ok]\n",
     .about = "Solve a grid of variants of one mechanism, changing its named parameters\n"
@@ -342,6 +344,20 @@ static int row_checks(const void *sweep, const char *row, size_t len, char *why,
     return sweep_row_content(sweep, row, len, why, size);
 }
 
+/* Which solver the variants through the sweep's one analysis had
+ * (docs/batch.md, "One compiled solver"). */
+static void solver_summary(cmd_jit_variants *jv)
+{
+    long compiled = 0, interpreted = 0;
+    const char *how = jv ? cmd_jit_variants_how(jv, &compiled, &interpreted)
+                         : "interpreted (--engine interpreted)";
+    fprintf(stderr, "mech sweep: solver %s", how);
+    if (compiled > 0)
+        fprintf(stderr, ": %ld variant%s compiled, %ld interpreted", compiled,
+                compiled == 1 ? "" : "s", interpreted);
+    fputc('\n', stderr);
+}
+
 /* This shard's variants, solved on worker threads (mech_sweep_run), each
  * row out as soon as it is known; then OUT written in index order; exit 1
  * when none was solved (unless --unsolvable-ok). */
@@ -365,12 +381,20 @@ static int run_variants(sweep_args *a, int argc, char **argv)
     mech_sweep_stats st = {0};
     mech_diag d;
     mech_diag_init(&d);
+    cmd_jit_variants *jv = a->engine == CMD_ENGINE_INTERPRETED
+                           ? NULL : cmd_jit_variants_new(a->engine, count - o.done, stderr);
+    if (jv)
+        sweep_set_engine(a->sweep, cmd_jit_variants_engine(jv));
     code = sweep_status(mech_sweep_run(a->sweep, &sink, &st, &d), &d);
     cmd_progress_done(&o.progress);
     if (code < 0 && !a->quiet && st.shared + st.alone > 0)  /* docs/batch.md */
         fprintf(stderr, "mech sweep: %ld variant%s solved through the sweep's one analysis, "
                 "%ld analysed on %s own\n", st.shared, st.shared == 1 ? "" : "s", st.alone,
                 st.alone == 1 ? "its" : "their");
+    if (code < 0 && !a->quiet && st.shared > 0)
+        solver_summary(jv);
+    sweep_set_engine(a->sweep, NULL);
+    cmd_jit_variants_free(&jv);
     long nok = 0;
     if (code < 0)
         code = rows_finish(&o.rows, a->out, a->shard.given || a->index_offset >= 0,

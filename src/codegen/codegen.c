@@ -73,7 +73,8 @@ static int make_identifiers(codegen *g)
  * and P_NAME (upper case: the enumerators and macros; P_X_... and
  * P_COL_... are families). */
 static const char *const public_lower[] = {"state", "init", "solve", "predict", "rcond",
-                                           "column_names", "column_units", "unknown_names"};
+                                           "column_names", "column_units", "unknown_names",
+                                           "numbers"};
 static const char *const public_upper[] = {
     "NX", "NOUT", "OK", "NO_ASSEMBLY", "SINGULAR", "BRANCH", "NF", "FORCE_SINGULAR",
     "FRICTION_STUCK", "DRIVER_FROM", "DRIVER_TO", "DRIVER_STEPS", "DRIVER_SPEED",
@@ -203,10 +204,14 @@ static int plan_solver(codegen *g, mech_diag *d)
     g->want_forces = g->opt.forces > 0 || (g->opt.forces == 0 && g->m->outputs.forces);
     if (g->want_forces)  /* reactions need every link's acceleration (sweep.c) */
         o.all_blocks = 1;
-    int rc = solver_plan_init(&g->sp, g->m, &o, d);
+    mech_system *sys = NULL;  /* NULL: the plan builds it */
+    int rc = g->opt.leaves ? sys_new_with(g->m, g->opt.leaves, &sys, d) : MECH_OK;
+    if (rc == MECH_OK)
+        rc = solver_plan_init_with(&g->sp, g->m, &o, sys, d);
     if (rc != MECH_OK)
         return rc;
     const solver_plan *sp = &g->sp;
+    g->nleaf = sp->sys->nvars - SYS_NVARS(sp->n);
     if (sp->aug)
         return diag_error(d, g->m->file, g->m->driver.mark,
                           "codegen: the loops have redundant constraints (%d equations for %d "
@@ -252,9 +257,17 @@ int codegen_init(codegen *g, const mech_model *m, const codegen_options *o, mech
                           "codegen: the prefix '%s' makes the public name '%s', which the "
                           "generated code's runtime uses itself: choose another (--prefix)",
                           o->prefix, clash);
+    if (o->leaves && (m->state_loads || model_ncams(m) > 0))  /* variant_regs.c's too */
+        return diag_error(d, m->file, (mech_mark){0, 0}, "codegen: one solver for a sweep's "
+                          "variants: not with loads that depend on the motion or cams");
     int rc = plan_solver(g, d);
     if (rc != MECH_OK)
         goto fail;
+    rc = MECH_ENOMEM;
+    if (!(g->point_at = xcalloc((size_t)m->nlinks + 1, sizeof *g->point_at)))
+        goto fail;
+    for (int l = 1; l <= m->nlinks; l++)
+        g->point_at[l] = g->point_at[l - 1] + m->links[l - 1].npoints;
     if (g->want_forces && model_ncams(m) > 0) {  /* the contact's geometry is the loader's */
         rc = diag_error(d, m->file, m->cams->cam[0].mark, "codegen: forces through a cam pair "
                         "('%s') are not generated (docs/cams.md, Limits): the interpreter "
@@ -296,6 +309,7 @@ void codegen_free(codegen *g)
     free(g->phase);
     free(g->keep);
     free(g->driver_only);
+    free(g->point_at);
     free(g->unk_col);
     columns_free(&g->cols);
     if (g->fp_ready)
@@ -401,7 +415,7 @@ static void emit_driver_macros(const codegen *g, FILE *f)
 static void emit_state(const codegen *g, FILE *f)
 {
     const solver_plan *sp = &g->sp;
-    int nx = at_least_1(sp->ns), nz = at_least_1(sp->nnzJ), nk = at_least_1(g->nkeep);
+    int nx = at_least_1(sp->ns), nz = at_least_1(sp->nnzJ), nk = at_least_1(g->nkeep + g->nleaf);
     int nd = at_least_1(sp->ns > 0 ? g->bp.nv : 0), nb = at_least_1(sp->ns > 0 ? g->bp.nblocks : 0);
     int largest = sp->ns > 0 ? g->bp.largest : 0;
     fprintf(f,
@@ -438,6 +452,9 @@ static void emit_state(const codegen *g, FILE *f)
             g->lower, g->lower, g->lower, nx, g->upper, nx, nx, nx, nx, g->cols.ncols, g->upper,
             g->lower, g->upper, g->lower, g->lower, g->lower, nx, nx, nx, nx, nx, nx, nx, nx, nx,
             4 * nx + 3 * largest, nx, nb, nk, nz, nz, nd, nx);
+    if (g->opt.leaves)
+        fprintf(f, "    const struct rt_numbers *num; /* the variant's numbers (%s_numbers) */\n",
+                g->lower);
     codegen_forces_state(g, f);
     fprintf(f, "} %s_state;\n\n", g->lower);
 }
@@ -465,6 +482,12 @@ static void emit_prototypes(const codegen *g, FILE *f)
             " * hold a lower bound, when the solve needed no more: docs/codegen.md). */\n"
             "double %s_rcond(%s_state *s);\n\n",
             p, P, p, P, p, at_least_1(g->sp.ns), p, p, P, P, P, P, p, p, p, p, p, p, p, p);
+    if (g->opt.leaves)
+        fprintf(f, "/* After %s_init: the numbers of the variant to solve (struct rt_numbers,\n"
+                   " * src/runtime/rt_base.h), read through s until the next %s_init. */\n"
+                   "struct rt_numbers;\n"
+                   "void %s_numbers(%s_state *s, const struct rt_numbers *num);\n\n",
+                p, p, p, p);
 }
 
 static void emit_declarations(const codegen *g, FILE *f)
@@ -517,6 +540,10 @@ static int emit_pattern(const codegen *g, FILE *f)
     codegen_number(ftol, sizeof ftol, sp->ftol);
     codegen_number(lref, sizeof lref, sp->lref);
     codegen_number(minr, sizeof minr, sp->opt.min_rcond);
+    if (g->opt.leaves) {  /* a sweep's variant's (P_numbers) */
+        snprintf(ftol, sizeof ftol, "(s->num->ftol)");
+        snprintf(lref, sizeof lref, "(s->num->lref)");
+    }
     fprintf(f, "#define NX %d      /* unknowns solved */\n#define NZ %d      /* nonzeros of J */\n"
                "#define NB %d      /* diagonal blocks of its block triangular form */\n"
                "#define NDENSE %d  /* their dense storage */\n"
@@ -540,6 +567,15 @@ static int emit_pattern(const codegen *g, FILE *f)
                "                              block_start, block_at, where, above_start, above_row,\n"
                "                              above_col};\n",
             ns > 0 ? b->dense_full : 1, ns > 0 ? b->pq_parity : 0);
+    if (g->opt.leaves) {
+        fprintf(f, "/* the unit of each unknown's step, Newton's sizes and tolerances: the\n"
+                   "   variant's (src/runtime/rt_newton.h) */\n"
+                   "#define unit (s->num->unit)\n"
+                   "#define newton_par ((rt_newton_par){NX, NX, unit, TOL, FTOL, MIN_RCOND, "
+                   "MAX_ITER, 0})\n\n");
+        free(unit);
+        return 0;
+    }
     fprintf(f, "/* the unit of each unknown's step: 1 (angle, rad), LREF (slide) */\n"
                "static const double unit[%d] = {", at_least_1(ns));
     for (int k = 0; k < ns; k++) {
@@ -582,7 +618,7 @@ static void emit_init(const codegen *g, FILE *f)
     const mech_model *m = g->m;
     fprintf(f, "void %s_init(%s_state *s)\n{\n    memset(s, 0, sizeof *s);\n", g->lower,
             g->lower);
-    for (int i = 0; i < m->nguesses; i++) {
+    for (int i = 0; !g->opt.leaves && i < m->nguesses; i++) {
         const mech_guess *gs = &m->guesses[i];
         int var = gs->is_slider ? g->sp.sys->joint_var[gs->index] : g->sp.sys->link_var[gs->index];
         if (var >= 0 && var < g->sp.n && g->unk_col[var] >= 0) {
@@ -593,7 +629,7 @@ static void emit_init(const codegen *g, FILE *f)
     }
     /* the driven unknowns start at their laws at the file's first position,
        as cont_start does (drivers_guess; the sweep's own coordinate is q) */
-    if (m->driver.nvalues > 0) {
+    if (m->driver.nvalues > 0 && !g->opt.leaves) {
         double *guess = xcalloc((size_t)g->sp.n + 1, sizeof *guess);
         for (int v = 0; guess && v < g->sp.n; v++)
             guess[v] = NAN;
@@ -609,6 +645,93 @@ static void emit_init(const codegen *g, FILE *f)
         free(guess);
     }
     fprintf(f, "    s->branch = -1;\n    s->first = 1;\n}\n\n");
+}
+
+/* P_numbers: the variant's numbers; its leaves into keep[], where the
+ * equations read them, and its guesses into x. */
+static void emit_numbers(const codegen *g, FILE *f)
+{
+    if (!g->opt.leaves)
+        return;
+    fprintf(f, "void %s_numbers(%s_state *s, const struct rt_numbers *num)\n{\n"
+               "    s->num = num;\n"
+               "    for (int k = 0; k < %d; k++)\n"
+               "        s->keep[%d + k] = num->leaf[k];\n"
+               "    for (int i = 0; i < NX; i++)\n"
+               "        if (!isnan(num->guess[i]))\n"
+               "            s->x[i] = num->guess[i];\n}\n\n",
+            g->lower, g->lower, g->nleaf, g->leaf0);
+}
+
+/* The guesses of the first position, in x[ns]: the file's guess of each
+ * solved unknown, then the driven unknowns at their laws at the file's
+ * first position (cont_start: drivers_guess); NaN where none, as emit_init
+ * writes them for m. 0, or -1 out of memory. */
+static int first_guesses(const codegen *g, const mech_model *m, double *x)
+{
+    for (int k = 0; k < g->sp.ns; k++)
+        x[k] = NAN;
+    for (int i = 0; i < m->nguesses; i++) {
+        const mech_guess *gs = &m->guesses[i];
+        int var = gs->is_slider ? g->sp.sys->joint_var[gs->index] : g->sp.sys->link_var[gs->index];
+        if (var >= 0 && var < g->sp.n && g->unk_col[var] >= 0)
+            x[g->unk_col[var]] = gs->value;
+    }
+    if (m->driver.nvalues == 0)
+        return 0;
+    double *guess = xcalloc((size_t)g->sp.n + 1, sizeof *guess);
+    if (!guess)
+        return -1;
+    for (int v = 0; v < g->sp.n; v++)
+        guess[v] = NAN;
+    drivers_guess(m, g->sp.sys->link_var, g->sp.sys->joint_var, m->driver.values[0], guess);
+    for (int v = 0; v < g->sp.n; v++)
+        if (!isnan(guess[v]) && g->unk_col[v] >= 0)
+            x[g->unk_col[v]] = guess[v];
+    free(guess);
+    return 0;
+}
+
+int codegen_numbers_fill(const codegen *g, const mech_analysis *view, const mech_model *mv,
+                         codegen_numbers *out)
+{
+    memset(out, 0, sizeof *out);
+    const solver_plan *sp = analysis_solver_plan(view);
+    const forces_plan *fp = analysis_forces_plan(view);
+    int npoints = g->point_at[mv->nlinks];
+    out->points = xcalloc(2 * (size_t)npoints + 1, sizeof *out->points);
+    out->guess = xcalloc((size_t)g->sp.ns + 1, sizeof *out->guess);
+    if (!out->points || !out->guess || first_guesses(g, mv, out->guess) < 0) {
+        codegen_numbers_free(out);
+        return -1;
+    }
+    for (int l = 0; l < mv->nlinks; l++)
+        for (int i = 0; i < mv->links[l].npoints; i++) {
+            out->points[2 * (g->point_at[l] + i)] = mv->links[l].points[i].x;
+            out->points[2 * (g->point_at[l] + i) + 1] = mv->links[l].points[i].y;
+        }
+    struct rt_numbers *n = &out->n;
+    n->lref = sp->lref;
+    n->ftol = sp->ftol;
+    n->unit = sp->unit;
+    n->leaf = sp->leaf;
+    n->attach = sp->tree.attach;
+    n->points = out->points;
+    n->guess = out->guess;
+    if (fp) {
+        const forces_numbers_t *fn = &fp->num;
+        n->fcols = fn->cols, n->fbody = fn->body, n->fgears = fn->gears;
+        n->floads = fn->loads, n->fsprings = fn->springs, n->ffriction = fn->fric;
+        n->fgrav = fn->grav;
+    }
+    return 0;
+}
+
+void codegen_numbers_free(codegen_numbers *c)
+{
+    free(c->points);
+    free(c->guess);
+    memset(c, 0, sizeof *c);
 }
 
 /* The public functions: src/runtime/rt_solver.h's bodies under the prefix's names. */
@@ -651,7 +774,8 @@ int codegen_emit_source(FILE *f, const void *ctx)
     if (g->want_forces)
         fprintf(f, "#define CG_FORCE_SINGULAR %s_FORCE_SINGULAR\n"
                    "#define CG_FRICTION_STUCK %s_FRICTION_STUCK\n", g->upper, g->upper);
-    fprintf(f, "#define CG_FORCES %d\n\n", g->want_forces);
+    fprintf(f, "#define CG_FORCES %d\n#define CG_NUMBERS %d\n\n", g->want_forces,
+            g->opt.leaves != NULL);
     /* the runtime (src/rt_*.h), its general block kernels unrolled for the
        block sizes of this mechanism (RT_KERNEL) */
     fprintf(f, "#if defined(__GNUC__)\n"
@@ -675,6 +799,7 @@ int codegen_emit_source(FILE *f, const void *ctx)
     emit_text(f, codegen_rt_solver);
     emit_names(g, f);
     emit_init(g, f);
+    emit_numbers(g, f);
     emit_solve(g, f);
     return ferror(f) ? -1 : 0;
 }

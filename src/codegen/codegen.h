@@ -31,6 +31,10 @@ typedef struct codegen_options {
     int anonymous;           /* 1: the comments name neither the file nor its title, so
                                 that files of one mechanism give one source (mech solve
                                 --jit's cache) */
+    const sys_leaves *leaves; /* non-NULL: one solver for a sweep's variants: the system
+                                has these leaves (variant_regs.c's) and the source reads
+                                every number a variant may change from the state
+                                (P_numbers) instead of literals */
 } codegen_options;
 
 typedef struct codegen {
@@ -48,6 +52,8 @@ typedef struct codegen {
     int *keep;               /* [DAG nodes] slot in the state's keep[] for a node used by a
                                 later phase, -1: none */
     int nkeep;
+    int leaf0, nleaf;        /* the leaves' slots in keep[] (after the kept nodes) */
+    int *point_at;           /* [nlinks] first point of each link in rt_numbers.points */
     int *driver_only;        /* [DAG nodes] 1: depends on the driver q alone, 0 not, -1 unknown */
     int *unk_col;            /* [n] solved column of each unknown of the system, -1: not solved */
     /* forces (codegen_forces.c) */
@@ -112,7 +118,21 @@ int codegen_sl_emit(const codegen *g, FILE *f);
 
 /* "1.5", "(-2)", as a C double literal that reads back to v. */
 void codegen_number(char *buf, size_t size, double v);
-/* "x, y" of point i of link l, as literals (codegen_forces.c). */
-void codegen_point_xy(const mech_model *m, int l, int i, char *buf, size_t size);
+/* "x, y" of point i of link l: literals, or the variant's (opt.leaves). */
+void codegen_point_xy(const codegen *g, int l, int i, char *buf, size_t size);
+
+/* ---- one solver for a sweep's variants (opt.leaves) ------------------------ */
+
+/* The numbers P_numbers takes, of variant model mv solved through view (an
+ * analysis of g's structure: variant_regs.c's): pointers into view and
+ * two arrays of its own (the points, the guesses). */
+typedef struct codegen_numbers {
+    struct rt_numbers n;
+    double *points, *guess;
+} codegen_numbers;
+/* 0, or -1 out of memory. */
+int codegen_numbers_fill(const codegen *g, const mech_analysis *view, const mech_model *mv,
+                         codegen_numbers *out);
+void codegen_numbers_free(codegen_numbers *c);
 
 #endif

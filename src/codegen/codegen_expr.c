@@ -44,7 +44,7 @@ static int var_allowed(const codegen *g, int var, int ph)
     int n = g->sp.n;
     if (var < n)
         return g->unk_col[var] >= 0;
-    if (var == SYS_VAR_Q(n))
+    if (var == SYS_VAR_Q(n) || var >= SYS_NVARS(n))  /* q, a sweep's leaves (keep) */
         return 1;
     if (var == SYS_VAR_QDOT(n))
         return ph >= PH_VELOCITY;
@@ -53,15 +53,15 @@ static int var_allowed(const codegen *g, int var, int ph)
     return ph == PH_ACCELERATION && g->unk_col[var - n - 1] >= 0;
 }
 
-/* Does e depend on nothing but constants and the driver q? (memo: -1
- * unknown, 0 no, 1 yes) */
+/* Does e depend on nothing but constants, the driver q and a sweep's
+ * leaves (fixed for a variant)? (memo: -1 unknown, 0 no, 1 yes) */
 static int driver_only(codegen *g, ex e)
 {
     const expr_node *nd = expr_at(&g->sp.sys->ex, e);
     if (nd->op == EX_CONST)
         return 1;
     if (nd->op == EX_VAR)
-        return nd->var == SYS_VAR_Q(g->sp.n);
+        return nd->var == SYS_VAR_Q(g->sp.n) || nd->var >= SYS_NVARS(g->sp.n);
     if (g->driver_only[e] < 0)
         g->driver_only[e] = driver_only(g, nd->a) &&
                             (nd->op != EX_ADD && nd->op != EX_MUL ? 1 : driver_only(g, nd->b));
@@ -208,13 +208,15 @@ int codegen_expr_plan(codegen *g, mech_diag *d)
     for (int ph = PH_POSITION; ph < NPH && rc == MECH_OK; ph++)
         for (int i = 0; i < nroots[ph] && rc == MECH_OK; i++)
             rc = visit(g, roots[ph][i], ph, ph, d);
+    g->leaf0 = g->nkeep;  /* a sweep's leaves: after the kept nodes (P_numbers sets them) */
     return rc;
 }
 
 /* ---- emission -------------------------------------------------------------- */
 
 /* The C text of variable var in phase code: x[k], q, xd[k], 1.0 (q' = 1),
- * 0.0 (q'' = 0): the rates are solved for q' = 1, q'' = 0 and scaled. */
+ * 0.0 (q'' = 0): the rates are solved for q' = 1, q'' = 0 and scaled; a
+ * sweep's leaf k is k[leaf0 + k], which P_numbers sets. */
 static void var_text(const codegen *g, int var, char *buf, size_t size)
 {
     int n = g->sp.n;
@@ -226,6 +228,8 @@ static void var_text(const codegen *g, int var, char *buf, size_t size)
         snprintf(buf, size, "1.0");
     else if (var == SYS_VAR_QDDOT(n))
         snprintf(buf, size, "0.0");
+    else if (var >= SYS_NVARS(n))
+        snprintf(buf, size, "k[%d]", g->leaf0 + var - SYS_NVARS(n));
     else
         snprintf(buf, size, "xd[%d]", g->unk_col[var - n - 1]);
 }
@@ -369,20 +373,30 @@ static void emit_angle(const codegen *g, FILE *f, int l)
         fprintf(f, "    F[%d].c = cos(F[%d].th), F[%d].s = sin(F[%d].th);\n", l, l, l, l);
 }
 
-void codegen_point_xy(const mech_model *m, int l, int i, char *buf, size_t size)
+void codegen_point_xy(const codegen *g, int l, int i, char *buf, size_t size)
 {
+    if (g->opt.leaves) {  /* the variant's, from P_numbers (codegen_numbers_fill) */
+        int at = 2 * (g->point_at[l] + i);
+        snprintf(buf, size, "s->num->points[%d], s->num->points[%d]", at, at + 1);
+        return;
+    }
     char x[40], y[40];
-    codegen_number(x, sizeof x, m->links[l].points[i].x);
-    codegen_number(y, sizeof y, m->links[l].points[i].y);
+    codegen_number(x, sizeof x, g->m->links[l].points[i].x);
+    codegen_number(y, sizeof y, g->m->links[l].points[i].y);
     snprintf(buf, size, "%s, %s", x, y);
 }
 
-/* "x, y": two coordinates as literals. */
-static void pair_text(const double *v, char *buf, size_t size)
+/* "x, y": attachment point k of the kinematic tree (kin_tree.attach[2k],
+ * [2k + 1]) as literals, or a variant's from P_numbers. */
+static void attach_text(const codegen *g, int k, char *buf, size_t size)
 {
+    if (g->opt.leaves) {
+        snprintf(buf, size, "s->num->attach[%d], s->num->attach[%d]", 2 * k, 2 * k + 1);
+        return;
+    }
     char x[40], y[40];
-    codegen_number(x, sizeof x, v[0]);
-    codegen_number(y, sizeof y, v[1]);
+    codegen_number(x, sizeof x, g->sp.tree.attach[2 * k]);
+    codegen_number(y, sizeof y, g->sp.tree.attach[2 * k + 1]);
     snprintf(buf, size, "%s, %s", x, y);
 }
 
@@ -395,8 +409,8 @@ static void emit_place(const codegen *g, FILE *f, int l)
     int j = t->parent_joint[l], pl = t->parent_link[l];
     const mech_joint *jt = &m->joints[j];
     char rp[96], rl[96];
-    pair_text(g->sp.tree.attach + 4 * l, rp, sizeof rp);
-    pair_text(g->sp.tree.attach + 4 * l + 2, rl, sizeof rl);
+    attach_text(g, 2 * l, rp, sizeof rp);
+    attach_text(g, 2 * l + 1, rl, sizeof rl);
     if (jt->kind == MECH_JOINT_REVOLUTE) {
         fprintf(f, "    rt_place_across(&F[%d], &F[%d], %s, %s, NULL, 1.0);\n", l, pl, rp, rl);
         return;
@@ -420,7 +434,7 @@ static void emit_point(const codegen *g, FILE *f, int id)
 {
     int l = g->sp.tree.point_link[id];
     char r[96];
-    codegen_point_xy(g->m, l, g->sp.tree.point_index[id], r, sizeof r);
+    codegen_point_xy(g, l, g->sp.tree.point_index[id], r, sizeof r);
     fprintf(f, "        rt_on_link(&F[%d], %s, p, p + 2, p + 4);\n", l, r);
 }
 

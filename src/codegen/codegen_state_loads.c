@@ -49,7 +49,7 @@ static int input_text(const codegen *g, const sl_input *in, char *buf, size_t si
         if (l < 0)
             return -1;
         char r[96];
-        codegen_point_xy(g->m, l, t->point_index[in->index], r, sizeof r);
+        codegen_point_xy(g, l, t->point_index[in->index], r, sizeof r);
         snprintf(buf, size, "rt_on_link(&F[%d], %s, p, p + 2, p + 4), p[%d]", l, r,
                  in->kind - SLIN_PX);
         return 0;

@@ -34,4 +34,20 @@
 #define RT_UNROLL
 #endif
 
+/* The numbers of one variant of a sweep, which the solver `mech sweep`
+ * compiles for all of its variants reads through its state (s->num, set by
+ * P_numbers) where `mech codegen` writes literals (docs/codegen.md, "One
+ * solver for a sweep's variants"); the host fills it from the variant's
+ * analysis (codegen_numbers_fill). */
+struct rt_numbers {
+    double lref, ftol;       /* largest length, m; the residual tolerance, m */
+    const double *unit;      /* [NX] the unknowns' step units */
+    const double *leaf;      /* the leaves' values: the varied lengths and angles */
+    const double *attach;    /* [4 NLINKS] the kinematic tree's attachment points */
+    const double *points;    /* every link's points (x, y), link after link */
+    const double *guess;     /* [NX] the first position's guesses (NaN: none) */
+    const void *fcols, *fbody, *fgears, *floads, *fsprings, *ffriction; /* rt_forces.h's */
+    const double *fgrav;
+};
+
 #endif

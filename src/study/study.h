@@ -137,6 +137,22 @@ int sweep_variant_solve(sweep_shared *sh, const mech_override *ov, int nov, mech
  * and how many were analysed on their own (re-analysed). */
 void sweep_variant_counts(const sweep_shared *sh, long *shared, long *alone);
 
+/* Another solver of the variants than the interpreter (mech sweep's
+ * compiled one, src/cli/jit_sweep.c): solve(ctx, b, view, mv, t, d) solves
+ * variant mv through view (b's analysis with mv's numbers) into t, with
+ * any notes in d: MECH_OK, or VBASE_INTERPRET (nothing in t or d): the
+ * interpreter solves it. Called from the sweep's worker threads. */
+typedef struct variant_base variant_base;
+typedef struct sweep_engine {
+    int (*solve)(void *ctx, const variant_base *b, const mech_analysis *view,
+                 const mech_model *mv, mech_table *t, mech_diag *d);
+    void *ctx;
+} sweep_engine;
+/* After mech_sweep_prepare: the variants through the base go to e (NULL:
+ * the interpreter), which must outlive mech_sweep_run. */
+void sweep_set_engine(mech_sweep *s, const sweep_engine *e);
+void sweep_shared_set_engine(sweep_shared *sh, const sweep_engine *e);
+
 /* ==== variant_regs ==== */
 /* variant_regs.c: one analysis per sweep (variant_regs.c): the system
  * of the sweep's base model analysed once with the lengths and angles that
@@ -156,9 +172,19 @@ int analysis_new_with(const mech_model *m, const mech_solve_options *o, mech_sys
 mech_analysis *analysis_view_new(const mech_analysis *base, const mech_model *mv);
 void analysis_view_free(mech_analysis **view);
 const mech_system *analysis_system(const mech_analysis *a);
+/* Its solver plan, and its force plan (NULL without forces): the numbers a
+ * compiled solver of its structure takes (codegen_numbers_fill). */
+const solver_plan *analysis_solver_plan(const mech_analysis *a);
+const forces_plan *analysis_forces_plan(const mech_analysis *a);
+/* The assembly's checks (assembly.c) of the positions smp kept from a
+ * sweep of a made elsewhere (mech solve's compiled rows), with the
+ * warnings the interpreter's sweep gives to d. 0, or -1 out of memory. */
+int analysis_assembly_check(const mech_analysis *a, assembly_samples *smp, mech_diag *d);
+/* Its driver positions, *n of them. */
+const double *analysis_positions(const mech_analysis *a, int *n);
 
-/* The analysed base of a sweep, shared read only by the variants. */
-typedef struct variant_base variant_base;
+/* The analysed base of a sweep, shared read only by the variants
+ * (variant_base, declared above). */
 
 /* The base: model `base` (checked; owned from here on, also on failure),
  * the parameters names[0..nnames-1] that the variants change, forces as
@@ -168,14 +194,19 @@ int vbase_new(mech_model *base, const char *const *names, int nnames, int forces
               variant_base **out, mech_diag *d);
 void vbase_free(variant_base **b);
 
-enum { VBASE_REANALYSE = -1000 };
+enum { VBASE_REANALYSE = -1000, VBASE_INTERPRET = -1001 };
 /* Solve the variant model mv (loaded and checked) through the base's
  * analysis into *t; VBASE_REANALYSE (nothing in t or d) when mv's
  * structure or a number the analysis folded differs from the base's, or
  * a length the base has as a leaf is exactly 0 (docs/batch.md, "One
  * analysis per sweep"); else mech_analysis_solve's status. Thread safe. */
-int vbase_solve(const variant_base *b, const mech_model *mv, mech_table *t, mech_diag *d);
+int vbase_solve(const variant_base *b, const mech_model *mv, const sweep_engine *e,
+                mech_table *t, mech_diag *d);
 const mech_model *vbase_model(const variant_base *b);
+/* The leaves its system was built with (the varied parameters). */
+const sys_leaves *vbase_leaves(const variant_base *b);
+/* Its forces flag (mech_solve_options.forces). */
+int vbase_forces(const variant_base *b);
 /* The base's own analysis: its numbers are the base model's (set-up). */
 const mech_analysis *vbase_analysis(const variant_base *b);
 

@@ -253,6 +253,19 @@ void analysis_view_free(mech_analysis **pv)
 
 const mech_system *analysis_system(const mech_analysis *a) { return a->sp.sys; }
 
+const solver_plan *analysis_solver_plan(const mech_analysis *a) { return &a->sp; }
+
+const forces_plan *analysis_forces_plan(const mech_analysis *a)
+{
+    return a->want_forces ? &a->fp : NULL;
+}
+
+const double *analysis_positions(const mech_analysis *a, int *n)
+{
+    *n = a->nvalues;
+    return a->values;
+}
+
 int mech_analysis_columns(const mech_analysis *a) { return a ? a->cols.ncols : 0; }
 
 int mech_analysis_header(const mech_analysis *a, mech_table *out)
@@ -640,6 +653,18 @@ static int analysis_solve(const mech_analysis *a, const double *q, int nq, mech_
     cont_free(&r.c);
     assembly_samples_free(&r.smp);
     return rc;
+}
+
+int analysis_assembly_check(const mech_analysis *a, assembly_samples *smp, mech_diag *d)
+{
+    if (smp->n == 0 || still_free_driver(a->m))
+        return 0;
+    solver sv;
+    int rc = solver_init(&sv, &a->sp);
+    if (rc == 0)
+        assembly_check(&sv, smp, d);
+    solver_free(&sv);
+    return rc == 0 ? 0 : -1;
 }
 
 /* The public sweeps: out may be NULL (the rows are not kept), stats and d

@@ -209,6 +209,12 @@ int mech_sweep_prepare(mech_sweep *s, const char *path, const mech_sweep_options
     return MECH_OK;
 }
 
+void sweep_set_engine(mech_sweep *s, const sweep_engine *e)
+{
+    if (s->shared)
+        sweep_shared_set_engine(s->shared, e);
+}
+
 long mech_sweep_total(const mech_sweep *s)
 {
     return s->total;

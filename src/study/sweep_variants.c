@@ -30,6 +30,7 @@ struct sweep_shared {
     char *names[MAX_BASE_NAMES];
     int nnames;
     variant_base *base;
+    const sweep_engine *engine;  /* NULL: the interpreter */
     atomic_long count_shared, count_alone;
 };
 
@@ -107,6 +108,8 @@ static const variant_base *base_of(sweep_shared *sh, const mech_override *ov, in
     return b;
 }
 
+void sweep_shared_set_engine(sweep_shared *sh, const sweep_engine *e) { sh->engine = e; }
+
 void sweep_variant_counts(const sweep_shared *sh, long *shared, long *alone)
 {
     *shared = atomic_load(&sh->count_shared);
@@ -152,7 +155,7 @@ int sweep_variant_solve(sweep_shared *sh, const mech_override *ov, int nov, mech
     if (b) {  /* through the shared analysis; re-analysed when it cannot be, or fails */
         mech_diag local;
         mech_diag_init(&local);
-        int rs = vbase_solve(b, m, t, &local);
+        int rs = vbase_solve(b, m, sh->engine, t, &local);
         if ((shared = rs == MECH_OK))
             append_diag(d, &local);
         else

@@ -22,6 +22,9 @@ struct variant_base {
     const loop_term **term;    /* [nterms] */
     int *rvar, *avar;          /* [nterms] variable of the length / angle, or -1 (folded) */
     double *r0, *a0;           /* [nterms] the base's length and angle */
+    int *which;                /* [nnames] the varied parameters (indices) */
+    sys_leaves leaves;         /* the system's leaves: SYS_LEAF_POLAR of which */
+    int forces;                /* the analysis's forces flag */
 };
 
 /* Relative size of a difference in a folded number taken as rounding
@@ -40,11 +43,16 @@ void vbase_free(variant_base **pb)
     free(b->avar);
     free(b->r0);
     free(b->a0);
+    free(b->which);
     free(b);
     *pb = NULL;
 }
 
 const mech_model *vbase_model(const variant_base *b) { return b->m; }
+
+const sys_leaves *vbase_leaves(const variant_base *b) { return &b->leaves; }
+
+int vbase_forces(const variant_base *b) { return b->forces; }
 
 const mech_analysis *vbase_analysis(const variant_base *b) { return b->a; }
 
@@ -97,10 +105,11 @@ int vbase_new(mech_model *base, const char *const *names, int nnames, int with_f
             rc = diag_error(d, base->file, (mech_mark){0, 0}, "no parameter '%s'", names[i]);
     }
     mech_system *sys = NULL;
-    sys_leaves varied = {SYS_LEAF_POLAR, which, nnames};
+    b->which = which;  /* the base's */
+    b->leaves = (sys_leaves){SYS_LEAF_POLAR, which, nnames};
+    b->forces = with_forces;
     if (rc == MECH_OK)
-        rc = sys_new_with(base, &varied, &sys, d);
-    free(which);
+        rc = sys_new_with(base, &b->leaves, &sys, d);
     if (rc == MECH_OK) {
         mech_solve_options o;
         mech_solve_options_default(&o);
@@ -239,7 +248,8 @@ static int same_folded_numbers(const variant_base *b, const mech_model *mv)
     return 1;
 }
 
-int vbase_solve(const variant_base *b, const mech_model *mv, mech_table *t, mech_diag *d)
+int vbase_solve(const variant_base *b, const mech_model *mv, const sweep_engine *e,
+                mech_table *t, mech_diag *d)
 {
     memset(t, 0, sizeof *t);
     if (!same_structure(b->m, mv) || !same_folded_numbers(b, mv))
@@ -247,7 +257,9 @@ int vbase_solve(const variant_base *b, const mech_model *mv, mech_table *t, mech
     mech_analysis *view = analysis_view_new(b->a, mv);
     if (!view)
         return diag_nomem(d, mv->file, (mech_mark){0, 0});
-    int rc = mech_analysis_solve(view, NULL, 0, t, NULL, d);
+    int rc = e && e->solve ? e->solve(e->ctx, b, view, mv, t, d) : VBASE_INTERPRET;
+    if (rc == VBASE_INTERPRET)
+        rc = mech_analysis_solve(view, NULL, 0, t, NULL, d);
     analysis_view_free(&view);
     return rc;
 }

@@ -452,7 +452,7 @@ Test(sweep_shared, a_variant_takes_every_number_from_its_model)
     cr_assert_eq(vbase_new(a, names, 2, 1, &va, &d), MECH_OK);
     cr_assert_eq(vbase_new(b, names, 2, 1, &vb, &d), MECH_OK);
     mech_table through = {0}, own = {0};
-    cr_assert_eq(vbase_solve(va, bv, &through, &d), MECH_OK, "B through A's analysis");
+    cr_assert_eq(vbase_solve(va, bv, NULL, &through, &d), MECH_OK, "B through A's analysis");
     cr_assert_eq(mech_analysis_solve(vbase_analysis(vb), NULL, 0, &own, NULL, &d), MECH_OK);
     cr_assert_eq(through.nrows, 73);
     cr_assert_eq(through.nrows, own.nrows);
