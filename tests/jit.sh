@@ -335,4 +335,105 @@ bstatus=$?
 [ $? = 2 ] && grep -q "engine.*auto, compiled or interpreted" "$tmp/bj.err" && pass ||
     fail "batch --engine fast: $(cat "$tmp/bj.err")"
 
+
+# ---- mech sweep: one compiled solver for all the variants ----------------
+# sweep_pair LABEL FILE SWEEP-ARGS...: the sweep interpreted and compiled
+# (-j 3, a fresh cache, the logging compiler): the same summary CSV and
+# the same messages byte for byte (-j 1 for their order), the compiler run
+# once, and the solver line saying how many variants it solved
+sweep_pair() {
+    label=$1 file=$2
+    shift 2
+    rm -rf "$tmp/swc" "$tmp/cc.log"
+    "$MECH" sweep "$file" "$@" -j 1 --engine interpreted -o "$tmp/sw-i.csv" 2>"$tmp/sw-i.all"
+    want=$?
+    grep -v "^mech sweep: solver" "$tmp/sw-i.all" >"$tmp/sw-i.err"
+    env MECH_CACHE_DIR="$tmp/swc" TMPDIR=$tmp/jt CC=$tmp/cc-log "$MECH" sweep "$file" "$@" \
+        -j 3 --engine compiled -o "$tmp/sw-c.csv" 2>/dev/null
+    got=$?
+    env MECH_CACHE_DIR="$tmp/swc" TMPDIR=$tmp/jt CC=$tmp/cc-log "$MECH" sweep "$file" "$@" \
+        -j 1 --engine compiled -o "$tmp/sw-c1.csv" 2>"$tmp/sw-c.err"
+    if [ "$got" != "$want" ]; then
+        fail "sweep $label: compiled exits $got, interpreted $want"
+    elif ! cmp -s "$tmp/sw-i.csv" "$tmp/sw-c.csv" || ! cmp -s "$tmp/sw-i.csv" "$tmp/sw-c1.csv"; then
+        fail "sweep $label: the compiled summary differs: $(diff "$tmp/sw-i.csv" "$tmp/sw-c.csv" | head -n 3)"
+    elif ! grep -v "^mech sweep: solver" "$tmp/sw-c.err" | cmp -s - "$tmp/sw-i.err"; then
+        fail "sweep $label: other messages: $(grep -v "^mech sweep: solver" "$tmp/sw-c.err" | diff - "$tmp/sw-i.err" | head -n 3)"
+    elif [ "$(wc -l <"$tmp/cc.log")" != 1 ]; then
+        fail "sweep $label: $(wc -l <"$tmp/cc.log") compiler runs for two sweeps of one structure"
+    else
+        pass
+    fi
+}
+sweep_pair "double crank lengths" mechanisms/double-crank.yaml --vary l1=55mm:65mm:5 \
+    --metric range:B.x --metric maxabs:A.ax --metric max:P.y
+has_line "$tmp/sw-c.err" "^mech sweep: solver compiled (from the cache, .*): 5 variants compiled, 0 interpreted$" \
+    "sweep: the second run from the cache"
+sweep_pair "conveyor lengths, forces" mechanisms/conveyor.yaml --vary l1=55mm:65mm:3 \
+    --list l3b=1128.6mm,1140mm,1154.82mm --forces --metric maxabs:driver.torque --metric range:D.x \
+    --metric max:A.y
+# three variants of that grid fail (two with a gap, one self-locking): the
+# interpreter solves them and says so
+has_line "$tmp/sw-c.err" ": 6 variants compiled, 3 interpreted$" "sweep: the failing variants"
+has_line "$tmp/sw-c.err" "^360 of 361 rows solved, 1 gap$" "sweep: a gap's message"
+grep -q ",self-locking,4,nan,nan,nan$" "$tmp/sw-c.csv" && pass || fail "sweep: no self-locking variant"
+sweep_pair "conveyor friction and cargo" mechanisms/conveyor.yaml --list mu=0,0.1,0.3 \
+    --list cargo=0kg,80kg --forces --metric maxabs:driver.torque
+sweep_pair "offset slider-crank" mechanisms/offset-slider-crank.yaml --vary e=10mm:40mm:5 \
+    --vary l=110mm:130mm:2 --metric range:B.x
+sweep_pair "spring slider-crank, forces" mechanisms/spring-slider-crank.yaml \
+    --vary r=35mm:45mm:3 --forces --metric maxabs:driver.torque
+sweep_pair "stirling" mechanisms/stirling.yaml --vary a1=14mm:16mm:3 --forces \
+    --metric maxabs:driver.torque
+# variants assembled another way than guessed: the assembly's warnings come
+# from the compiled rows too (tests/warn/steering.yaml, its arm a parameter)
+sed -e 's|^ground:|parameters: {arm: 150 mm}\nground:|' \
+    -e 's|KL: \[0, 0\], AL: \[150, 0\]|KL: [0, 0], AL: [arm, 0]|' \
+    tests/warn/steering.yaml >"$tmp/steering-arm.yaml"
+sweep_pair "steering, far from the guess" "$tmp/steering-arm.yaml" --vary arm=148mm:152mm:3
+has_line "$tmp/sw-c.err" ": 3 variants compiled, 0 interpreted$" "sweep: steering compiled"
+[ "$(grep -c "warning: link 'knuckle_l' is at 15.0 deg in the first position, far from the guess" \
+    "$tmp/sw-c.err")" = 3 ] && pass || fail "sweep: the compiled variants' assembly warnings"
+# auto: compiled when the rows of all the variants pay for it
+rm -rf "$tmp/swc" "$tmp/cc.log"
+env -u MECH_JIT_AUTO MECH_JIT_AUTO_ROWS=1000 MECH_CACHE_DIR="$tmp/swc" TMPDIR=$tmp/jt \
+    CC=$tmp/cc-log "$MECH" sweep mechanisms/offset-slider-crank.yaml --vary e=10mm:40mm:3 \
+    -o "$tmp/sw-a.csv" 2>"$tmp/sw-a.err"
+has_line "$tmp/sw-a.err" "^mech sweep: solver compiled (auto: compiled in .*): 3 variants compiled, 0 interpreted$" \
+    "sweep auto: 3 variants of 361 rows from 1000"
+env -u MECH_JIT_AUTO MECH_JIT_AUTO_ROWS=2000 MECH_CACHE_DIR="$tmp/swc2" TMPDIR=$tmp/jt \
+    CC=$tmp/cc-log "$MECH" sweep mechanisms/offset-slider-crank.yaml --vary e=10mm:40mm:3 \
+    -o "$tmp/sw-a2.csv" 2>"$tmp/sw-a.err"
+has_line "$tmp/sw-a.err" "^mech sweep: solver interpreted (auto: 1083 rows, fewer than the 2000 from which compiling pays off; no compiled solver in the cache)$" \
+    "sweep auto: 1083 rows from 2000"
+[ "$(wc -l <"$tmp/cc.log")" = 1 ] && cmp -s "$tmp/sw-a.csv" "$tmp/sw-a2.csv" && pass ||
+    fail "sweep auto: $(wc -l <"$tmp/cc.log") compiler runs, or other rows"
+env MECH_CACHE_DIR="$tmp/swc3" TMPDIR=$tmp/jt CC=false "$MECH" sweep \
+    mechanisms/offset-slider-crank.yaml --vary e=10mm:40mm:3 --engine compiled -o "$tmp/sw-f.csv" \
+    2>"$tmp/sw-f.err"
+[ $? = 0 ] && cmp -s "$tmp/sw-a.csv" "$tmp/sw-f.csv" &&
+    grep -q "^mech sweep: note: the compiled solver: no C compiler ran ('false'.*; the interpreter solves the variants$" "$tmp/sw-f.err" &&
+    pass || fail "sweep --engine compiled, no compiler: $(cat "$tmp/sw-f.err")"
+[ -z "$(ls "$tmp/jt")" ] && pass || fail "sweep: files left in TMPDIR: $(ls "$tmp/jt")"
+
+# ---- what the compiled rows do not follow, and the assembly's checks -----
+# a drawn file assembled at another driver value than its first row's: the
+# interpreter's rows (it follows the drawing), with a note
+"$MECH" solve tests/drawn/fourbar.yaml -q --engine interpreted -o "$tmp/dr-i.csv" 2>/dev/null
+TMPDIR=$tmp/jt "$MECH" solve tests/drawn/fourbar.yaml -q --engine compiled -o "$tmp/dr-c.csv" \
+    2>"$tmp/dr.err"
+cmp -s "$tmp/dr-i.csv" "$tmp/dr-c.csv" &&
+    grep -q "note: --jit does not follow a drawing's driver value other than the first" "$tmp/dr.err" &&
+    pass || fail "drawn file, compiled: other rows, or no note: $(cat "$tmp/dr.err")"
+# a suspect assembly: the warning and --strict's refusal, compiled as interpreted
+for e in interpreted compiled; do
+    TMPDIR=$tmp/jt "$MECH" solve tests/warn/steering.yaml -q --strict --engine $e \
+        -o "$tmp/st-$e.csv" 2>"$tmp/st-$e.err"
+    echo "exit $?" >>"$tmp/st-$e.err"
+done
+cmp -s "$tmp/st-interpreted.err" "$tmp/st-compiled.err" &&
+    grep -q "steering.yaml:39:11: error: link 'knuckle_l' is at 15.0 deg in the first position" "$tmp/st-compiled.err" &&
+    grep -q "^exit 1$" "$tmp/st-compiled.err" && [ ! -e "$tmp/st-compiled.csv" ] && pass ||
+    fail "steering --strict compiled: $(diff "$tmp/st-interpreted.err" "$tmp/st-compiled.err" | head -n 4)"
+
 summary
