@@ -11,7 +11,12 @@
  * forces), an option the generated code does not follow, or no compiler,
  * and the interpreter solves the sweep instead, with a note on stderr. A
  * row with a value that is not finite stops the sweep with the
- * interpreter's error (its check, sweep.c), as the interpreter does. */
+ * interpreter's error (its check, sweep.c), as the interpreter does; the
+ * assembly's checks run on the rows' positions, as the interpreter's.
+ * mech sweep (cmd_jit_variants, at the end): one solver for all the
+ * variants through the sweep's one analysis, its source reading their
+ * numbers from the state (docs/codegen.md, "One solver for a sweep's
+ * variants"). */
 #include <dlfcn.h>
 #include <errno.h>
 #include <fcntl.h>
