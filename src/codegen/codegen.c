@@ -524,17 +524,12 @@ static void int_table(FILE *f, const char *name, const int *v, int n)
 
 /* The Jacobian's block triangular form as blocklu_analyze made it (the
  * tables of an rt_blocks, rt_blocklu.h), and the solver's constants. */
-static int emit_pattern(const codegen *g, FILE *f)
+static void emit_pattern(const codegen *g, FILE *f)
 {
     const solver_plan *sp = &g->sp;
     const blocklu_plan *b = &g->bp;
     int ns = sp->ns, nz = sp->nnzJ, nb = ns > 0 ? b->nblocks : 0;
     int nabove = ns > 0 ? b->op[ns] : 0, none[2] = {0, 0};
-    double *unit = xcalloc((size_t)ns + 1, sizeof *unit);
-    if (!unit)
-        return -1;
-    for (int k = 0; k < ns; k++)
-        unit[k] = sp->unit[k];
     char tol[40], ftol[40], lref[40], minr[40];
     codegen_number(tol, sizeof tol, sp->opt.tol);
     codegen_number(ftol, sizeof ftol, sp->ftol);
@@ -573,22 +568,19 @@ static int emit_pattern(const codegen *g, FILE *f)
                    "#define unit (s->num->unit)\n"
                    "#define newton_par ((rt_newton_par){NX, NX, unit, TOL, FTOL, MIN_RCOND, "
                    "MAX_ITER, 0})\n\n");
-        free(unit);
-        return 0;
+        return;
     }
     fprintf(f, "/* the unit of each unknown's step: 1 (angle, rad), LREF (slide) */\n"
                "static const double unit[%d] = {", at_least_1(ns));
     for (int k = 0; k < ns; k++) {
         char u[40];
-        codegen_number(u, sizeof u, unit[k]);
+        codegen_number(u, sizeof u, sp->unit[k]);
         fprintf(f, "%s%s", k ? ", " : "", u);
     }
     fprintf(f, "%s};\n", ns ? "" : "0.0");
     fprintf(f, "/* Newton's sizes and tolerances (src/runtime/rt_newton.h) */\n"
                "static const rt_newton_par newton_par = {NX, NX, unit, TOL, FTOL, MIN_RCOND, "
                "MAX_ITER, 0};\n\n");
-    free(unit);
-    return 0;
 }
 
 static void emit_names(const codegen *g, FILE *f)
@@ -610,57 +602,6 @@ static void emit_names(const codegen *g, FILE *f)
         c_string(f, g->sp.sys->names[g->sp.col[k]]);
     }
     fprintf(f, "%s};\n\n", g->sp.ns ? "" : "\"\"");
-}
-
-/* The file's guess of each solved unknown, else 0 (continuation.c, row 0). */
-static void emit_init(const codegen *g, FILE *f)
-{
-    const mech_model *m = g->m;
-    fprintf(f, "void %s_init(%s_state *s)\n{\n    memset(s, 0, sizeof *s);\n", g->lower,
-            g->lower);
-    for (int i = 0; !g->opt.leaves && i < m->nguesses; i++) {
-        const mech_guess *gs = &m->guesses[i];
-        int var = gs->is_slider ? g->sp.sys->joint_var[gs->index] : g->sp.sys->link_var[gs->index];
-        if (var >= 0 && var < g->sp.n && g->unk_col[var] >= 0) {
-            char v[40];
-            codegen_number(v, sizeof v, gs->value);
-            fprintf(f, "    s->x[%d] = %s;\n", g->unk_col[var], v);
-        }
-    }
-    /* the driven unknowns start at their laws at the file's first position,
-       as cont_start does (drivers_guess; the sweep's own coordinate is q) */
-    if (m->driver.nvalues > 0 && !g->opt.leaves) {
-        double *guess = xcalloc((size_t)g->sp.n + 1, sizeof *guess);
-        for (int v = 0; guess && v < g->sp.n; v++)
-            guess[v] = NAN;
-        if (guess)
-            drivers_guess(m, g->sp.sys->link_var, g->sp.sys->joint_var, m->driver.values[0],
-                          guess);
-        for (int v = 0; guess && v < g->sp.n; v++)
-            if (!isnan(guess[v]) && g->unk_col[v] >= 0) {
-                char num[40];
-                codegen_number(num, sizeof num, guess[v]);
-                fprintf(f, "    s->x[%d] = %s;\n", g->unk_col[v], num);
-            }
-        free(guess);
-    }
-    fprintf(f, "    s->branch = -1;\n    s->first = 1;\n}\n\n");
-}
-
-/* P_numbers: the variant's numbers; its leaves into keep[], where the
- * equations read them, and its guesses into x. */
-static void emit_numbers(const codegen *g, FILE *f)
-{
-    if (!g->opt.leaves)
-        return;
-    fprintf(f, "void %s_numbers(%s_state *s, const struct rt_numbers *num)\n{\n"
-               "    s->num = num;\n"
-               "    for (int k = 0; k < %d; k++)\n"
-               "        s->keep[%d + k] = num->leaf[k];\n"
-               "    for (int i = 0; i < NX; i++)\n"
-               "        if (!isnan(num->guess[i]))\n"
-               "            s->x[i] = num->guess[i];\n}\n\n",
-            g->lower, g->lower, g->nleaf, g->leaf0);
 }
 
 /* The guesses of the first position, in x[ns]: the file's guess of each
@@ -690,6 +631,44 @@ static int first_guesses(const codegen *g, const mech_model *m, double *x)
             x[g->unk_col[v]] = guess[v];
     free(guess);
     return 0;
+}
+
+/* The file's guess of each solved unknown, else 0 (continuation.c, row 0):
+ * literals, or P_numbers's for a sweep's variants. */
+static int emit_init(const codegen *g, FILE *f)
+{
+    fprintf(f, "void %s_init(%s_state *s)\n{\n    memset(s, 0, sizeof *s);\n", g->lower,
+            g->lower);
+    double *x = g->opt.leaves ? NULL : xcalloc((size_t)g->sp.ns + 1, sizeof *x);
+    if (!g->opt.leaves && (!x || first_guesses(g, g->m, x) < 0)) {
+        free(x);
+        return -1;
+    }
+    for (int k = 0; x && k < g->sp.ns; k++)
+        if (!isnan(x[k])) {
+            char v[40];
+            codegen_number(v, sizeof v, x[k]);
+            fprintf(f, "    s->x[%d] = %s;\n", k, v);
+        }
+    free(x);
+    fprintf(f, "    s->branch = -1;\n    s->first = 1;\n}\n\n");
+    return 0;
+}
+
+/* P_numbers: the variant's numbers; its leaves into keep[], where the
+ * equations read them, and its guesses into x. */
+static void emit_numbers(const codegen *g, FILE *f)
+{
+    if (!g->opt.leaves)
+        return;
+    fprintf(f, "void %s_numbers(%s_state *s, const struct rt_numbers *num)\n{\n"
+               "    s->num = num;\n"
+               "    for (int k = 0; k < %d; k++)\n"
+               "        s->keep[%d + k] = num->leaf[k];\n"
+               "    for (int i = 0; i < NX; i++)\n"
+               "        if (!isnan(num->guess[i]))\n"
+               "            s->x[i] = num->guess[i];\n}\n\n",
+            g->lower, g->lower, g->nleaf, g->leaf0);
 }
 
 int codegen_numbers_fill(const codegen *g, const mech_analysis *view, const mech_model *mv,
@@ -792,13 +771,15 @@ int codegen_emit_source(FILE *f, const void *ctx)
         emit_text(f, codegen_rt_law);
         codegen_laws_emit(g, f);
     }
-    if (emit_pattern(g, f) < 0 || codegen_expr_emit(g, f) < 0)
+    emit_pattern(g, f);
+    if (codegen_expr_emit(g, f) < 0)
         return -1;
     if (codegen_forces_emit(g, f) < 0 || codegen_kin_emit(g, f) < 0)
         return -1;
     emit_text(f, codegen_rt_solver);
     emit_names(g, f);
-    emit_init(g, f);
+    if (emit_init(g, f) < 0)
+        return -1;
     emit_numbers(g, f);
     emit_solve(g, f);
     return ferror(f) ? -1 : 0;

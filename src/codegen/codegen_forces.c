@@ -149,59 +149,20 @@ static void emit_form(const codegen *g, FILE *f)
             fp->nnz, b->dense_full, b->pq_parity);
 }
 
-static void emit_number_tables(const codegen *g, FILE *f);
-
-/* A sweep's variants (codegen_options.leaves): the tables of numbers are
- * the variant's, which P_numbers points the state at (codegen_numbers_fill:
- * the view's forces_numbers_t). */
-static void emit_tables_from_state(FILE *f)
-{
-    fprintf(f, "/* the variant's tables (P_numbers) */\n"
-               "#define fcols ((const rt_fcol *)s->num->fcols)\n"
-               "#define fbody ((const rt_body *)s->num->fbody)\n"
-               "#define fgrav (s->num->fgrav)\n"
-               "#define fgears ((const rt_gear *)s->num->fgears)\n"
-               "#define floads ((const rt_load *)s->num->floads)\n"
-               "#define fsprings ((const rt_spring *)s->num->fsprings)\n"
-               "#define ffriction ((const rt_friction *)s->num->ffriction)\n");
-}
-
-/* What enters each row and column (forces_numbers_t, rt_forces.h). */
-static void emit_description(const codegen *g, FILE *f)
+/* Each column's description (rt_fcol) as literals. */
+static void emit_fcols(const codegen *g, FILE *f)
 {
     const forces_plan *fp = &g->fp;
-    const forces_numbers_t *fn = &fp->num;
     char a[128], x[40];
-    int from_state = g->opt.leaves != NULL;  /* the numbers: the variant's */
-    fprintf(f, "/* ---- what enters each row and column (src/forces/forces.c forces_numbers) */\n");
-    if (from_state)
-        emit_tables_from_state(f);
-    else
-        fprintf(f, "static const rt_fcol fcols[NF] = {\n");
-    for (int c = 0; !from_state && c < fp->ncols; c++) {
-        const rt_fcol *d = &fn->cols[c];
+    fprintf(f, "static const rt_fcol fcols[NF] = {\n");
+    for (int c = 0; c < fp->ncols; c++) {
+        const rt_fcol *d = &fp->num.cols[c];
         point_init(&d->at, a, sizeof a);
         num(x, sizeof x, d->angle);
         fprintf(f, "    {%d, {%d, %d}, %s, %d, %d, %s, %d},\n", d->kind, d->on[0], d->on[1], a,
                 d->dir, d->guide, x, d->gear);
     }
-    fprintf(f, "%s/* each column's entries' slots in fv, in rt_fcol_entries' order */\n",
-            from_state ? "" : "};\n");
-    int *dst = xcalloc((size_t)fp->nnz + 1, sizeof *dst);
-    for (int p = 0; dst && p < fp->nnz; p++)
-        dst[p] = fp->lp.blu.where[fp->slot[p]];
-    int_table(f, "fdst", dst, dst ? fp->nnz : 0);
-    free(dst);
-    if (!from_state)
-        emit_number_tables(g, f);
-    if (drivers_rows(g->m) > 0) {
-        fprintf(f, "static const rt_drive fdrive[%d] = {", fp->ndrive);
-        for (int k = 0; k < fp->ndrive; k++)
-            fprintf(f, "%s{%d, %d}", k ? ", " : "", fn->drive[k].link,
-                    rate_index(g, fn->drive[k].var));
-        fprintf(f, "};\n");
-    }
-    fprintf(f, "\n");
+    fprintf(f, "};\n");
 }
 
 /* The bodies, gravity, gears, loads, springs and friction as literals. */
@@ -280,6 +241,49 @@ static void emit_number_tables(const codegen *g, FILE *f)
     }
     if (fp->friction && fn->nfric > 0)
         fprintf(f, "};\n");
+}
+
+/* A sweep's variants (codegen_options.leaves): the tables of numbers are
+ * the variant's, which P_numbers points the state at (codegen_numbers_fill:
+ * the view's forces_numbers_t). */
+static void emit_tables_from_state(FILE *f)
+{
+    fprintf(f, "/* the variant's tables (P_numbers) */\n"
+               "#define fcols ((const rt_fcol *)s->num->fcols)\n"
+               "#define fbody ((const rt_body *)s->num->fbody)\n"
+               "#define fgrav (s->num->fgrav)\n"
+               "#define fgears ((const rt_gear *)s->num->fgears)\n"
+               "#define floads ((const rt_load *)s->num->floads)\n"
+               "#define fsprings ((const rt_spring *)s->num->fsprings)\n"
+               "#define ffriction ((const rt_friction *)s->num->ffriction)\n");
+}
+
+/* What enters each row and column (forces_numbers_t, rt_forces.h): the
+ * numbers as literals, or a sweep's variant's; the slots and drivers. */
+static void emit_description(const codegen *g, FILE *f)
+{
+    const forces_plan *fp = &g->fp;
+    fprintf(f, "/* ---- what enters each row and column (src/forces/forces.c forces_numbers) */\n");
+    if (g->opt.leaves) {
+        emit_tables_from_state(f);
+    } else {
+        emit_fcols(g, f);
+        emit_number_tables(g, f);
+    }
+    fprintf(f, "/* each column's entries' slots in fv, in rt_fcol_entries' order */\n");
+    int *dst = xcalloc((size_t)fp->nnz + 1, sizeof *dst);
+    for (int p = 0; dst && p < fp->nnz; p++)
+        dst[p] = fp->lp.blu.where[fp->slot[p]];
+    int_table(f, "fdst", dst, dst ? fp->nnz : 0);
+    free(dst);
+    if (drivers_rows(g->m) > 0) {
+        fprintf(f, "static const rt_drive fdrive[%d] = {", fp->ndrive);
+        for (int k = 0; k < fp->ndrive; k++)
+            fprintf(f, "%s{%d, %d}", k ? ", " : "", fp->num.drive[k].link,
+                    rate_index(g, fp->num.drive[k].var));
+        fprintf(f, "};\n");
+    }
+    fprintf(f, "\n");
 }
 
 /* ---- the per-mechanism functions: one call per entry of the tables ------------ */
