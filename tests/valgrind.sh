@@ -38,6 +38,11 @@ check "mech solve --sensitivity" solve mechanisms/conveyor.yaml --sensitivity l1
 sed 's/^  r: 40 mm .*/  r: {value: 40 mm, tolerance: 0.05 mm}/' mechanisms/offset-slider-crank.yaml >"$tmp/tol.yaml"
 check "mech solve --tolerances" solve "$tmp/tol.yaml" --tolerances --sensitivity e -q -o "$tmp/t.csv"
 check "mech solve --sensitivity, unknown name" solve mechanisms/conveyor.yaml --sensitivity zz -q
+# the compiled solvers (a private cache): one solve, one sweep of variants
+MECH_CACHE_DIR=$tmp/cache check "mech solve --engine compiled" solve mechanisms/conveyor.yaml \
+    --forces --engine compiled -o "$tmp/x.csv"
+MECH_CACHE_DIR=$tmp/cache check "mech sweep --engine compiled" sweep mechanisms/conveyor.yaml \
+    --list l1=58mm,60mm,62mm --forces --metric maxabs:driver.torque --engine compiled -j 2
 check "mech sweep flywheel" sweep mechanisms/spring-slider-crank.yaml --list r=30mm,40mm --forces --metric flywheel:0.02 -j 2
 check "mech solve --speed-fluctuation" solve mechanisms/spring-slider-crank.yaml --stats --speed-fluctuation 0.02 -o "$tmp/x.csv"
 check "mech check bad springs" check tests/bad/63-springs.yaml
