@@ -51,3 +51,30 @@ done
 echo "target 1 (compile <= 0.5 s CPU): met on $met of $total compiled examples; the cause where"
 echo "not: the straight-line code and the unrolled block kernels of one source per mechanism"
 echo "(gcc -O2; docs/codegen.md, 'Compile time, what was tried')"
+
+# A sweep's variants share one compiled solver (target 1: "every variant of
+# a sweep ... compile at most once"): 200 variants of the conveyor with
+# forces (two lengths, leaves of the solver), one thread, the compiler's runs
+# counted through a $CC that logs them; CPU of the sweep interpreted, then
+# compiled with an empty cache, then again from the cache.
+sweep_cpu() {  # sweep_cpu ENGINE OUT: CPU seconds; the messages in $tmp/err
+    /usr/bin/time -f "cpu %U %S" "$MECH" sweep mechanisms/conveyor.yaml --vary l1=55mm:65mm:20 \
+        --vary l4=435mm:445mm:10 --forces --metric maxabs:driver.torque -j 1 --engine "$1" \
+        -o "$2" 2>"$tmp/err" >/dev/null || return 1
+    awk '/^cpu / { printf "%.3f\n", $2 + $3 }' "$tmp/err"
+}
+printf '#!/bin/sh\necho run >>"%s/cc.log"\nexec %s "$@"\n' "$tmp" "${CC:-cc}" >"$tmp/cc-log"
+chmod +x "$tmp/cc-log"
+rm -rf "$MECH_CACHE_DIR" "$tmp/cc.log"
+si=$(sweep_cpu interpreted "$tmp/si.csv")
+sc=$(CC=$tmp/cc-log sweep_cpu compiled "$tmp/sc.csv")
+sw=$(CC=$tmp/cc-log sweep_cpu compiled "$tmp/sw.csv")
+runs=$(wc -l <"$tmp/cc.log" 2>/dev/null || echo 0)
+same=no
+cmp -s "$tmp/si.csv" "$tmp/sc.csv" && cmp -s "$tmp/si.csv" "$tmp/sw.csv" && same=yes
+echo
+echo "a sweep of 200 conveyor variants with forces (72 200 rows, one thread): CPU seconds"
+printf '%-14s %-14s %-14s %-16s %s\n' interpreted "compiled cold" "compiled warm" "compiler runs" "summaries identical"
+printf '%-14s %-14s %-14s %-16s %s\n' "${si:--}" "${sc:--}" "${sw:--}" "$runs" "$same"
+[ "$runs" = 1 ] && [ "$same" = yes ] && verdict=met || verdict="not met"
+echo "target 1 (a sweep's variants compile at most once, in two sweeps of one structure): $verdict"
