@@ -414,6 +414,18 @@ env MECH_CACHE_DIR="$tmp/swc3" TMPDIR=$tmp/jt CC=false "$MECH" sweep \
 [ $? = 0 ] && cmp -s "$tmp/sw-a.csv" "$tmp/sw-f.csv" &&
     grep -q "^mech sweep: note: the compiled solver: no C compiler ran ('false'.*; the interpreter solves the variants$" "$tmp/sw-f.err" &&
     pass || fail "sweep --engine compiled, no compiler: $(cat "$tmp/sw-f.err")"
+# the engine changes no result: shards solved by either merge (it is not in
+# their manifests' arguments)
+for k in 0 1; do
+    e=compiled
+    [ $k = 1 ] && e=interpreted
+    env MECH_CACHE_DIR="$tmp/swc" TMPDIR=$tmp/jt CC=$tmp/cc-log "$MECH" sweep \
+        mechanisms/offset-slider-crank.yaml --vary e=10mm:40mm:3 --engine $e --shard $k/2 -q \
+        -o "$tmp/shard$k.csv" 2>/dev/null
+done
+"$MECH" merge -o "$tmp/merged.csv" "$tmp/shard0.csv" "$tmp/shard1.csv" 2>"$tmp/merge.err" &&
+    ! grep -q engine "$tmp/shard0.csv" && cmp -s "$tmp/merged.csv" "$tmp/sw-a.csv" && pass ||
+    fail "sweep: shards of both engines do not merge to the whole: $(cat "$tmp/merge.err")"
 [ -z "$(ls "$tmp/jt")" ] && pass || fail "sweep: files left in TMPDIR: $(ls "$tmp/jt")"
 
 # ---- what the compiled rows do not follow, and the assembly's checks -----

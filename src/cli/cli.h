@@ -240,6 +240,7 @@ enum { CMD_ENGINE_AUTO, CMD_ENGINE_COMPILED, CMD_ENGINE_INTERPRETED };
 extern const cmd_word cmd_engine_words[];
 #define CMD_ENGINE_ENTRY(at_)                                                            \
     {.names = "--engine", .kind = CMD_OPT_WORD, .at = (at_), .words = cmd_engine_words,   \
+     .flags = CMD_RUN_ONLY, /* the same table either way: shards of both merge */       \
      .expect = "is auto, compiled or interpreted", .label = "--engine E",                \
      .help = "compiled: solve with the code 'mech codegen' writes,\n"                     \
              "compiled by $CC (else cc) and loaded, the same table;\n"                    \
