@@ -394,6 +394,15 @@ sweep_pair "steering, far from the guess" "$tmp/steering-arm.yaml" --vary arm=14
 has_line "$tmp/sw-c.err" ": 3 variants compiled, 0 interpreted$" "sweep: steering compiled"
 [ "$(grep -c "warning: link 'knuckle_l' is at 15.0 deg in the first position, far from the guess" \
     "$tmp/sw-c.err")" = 3 ] && pass || fail "sweep: the compiled variants' assembly warnings"
+# the guesses are a variant's too: a parameter that only guesses picks the
+# assembly (B above or below the line of the pivots)
+sed -e 's|^ground:|parameters: {gc: 40 deg}\nground:|' -e 's|^  coupler: 40$|  coupler: gc|' \
+    -e 's|^  rocker: 100$|  rocker: 2.5 * gc|' -e '/^branch:/,+1d' mechanisms/fourbar.yaml \
+    >"$tmp/fourbar-guess.yaml"
+sweep_pair "four-bar, guessed assemblies" "$tmp/fourbar-guess.yaml" --list gc=40deg,-40deg \
+    --metric max:B.y
+grep -q "^1,-0.698.*,ok,361,-0.0279" "$tmp/sw-c.csv" && pass ||
+    fail "sweep: the guess of variant 1 did not assemble B below: $(cat "$tmp/sw-c.csv")"
 # auto: compiled when the rows of all the variants pay for it
 rm -rf "$tmp/swc" "$tmp/cc.log"
 env -u MECH_JIT_AUTO MECH_JIT_AUTO_ROWS=1000 MECH_CACHE_DIR="$tmp/swc" TMPDIR=$tmp/jt \
