@@ -151,9 +151,25 @@ done:
     return rc;
 }
 
-int blocklu_factor(blocklu *b, const double *Ax)
+/* One dense 2 x 2 block with nothing above it (a single loop's two
+ * unknowns: a four-bar, a slider-crank) is the commonest system: the
+ * functions below pass it to the runtime's loops as a table whose sizes are
+ * constants in the call, which the compiler unrolls as it does for the
+ * generated code's tables (the loops' overhead is most of the work at this
+ * size). The same operations in the same order: the same values. */
+static const int one_R[2] = {0, 2}, one_at[1] = {0}, one_op[3] = {0, 0, 0};
+
+static int one_2x2(const rt_blocks *rb)
 {
-    const rt_blocks *rb = &b->plan->rb;
+    return rb->n == 2 && rb->nblocks == 1 && rb->nnz == 4 && rb->dense_full;
+}
+
+#define ONE_2X2(rb)                                                                           \
+    ((rt_blocks){2, 1, 4, 4, 1, (rb)->pq_parity, (rb)->P, (rb)->Q, one_R, one_at, (rb)->where, \
+                 one_op, (rb)->oi, (rb)->oj})
+
+RT_INLINE int factor_with(blocklu *b, const rt_blocks *rb, const double *Ax)
+{
     b->singular_col = -1;
     if (rt_blocks_place(rb, Ax, b->v) < 0)
         return -1;
@@ -166,7 +182,26 @@ int blocklu_factor(blocklu *b, const double *Ax)
     return 0;
 }
 
-void blocklu_solve(blocklu *b, double *x) { rt_blocks_solve(&b->plan->rb, b->v, b->piv, b->w, x); }
+int blocklu_factor(blocklu *b, const double *Ax)
+{
+    const rt_blocks *rb = &b->plan->rb;
+    if (one_2x2(rb)) {
+        const rt_blocks one = ONE_2X2(rb);
+        return factor_with(b, &one, Ax);
+    }
+    return factor_with(b, rb, Ax);
+}
+
+void blocklu_solve(blocklu *b, double *x)
+{
+    const rt_blocks *rb = &b->plan->rb;
+    if (one_2x2(rb)) {
+        const rt_blocks one = ONE_2X2(rb);
+        rt_blocks_solve(&one, b->v, b->piv, b->w, x);
+        return;
+    }
+    rt_blocks_solve(rb, b->v, b->piv, b->w, x);
+}
 
 double blocklu_rcond_whole(blocklu *b)
 {
@@ -175,7 +210,12 @@ double blocklu_rcond_whole(blocklu *b)
 
 int blocklu_rcond_bounds(blocklu *b, double *rcond, double *rcond_whole)
 {
-    return rt_blocks_rcond_bounds(&b->plan->rb, b->v, b->piv, b->anorm, b->w, rcond, rcond_whole);
+    const rt_blocks *rb = &b->plan->rb;
+    if (one_2x2(rb)) {
+        const rt_blocks one = ONE_2X2(rb);
+        return rt_blocks_rcond_bounds(&one, b->v, b->piv, b->anorm, b->w, rcond, rcond_whole);
+    }
+    return rt_blocks_rcond_bounds(rb, b->v, b->piv, b->anorm, b->w, rcond, rcond_whole);
 }
 
 double blocklu_rcond(blocklu *b)
