@@ -15,6 +15,7 @@ check() {  # check LABEL ARGS...: valgrind must report nothing (exit 99 on error
     shift
     valgrind -q --leak-check=full --show-leak-kinds=definite,indirect \
         --errors-for-leak-kinds=definite,indirect --error-exitcode=99 \
+        --suppressions=tests/valgrind.supp \
         "$MECH" "$@" >"$tmp/out" 2>"$tmp/err"
     if [ $? -eq 99 ]; then
         failed=$((failed + 1))
@@ -79,7 +80,7 @@ check "mech fit, constraints and free timing" fit "$tmp/cons.yaml" --free r,l,b 
 # mech watch: served, saved (good, broken, good again), requests refused,
 # a long poll and an idle connection open at SIGINT; nothing may leak
 cp mechanisms/fourbar.yaml "$tmp/w.yaml"
-valgrind -q --leak-check=full --show-leak-kinds=definite,indirect \
+valgrind -q --suppressions=tests/valgrind.supp --leak-check=full --show-leak-kinds=definite,indirect \
     --errors-for-leak-kinds=definite,indirect --error-exitcode=99 \
     "$MECH" watch "$tmp/w.yaml" >"$tmp/url" 2>"$tmp/werr" &
 wpid=$!
