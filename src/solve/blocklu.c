@@ -143,6 +143,7 @@ int blocklu_analyze(blocklu_plan *b, int n, const int *Ap, const int *Ai, int ma
     b->pq_parity = permutation_parity(b->P, n, seen) ^ permutation_parity(b->Q, n, seen);
     b->rb = (rt_blocks){n, b->nblocks, b->ndense, b->nnz, b->dense_full, b->pq_parity,
                         b->P, b->Q, b->R, b->at, b->where, b->op, b->oi, b->oj};
+    b->one_2x2 = n == 2 && b->nblocks == 1 && b->nnz == 4 && b->dense_full;
     rc = 0;
 done:
     free(work);
@@ -158,11 +159,6 @@ done:
  * generated code's tables (the loops' overhead is most of the work at this
  * size). The same operations in the same order: the same values. */
 static const int one_R[2] = {0, 2}, one_at[1] = {0}, one_op[3] = {0, 0, 0};
-
-static int one_2x2(const rt_blocks *rb)
-{
-    return rb->n == 2 && rb->nblocks == 1 && rb->nnz == 4 && rb->dense_full;
-}
 
 #define ONE_2X2(rb)                                                                           \
     ((rt_blocks){2, 1, 4, 4, 1, (rb)->pq_parity, (rb)->P, (rb)->Q, one_R, one_at, (rb)->where, \
@@ -185,7 +181,7 @@ RT_INLINE int factor_with(blocklu *b, const rt_blocks *rb, const double *Ax)
 int blocklu_factor(blocklu *b, const double *Ax)
 {
     const rt_blocks *rb = &b->plan->rb;
-    if (one_2x2(rb)) {
+    if (b->plan->one_2x2) {
         const rt_blocks one = ONE_2X2(rb);
         return factor_with(b, &one, Ax);
     }
@@ -195,7 +191,7 @@ int blocklu_factor(blocklu *b, const double *Ax)
 void blocklu_solve(blocklu *b, double *x)
 {
     const rt_blocks *rb = &b->plan->rb;
-    if (one_2x2(rb)) {
+    if (b->plan->one_2x2) {
         const rt_blocks one = ONE_2X2(rb);
         rt_blocks_solve(&one, b->v, b->piv, b->w, x);
         return;
@@ -211,7 +207,7 @@ double blocklu_rcond_whole(blocklu *b)
 int blocklu_rcond_bounds(blocklu *b, double *rcond, double *rcond_whole)
 {
     const rt_blocks *rb = &b->plan->rb;
-    if (one_2x2(rb)) {
+    if (b->plan->one_2x2) {
         const rt_blocks one = ONE_2X2(rb);
         return rt_blocks_rcond_bounds(&one, b->v, b->piv, b->anorm, b->w, rcond, rcond_whole);
     }

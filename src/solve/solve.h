@@ -44,6 +44,7 @@ typedef struct blocklu_plan {
                                   structural zero to clear before factoring) */
     int pq_parity;             /* parity of P and Q together */
     rt_blocks rb;              /* the same as the runtime's table (rt_blocklu.h: the kernels) */
+    int one_2x2;               /* one dense 2 x 2 block, nothing above (blocklu.c ONE_2X2) */
 } blocklu_plan;
 
 /* Factors of one matrix with an analysed pattern (per thread). */
