@@ -46,12 +46,14 @@ static const char *const wrapper[] = {
     "",
     "size_t jit_state_size(void);",
     "int jit_nout(void);",
+    "int jit_nx(void);",
     "const char *const *jit_names(void);",
     "int jit_row(void *vs, const void *num, double q, double qd, double qdd, int first,",
     "            double *out, double *info, double *x);",
     "",
     "size_t jit_state_size(void) { return sizeof(jit_state); }",
     "int jit_nout(void) { return JIT_NOUT; }",
+    "int jit_nx(void) { return NX; }",
     "const char *const *jit_names(void) { return jit_column_names; }",
     "",
     "/* Row q: 0 solved (out, info, x set), a status of jit_solve, or -1 where the",
@@ -129,6 +131,7 @@ typedef struct jit {
     void *so;
     size_t (*state_size)(void);
     int (*nout)(void);
+    int (*nx)(void);           /* the unknowns solved: x of jit_row */
     const char *const *(*names)(void);
     int (*row)(void *, const void *, double, double, double, int, double *, double *,
                double *);
@@ -525,13 +528,14 @@ static int build_in_dir(jit *j, const jit_spec *sp, mech_solve_stats *st, int ca
     if (!j->so)
         return snprintf(note, size, "dlopen: %s", dlerror()), -1;
     /* POSIX: dlsym's object pointer holds a function's address */
-    void *f[4] = {dlsym(j->so, "jit_state_size"), dlsym(j->so, "jit_nout"),
-                  dlsym(j->so, "jit_names"), dlsym(j->so, "jit_row")};
+    void *f[5] = {dlsym(j->so, "jit_state_size"), dlsym(j->so, "jit_nout"),
+                  dlsym(j->so, "jit_names"), dlsym(j->so, "jit_row"), dlsym(j->so, "jit_nx")};
     memcpy(&j->state_size, &f[0], sizeof f[0]);
     memcpy(&j->nout, &f[1], sizeof f[1]);
     memcpy(&j->names, &f[2], sizeof f[2]);
     memcpy(&j->row, &f[3], sizeof f[3]);
-    if (!j->state_size || !j->nout || !j->names || !j->row)
+    memcpy(&j->nx, &f[4], sizeof f[4]);
+    if (!j->state_size || !j->nout || !j->names || !j->row || !j->nx)
         return snprintf(note, size, "the shared object lacks its functions"), -1;
     return 0;
 }
@@ -618,6 +622,9 @@ static int jit_sweep(jit_run *r, mech_table *t, mech_solve_stats *st, int *bad, 
     if (nout != t->ncolumns)
         return snprintf(note, size, "the generated code has %d columns, mech solve %d", nout,
                         t->ncolumns), -1;
+    if (j->nx() != ns)  /* x holds ns */
+        return snprintf(note, size, "the generated code solves %d unknowns, mech solve %d",
+                        j->nx(), ns), -1;
     for (int c = 0; c < nout; c++)
         if (strcmp(names[c], t->columns[c].name) != 0)
             return snprintf(note, size, "column %d is %s, mech solve's %s", c + 1, names[c],
