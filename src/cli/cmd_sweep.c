@@ -344,18 +344,16 @@ static int row_checks(const void *sweep, const char *row, size_t len, char *why,
     return sweep_row_content(sweep, row, len, why, size);
 }
 
-/* Which solver the variants through the sweep's one analysis had
- * (docs/batch.md, "One compiled solver"). */
+/* The compiled solver, and how many variants it solved, when it solved
+ * some (as mech batch says of a file; docs/batch.md, "One compiled solver
+ * per sweep"): the interpreter's runs say nothing more than before. */
 static void solver_summary(cmd_jit_variants *jv)
 {
     long compiled = 0, interpreted = 0;
-    const char *how = jv ? cmd_jit_variants_how(jv, &compiled, &interpreted)
-                         : "interpreted (--engine interpreted)";
-    fprintf(stderr, "mech sweep: solver %s", how);
+    const char *how = jv ? cmd_jit_variants_how(jv, &compiled, &interpreted) : "";
     if (compiled > 0)
-        fprintf(stderr, ": %ld variant%s compiled, %ld interpreted", compiled,
-                compiled == 1 ? "" : "s", interpreted);
-    fputc('\n', stderr);
+        fprintf(stderr, "mech sweep: solver %s: %ld variant%s compiled, %ld interpreted\n", how,
+                compiled, compiled == 1 ? "" : "s", interpreted);
 }
 
 /* This shard's variants, solved on worker threads (mech_sweep_run), each
