@@ -56,8 +56,9 @@ static const char *const wrapper[] = {
     "int jit_nx(void) { return NX; }",
     "const char *const *jit_names(void) { return jit_column_names; }",
     "",
-    "/* Row q: 0 solved (out, info, x set), a status of jit_solve, or -1 where the",
-    " * interpreter's continuation would not accept its first step. num: a sweep's",
+    "/* Row q: 0 solved (out, info and, unless NULL, x set), a status of",
+    " * jit_solve, or -1 where the interpreter's continuation would not accept",
+    " * its first step. num: a sweep's",
     " * variant's numbers (struct rt_numbers) for the first row of a solver built",
     " * for them, else unused. */",
     "int jit_row(void *vs, const void *num, double q, double qd, double qdd, int first,",
@@ -95,7 +96,7 @@ static const char *const wrapper[] = {
     "        return st;",
     "    for (int c = 0; c < JIT_NOUT; c++)",
     "        out[c] = s->out[c];",
-    "    for (int i = 0; i < NX; i++)",
+    "    for (int i = 0; x && i < NX; i++)",
     "        x[i] = s->x[i];",
     "    info[0] = s->iterations;",
     "    info[1] = s->residual;",
@@ -457,8 +458,6 @@ static int compile(cc_command *cp, char *note, size_t size)
                     w == pid && WIFEXITED(status) ? WEXITSTATUS(status) : -1), -1;
 }
 
-/* Generate, compile and load the solver of m in the private directory: 0,
- * or -1 with why in note. */
 /* What a build is of: model m with options o; with leaves (a sweep's
  * variants), the generated code reads their numbers (codegen_options). */
 typedef struct jit_spec {
@@ -469,6 +468,8 @@ typedef struct jit_spec {
                                   (codegen_numbers_fill), else freed */
 } jit_spec;
 
+/* Generate, compile and load the solver of sp in the private directory:
+ * 0, or -1 with why in note. */
 static int build_in_dir(jit *j, const jit_spec *sp, mech_solve_stats *st, int cached_only,
                         char *note, size_t size)
 {
@@ -640,8 +641,9 @@ static int jit_sweep(jit_run *r, mech_table *t, mech_solve_stats *st, int *bad, 
     for (int i = 0; !rc && i < r->nq; i++) {
         double *out = t->values + (size_t)i * (size_t)nout;
         info[2] = st->min_rcond;
+        double *keep = i >= r->smp.next_row ? x : NULL;  /* only the assembly's samples */
         rc = j->row(s, r->num, r->q[i], r->m->driver.speed, r->m->driver.accel, i == 0, out,
-                    info, x);
+                    info, keep);
         if (rc != 0) {
             snprintf(note, size, "the generated code %s at row %d", row_failure(rc), i + 1);
             break;
@@ -650,7 +652,7 @@ static int jit_sweep(jit_run *r, mech_table *t, mech_solve_stats *st, int *bad, 
             *bad = i;  /* sweep.c's fill_row: the row is not added, the sweep stops */
             break;
         }
-        if (i >= r->smp.next_row)
+        if (keep)
             assembly_take(&r->smp, i, r->q[i], x);
         row_stats(st, info, r->q[i]);
         t->nrows = i + 1;

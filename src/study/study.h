@@ -138,10 +138,12 @@ int sweep_variant_solve(sweep_shared *sh, const mech_override *ov, int nov, mech
 void sweep_variant_counts(const sweep_shared *sh, long *shared, long *alone);
 
 /* Another solver of the variants than the interpreter (mech sweep's
- * compiled one, src/cli/jit_sweep.c): solve(ctx, b, view, mv, t, d) solves
+ * compiled one, src/cli/cmd_codegen_jit.c): solve(ctx, b, view, mv, t, d) solves
  * variant mv through view (b's analysis with mv's numbers) into t, with
  * any notes in d: MECH_OK, or VBASE_INTERPRET (nothing in t or d): the
  * interpreter solves it. Called from the sweep's worker threads. */
+/* The analysed base of a sweep, shared read only by the variants
+ * (variant_regs.c, below). */
 typedef struct variant_base variant_base;
 typedef struct sweep_engine {
     int (*solve)(void *ctx, const variant_base *b, const mech_analysis *view,
@@ -182,9 +184,6 @@ const forces_plan *analysis_forces_plan(const mech_analysis *a);
 int analysis_assembly_check(const mech_analysis *a, assembly_samples *smp, mech_diag *d);
 /* Its driver positions, *n of them. */
 const double *analysis_positions(const mech_analysis *a, int *n);
-
-/* The analysed base of a sweep, shared read only by the variants
- * (variant_base, declared above). */
 
 /* The base: model `base` (checked; owned from here on, also on failure),
  * the parameters names[0..nnames-1] that the variants change, forces as

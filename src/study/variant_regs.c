@@ -22,8 +22,8 @@ struct variant_base {
     const loop_term **term;    /* [nterms] */
     int *rvar, *avar;          /* [nterms] variable of the length / angle, or -1 (folded) */
     double *r0, *a0;           /* [nterms] the base's length and angle */
-    int *which;                /* [nnames] the varied parameters (indices) */
-    sys_leaves leaves;         /* the system's leaves: SYS_LEAF_POLAR of which */
+    sys_leaves leaves;         /* the system's leaves: SYS_LEAF_POLAR of the varied
+                                  parameters (leaves.params owned) */
     int forces;                /* the analysis's forces flag */
 };
 
@@ -43,7 +43,7 @@ void vbase_free(variant_base **pb)
     free(b->avar);
     free(b->r0);
     free(b->a0);
-    free(b->which);
+    free((int *)b->leaves.params);  /* allocated here (vbase_new) */
     free(b);
     *pb = NULL;
 }
@@ -105,8 +105,7 @@ int vbase_new(mech_model *base, const char *const *names, int nnames, int with_f
             rc = diag_error(d, base->file, (mech_mark){0, 0}, "no parameter '%s'", names[i]);
     }
     mech_system *sys = NULL;
-    b->which = which;  /* the base's */
-    b->leaves = (sys_leaves){SYS_LEAF_POLAR, which, nnames};
+    b->leaves = (sys_leaves){SYS_LEAF_POLAR, which, nnames};  /* owns which */
     b->forces = with_forces;
     if (rc == MECH_OK)
         rc = sys_new_with(base, &b->leaves, &sys, d);
